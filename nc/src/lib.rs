@@ -1,0 +1,5 @@
+//! NC core: the NC language, double-NURBS evaluation, feed planning, kinematics and the
+//! allocation-free per-period interpolation step.
+#![forbid(unsafe_code)]
+
+pub mod program;

@@ -1,0 +1,114 @@
+//! The parsed NC program: what the parser (`crate::parse`) produces and the segment
+//! builder (`crate::segment`) consumes.
+//!
+//! Every modal value is resolved by the parser, so each move here is complete: a linear move
+//! carries its full end point and tool orientation, a NURBS block its full control net.
+//! Control nets live in fixed-capacity `heapless` vectors: a block is a value of known size
+//! that can later travel through the real-time queue without touching the heap.
+
+use heapless::Vec as HVec;
+
+/// Highest NURBS degree accepted (`G06.5 P5`, `G06.2 P6`).
+pub const MAX_DEGREE: usize = 5;
+/// Most control points one NURBS block may carry. Fixed so a block has a known size.
+pub const MAX_CTRL: usize = 64;
+/// Most knots one NURBS block may carry: control points + degree + 1.
+pub const MAX_KNOTS: usize = MAX_CTRL + MAX_DEGREE + 1;
+
+/// Where a token stands in the source: 1-based line and column (in characters).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct SrcPos {
+    pub line: u32,
+    pub col: u32,
+}
+
+impl core::fmt::Display for SrcPos {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{}:{}", self.line, self.col)
+    }
+}
+
+/// Tool orientation as programmed on a linear move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Orientation {
+    /// `A_ C_` (or `B_ C_` on an xyzbc machine): machine rotary angles in degrees,
+    /// interpolated linearly in angle along the move.
+    Angles { r1_deg: f64, r2_deg: f64 },
+    /// `I_ J_ K_`: tool-axis vector in the workpiece frame, normalised by the parser,
+    /// interpolated along the great circle (slerp).
+    Vector([f64; 3]),
+}
+
+/// `G00` / `G01`: a straight move of the cutter centre with (optionally) changing orientation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LinearMove {
+    /// Position of the `G00`/`G01` word (or of the first word of a modal-motion line).
+    pub pos: SrcPos,
+    /// `N` number, if the line had one.
+    pub n: Option<u32>,
+    /// `true` for G00 (moves at the machine's rapid feed).
+    pub rapid: bool,
+    /// End point of the cutter centre, workpiece frame, mm (modal X/Y/Z resolved).
+    pub end: [f64; 3],
+    /// Tool orientation at the end point (modal: the previous one if the line gave none).
+    pub orientation: Orientation,
+    /// Programmed feed, mm/min (ignored for rapid moves; may then be 0).
+    pub feed_mm_min: f64,
+}
+
+/// Which NURBS word opened the block.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NurbsKind {
+    /// `G06.2`: Fanuc 3-axis NURBS. The tool orientation stays as it was before the block.
+    G062,
+    /// `G06.5`: the paper's double NURBS, with the orientation curve's control points in U V W.
+    G065,
+}
+
+/// `G06.2` / `G06.5`: one (double) NURBS curve with shared knots and weights.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NurbsBlock {
+    pub pos: SrcPos,
+    pub n: Option<u32>,
+    pub kind: NurbsKind,
+    /// Degree p (for G06.2 the parser converts the rank P to p = P - 1).
+    pub degree: u8,
+    /// Control points of the cutter-centre curve C(u), X Y Z, mm.
+    pub ctrl: HVec<[f64; 3], MAX_CTRL>,
+    /// Control points of the orientation curve CT(u), U V W (G06.5 only; empty for G06.2).
+    pub tool_ctrl: HVec<[f64; 3], MAX_CTRL>,
+    /// Source position of each control point's first word, for error messages.
+    pub ctrl_pos: HVec<SrcPos, MAX_CTRL>,
+    /// Weights R (default 1.0 where a line has none), one per control point.
+    pub weights: HVec<f64, MAX_CTRL>,
+    /// Knot vector, `ctrl.len() + degree + 1` values, non-decreasing and clamped.
+    pub knots: HVec<f64, MAX_KNOTS>,
+    /// Programmed feed, mm/min (modal F resolved).
+    pub feed_mm_min: f64,
+}
+
+/// One motion block of the program.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Block {
+    Linear(LinearMove),
+    Nurbs(NurbsBlock),
+}
+
+impl Block {
+    pub fn pos(&self) -> SrcPos {
+        match self {
+            Block::Linear(m) => m.pos,
+            Block::Nurbs(b) => b.pos,
+        }
+    }
+}
+
+/// A whole parsed program. The first block must be a linear move with a full X Y Z (and
+/// orientation, else the tool is vertical): it defines the start pose, and the interpolator
+/// starts there (no motion is generated towards it).
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct Program {
+    pub blocks: Vec<Block>,
+    /// Where `M02`/`M30` stood, if the program had one.
+    pub end: Option<SrcPos>,
+}

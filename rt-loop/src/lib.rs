@@ -1,0 +1,1 @@
+//! The real-time thread. Filled by issue 4 ("The real-time pipeline").
