@@ -2,4 +2,6 @@
 //! allocation-free per-period interpolation step.
 #![forbid(unsafe_code)]
 
+pub mod arclen;
+pub mod nurbs;
 pub mod program;

@@ -1,0 +1,189 @@
+//! Arc length of the cutter curve and its inverse u(s), for the `arclength` parameter update.
+//!
+//! Built once per block, outside the real-time thread: every non-empty knot span is cut into
+//! equal parameter steps and each step's length is integrated with 8-point Gauss-Legendre,
+//! giving a table of nodes (u_i, s_i, |C'(u_i)|). Per period, u(s) is found by
+//!   1. locating the node interval holding s (binary search, bounded);
+//!   2. cubic Hermite interpolation between the two nodes, using du/ds = 1/|C'| at both ends;
+//!   3. Newton steps on S(u) - s = 0 with S(u) = s_i + integral from u_i to u of |C'|,
+//!      integrated by 4-point Gauss-Legendre (the interval lies inside one knot span, where
+//!      |C'| is smooth) and the derivative dS/du = |C'(u)|.
+//!
+//! Newton converges quadratically from the Hermite guess; two steps bring the residual far
+//! below a nanometre on the paper's block, which keeps the feed fluctuation under 1e-4
+//! (see the `interp` tests).
+
+use crate::nurbs::DoubleNurbs;
+use heapless::Vec as HVec;
+
+/// Table capacity per block.
+pub const MAX_NODES: usize = 1025;
+/// Newton steps per evaluation (bounded, no convergence loop in the real-time path).
+pub const NEWTON_STEPS: usize = 2;
+
+/// Gauss-Legendre 8-point nodes and weights on [-1, 1].
+const GL8: [(f64, f64); 8] = [
+    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (-0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
+    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+];
+/// Gauss-Legendre 4-point nodes and weights on [-1, 1].
+const GL4: [(f64, f64); 4] = [
+    (-0.861_136_311_594_052_6, 0.347_854_845_137_453_85),
+    (-0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.339_981_043_584_856_3, 0.652_145_154_862_546_1),
+    (0.861_136_311_594_052_6, 0.347_854_845_137_453_85),
+];
+
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Node {
+    u: f64,
+    s: f64,
+    /// |C'(u)|, clamped away from 0.
+    speed: f64,
+}
+
+/// Smallest parametric speed used as a divisor (mm per unit u). A curve that slows below it
+/// is treated as having a cusp there; the parser rejects such nets.
+const MIN_SPEED: f64 = 1e-12;
+
+/// Arc-length table of one block's cutter curve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArcTable {
+    nodes: HVec<Node, MAX_NODES>,
+}
+
+fn integrate(curve: &DoubleNurbs, a: f64, b: f64, rule: &[(f64, f64)]) -> f64 {
+    let (m, h) = (0.5 * (a + b), 0.5 * (b - a));
+    rule.iter().map(|&(x, w)| w * curve.speed(m + h * x)).sum::<f64>() * h
+}
+
+impl ArcTable {
+    /// Tabulate the curve, spending the node budget evenly across its non-empty spans.
+    pub fn new(curve: &DoubleNurbs) -> Self {
+        let knots = curve.knots();
+        let spans = knots.windows(2).filter(|w| w[1] > w[0]).count().max(1);
+        let per_span = ((MAX_NODES - 1) / spans).clamp(1, 64);
+        let mut nodes: HVec<Node, MAX_NODES> = HVec::new();
+        let (u0, _) = curve.range();
+        let node = |u: f64, s: f64| Node {
+            u,
+            s,
+            speed: curve.speed(u).max(MIN_SPEED),
+        };
+        let _ = nodes.push(node(u0, 0.0));
+        let mut s = 0.0;
+        for w in knots.windows(2).filter(|w| w[1] > w[0]) {
+            let (a, b) = (w[0], w[1]);
+            for i in 0..per_span {
+                let ua = a + (b - a) * i as f64 / per_span as f64;
+                let ub = if i + 1 == per_span {
+                    b
+                } else {
+                    a + (b - a) * (i + 1) as f64 / per_span as f64
+                };
+                s += integrate(curve, ua, ub, &GL8);
+                // spans * per_span + 1 <= MAX_NODES by construction.
+                let _ = nodes.push(node(ub, s));
+            }
+        }
+        ArcTable { nodes }
+    }
+
+    /// Total arc length of the cutter curve, mm.
+    pub fn length(&self) -> f64 {
+        self.nodes.last().map_or(0.0, |n| n.s)
+    }
+
+    /// Arc length from the start to parameter u (non-real-time helper for tests and reports).
+    pub fn s_of_u(&self, curve: &DoubleNurbs, u: f64) -> f64 {
+        let n = &self.nodes;
+        let i = n.partition_point(|x| x.u <= u).saturating_sub(1).min(n.len() - 2);
+        n[i].s + integrate(curve, n[i].u, u.clamp(n[i].u, n[i + 1].u), &GL8)
+    }
+
+    /// Parameter u at arc length s (clamped to [0, length]). Allocation-free and bounded:
+    /// one binary search, one Hermite guess, [`NEWTON_STEPS`] Newton steps.
+    pub fn u_of_s(&self, curve: &DoubleNurbs, s: f64) -> f64 {
+        let n = &self.nodes;
+        let len = n.len();
+        if len < 2 {
+            return n.first().map_or(0.0, |x| x.u);
+        }
+        let s = s.clamp(0.0, n[len - 1].s);
+        let i = n.partition_point(|x| x.s <= s).saturating_sub(1).min(len - 2);
+        let (a, b) = (n[i], n[i + 1]);
+        let ds = b.s - a.s;
+        if ds <= 0.0 {
+            return a.u;
+        }
+        // Cubic Hermite for u(s) with end slopes 1/|C'|.
+        let t = (s - a.s) / ds;
+        let (t2, t3) = (t * t, t * t * t);
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        let mut u = h00 * a.u + h10 * ds / a.speed + h01 * b.u + h11 * ds / b.speed;
+        u = u.clamp(a.u, b.u);
+        for _ in 0..NEWTON_STEPS {
+            let f = a.s + integrate(curve, a.u, u, &GL4) - s;
+            let d = curve.speed(u).max(MIN_SPEED);
+            u = (u - f / d).clamp(a.u, b.u);
+        }
+        u
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nurbs::tests::paper;
+
+    #[test]
+    fn quarter_circle_length_is_pi_over_two() {
+        let s = core::f64::consts::FRAC_1_SQRT_2;
+        let c = DoubleNurbs::new(
+            2,
+            &[[10.0, 0.0, 0.0], [10.0, 10.0, 0.0], [0.0, 10.0, 0.0]],
+            &[],
+            &[1.0, s, 1.0],
+            &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap();
+        let t = ArcTable::new(&c);
+        assert!((t.length() - 5.0 * core::f64::consts::PI).abs() < 1e-12);
+        // On a circle, arc length maps to angle: s = r * phi.
+        for i in 0..=50 {
+            let s_target = t.length() * i as f64 / 50.0;
+            let p = c.cutter(t.u_of_s(&c, s_target), 0).p;
+            let phi = p.y.atan2(p.x);
+            assert!((10.0 * phi - s_target).abs() < 1e-11, "s={s_target} got {}", 10.0 * phi);
+        }
+    }
+
+    #[test]
+    fn inverse_round_trips_on_the_paper_block() {
+        let c = paper();
+        let t = ArcTable::new(&c);
+        // Length by an independent fine Simpson sum over u.
+        let n = 200_000;
+        let h = 1.0 / n as f64;
+        let mut simpson = c.speed(0.0) + c.speed(1.0);
+        for i in 1..n {
+            simpson += c.speed(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        simpson *= h / 3.0;
+        assert!((t.length() - simpson).abs() < 1e-9, "{} vs {simpson}", t.length());
+        for i in 0..=1000 {
+            let s = t.length() * i as f64 / 1000.0;
+            let u = t.u_of_s(&c, s);
+            assert!((t.s_of_u(&c, u) - s).abs() < 1e-9, "s={s}");
+        }
+    }
+}

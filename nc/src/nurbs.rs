@@ -1,0 +1,490 @@
+//! Rational B-spline evaluation for the double-NURBS block: the cutter-centre curve C(u) and
+//! the orientation curve CT(u) share degree, knots and weights (paper eq. 2-3), so one basis
+//! evaluation per period serves both curves.
+//!
+//! Algorithms are the standard ones from Piegl & Tiller, *The NURBS Book*: span search (A2.1),
+//! basis functions with derivatives (A2.3) and derivatives of a rational curve from the
+//! derivatives of its homogeneous form (A4.2). The recursive definition (paper eq. 4, 13) is
+//! used only by the tests, as an independent check.
+//!
+//! Nothing here allocates: control nets are `heapless` vectors of fixed capacity and the
+//! scratch space of A2.3 lives on the stack, sized by [`MAX_DEGREE`]. Loops are bounded by the
+//! degree or by `log2(MAX_KNOTS)`. Evaluation outside the knot range clamps `u` to it.
+
+use crate::program::{MAX_CTRL, MAX_DEGREE, MAX_KNOTS};
+use heapless::Vec as HVec;
+use nalgebra::{Vector3, Vector4};
+
+/// Position, first and second derivative with respect to u of one curve.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Ders {
+    pub p: Vector3<f64>,
+    pub d1: Vector3<f64>,
+    pub d2: Vector3<f64>,
+}
+
+/// Why a control net cannot form a curve. The parser reports these with source positions;
+/// this type guards the constructor for programmatic use.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum CurveError {
+    #[error("degree {0} is outside 1..={MAX_DEGREE}")]
+    Degree(usize),
+    #[error("{ctrl} control points need {expected} knots, got {knots}")]
+    KnotCount {
+        ctrl: usize,
+        knots: usize,
+        expected: usize,
+    },
+    #[error("{0} control points: a degree-p curve needs p+1..={MAX_CTRL}")]
+    CtrlCount(usize),
+    #[error("knot vector is not non-decreasing, clamped and finite with a non-empty range")]
+    Knots,
+    #[error("weight {0} is not finite and > 0")]
+    Weight(f64),
+    #[error("control point is not finite")]
+    NonFinite,
+    #[error("the orientation net has {tool} points, the cutter net {ctrl}")]
+    ToolCount { ctrl: usize, tool: usize },
+}
+
+/// A pair of rational curves with shared degree, knots and weights. For a 3-axis block
+/// (`G06.2`) the orientation net is empty and only C(u) is defined.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DoubleNurbs {
+    degree: usize,
+    knots: HVec<f64, MAX_KNOTS>,
+    /// Homogeneous cutter control points (w x, w y, w z, w).
+    cw: HVec<Vector4<f64>, MAX_CTRL>,
+    /// Homogeneous orientation control points (w u, w v, w w, w); empty for G06.2.
+    tw: HVec<Vector4<f64>, MAX_CTRL>,
+}
+
+/// Basis functions and their first two derivatives at one parameter (A2.3 output).
+#[derive(Clone, Copy, Debug)]
+struct Basis {
+    span: usize,
+    /// `n[k][j]`: k-th derivative of N_{span-p+j,p}.
+    n: [[f64; MAX_DEGREE + 1]; 3],
+}
+
+impl DoubleNurbs {
+    /// Build from a control net. `tool` is either empty or as long as `ctrl`.
+    pub fn new(
+        degree: usize,
+        ctrl: &[[f64; 3]],
+        tool: &[[f64; 3]],
+        weights: &[f64],
+        knots: &[f64],
+    ) -> Result<Self, CurveError> {
+        if !(1..=MAX_DEGREE).contains(&degree) {
+            return Err(CurveError::Degree(degree));
+        }
+        let n = ctrl.len();
+        if n < degree + 1 || n > MAX_CTRL || weights.len() != n {
+            return Err(CurveError::CtrlCount(n));
+        }
+        if !tool.is_empty() && tool.len() != n {
+            return Err(CurveError::ToolCount {
+                ctrl: n,
+                tool: tool.len(),
+            });
+        }
+        let expected = n + degree + 1;
+        if knots.len() != expected {
+            return Err(CurveError::KnotCount {
+                ctrl: n,
+                knots: knots.len(),
+                expected,
+            });
+        }
+        let ok = knots.iter().all(|k| k.is_finite())
+            && knots.windows(2).all(|w| w[0] <= w[1])
+            && knots[..=degree].iter().all(|&k| k == knots[0])
+            && knots[n..].iter().all(|&k| k == knots[n + degree])
+            && knots[n + degree] > knots[0];
+        if !ok {
+            return Err(CurveError::Knots);
+        }
+        let mut out = DoubleNurbs {
+            degree,
+            knots: HVec::new(),
+            cw: HVec::new(),
+            tw: HVec::new(),
+        };
+        // Capacities were checked above, so these pushes cannot fail.
+        out.knots.extend_from_slice(knots).map_err(|_| CurveError::Knots)?;
+        for (i, (&p, &w)) in ctrl.iter().zip(weights).enumerate() {
+            if !(w.is_finite() && w > 0.0) {
+                return Err(CurveError::Weight(w));
+            }
+            let hp = homogeneous(p, w).ok_or(CurveError::NonFinite)?;
+            let _ = out.cw.push(hp);
+            if let Some(&t) = tool.get(i) {
+                let ht = homogeneous(t, w).ok_or(CurveError::NonFinite)?;
+                let _ = out.tw.push(ht);
+            }
+        }
+        Ok(out)
+    }
+
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// Whether the block carries an orientation curve (G06.5).
+    pub fn has_tool_curve(&self) -> bool {
+        !self.tw.is_empty()
+    }
+
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// Parameter range [u_min, u_max].
+    pub fn range(&self) -> (f64, f64) {
+        let k = &self.knots;
+        (k[self.degree], k[k.len() - 1 - self.degree])
+    }
+
+    /// Index of the knot span holding u (A2.1), with `u` already clamped to the range.
+    /// Returns the last non-empty span for u = u_max. At most log2(MAX_KNOTS) iterations.
+    fn find_span(&self, u: f64) -> usize {
+        let n = self.cw.len() - 1; // index of the last control point
+        let k = &self.knots;
+        if u >= k[n + 1] {
+            return n;
+        }
+        if u <= k[self.degree] {
+            return self.degree;
+        }
+        let (mut low, mut high) = (self.degree, n + 1);
+        let mut mid = (low + high) / 2;
+        // Each pass halves [low, high]: bounded by log2(MAX_KNOTS) + 1.
+        for _ in 0..16 {
+            if u < k[mid] {
+                high = mid;
+            } else if u >= k[mid + 1] {
+                low = mid;
+            } else {
+                break;
+            }
+            mid = (low + high) / 2;
+        }
+        mid
+    }
+
+    /// Basis functions and derivatives up to `nd` (<= 2) at u (A2.3).
+    fn basis(&self, u: f64, nd: usize) -> Basis {
+        let (lo, hi) = self.range();
+        let u = u.clamp(lo, hi);
+        let p = self.degree;
+        let span = self.find_span(u);
+        let k = &self.knots;
+        let mut ndu = [[0.0f64; MAX_DEGREE + 1]; MAX_DEGREE + 1];
+        let mut left = [0.0f64; MAX_DEGREE + 1];
+        let mut right = [0.0f64; MAX_DEGREE + 1];
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - k[span + 1 - j];
+            right[j] = k[span + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        let mut out = Basis {
+            span,
+            n: [[0.0; MAX_DEGREE + 1]; 3],
+        };
+        for j in 0..=p {
+            out.n[0][j] = ndu[j][p];
+        }
+        let nd = nd.min(2).min(p);
+        let mut a = [[0.0f64; MAX_DEGREE + 1]; 2];
+        for r in 0..=p {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            a[0][0] = 1.0;
+            for kk in 1..=nd {
+                let mut d = 0.0;
+                let rk = r as isize - kk as isize;
+                let pk = p - kk;
+                if r >= kk {
+                    let rk = rk as usize;
+                    a[s2][0] = a[s1][0] / ndu[pk + 1][rk];
+                    d = a[s2][0] * ndu[rk][pk];
+                }
+                let j1 = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2 = if r as isize - 1 <= pk as isize {
+                    kk - 1
+                } else {
+                    p - r
+                };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    a[s2][kk] = -a[s1][kk - 1] / ndu[pk + 1][r];
+                    d += a[s2][kk] * ndu[r][pk];
+                }
+                out.n[kk][r] = d;
+                core::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut factor = p as f64;
+        for kk in 1..=nd {
+            for j in 0..=p {
+                out.n[kk][j] *= factor;
+            }
+            factor *= (p - kk) as f64;
+        }
+        out
+    }
+
+    /// Derivatives 0..=nd of one rational curve from its homogeneous net (A4.2).
+    fn rational(&self, b: &Basis, net: &[Vector4<f64>], nd: usize) -> Ders {
+        let p = self.degree;
+        let mut aw = [Vector4::zeros(); 3];
+        for (k, awk) in aw.iter_mut().enumerate().take(nd + 1) {
+            for j in 0..=p {
+                *awk += net[b.span - p + j] * b.n[k][j];
+            }
+        }
+        let w0 = aw[0].w;
+        let c0 = aw[0].xyz() / w0;
+        let mut out = Ders {
+            p: c0,
+            ..Ders::default()
+        };
+        if nd >= 1 {
+            out.d1 = (aw[1].xyz() - c0 * aw[1].w) / w0;
+        }
+        if nd >= 2 {
+            out.d2 = (aw[2].xyz() - out.d1 * (2.0 * aw[1].w) - c0 * aw[2].w) / w0;
+        }
+        out
+    }
+
+    /// C(u) and its derivatives up to `nd` (0, 1 or 2).
+    pub fn cutter(&self, u: f64, nd: usize) -> Ders {
+        let b = self.basis(u, nd);
+        self.rational(&b, &self.cw, nd)
+    }
+
+    /// C(u) and CT(u), each with derivatives up to `nd`, from one basis evaluation.
+    /// For a block without orientation curve, the second value equals the first.
+    pub fn both(&self, u: f64, nd: usize) -> (Ders, Ders) {
+        let b = self.basis(u, nd);
+        let c = self.rational(&b, &self.cw, nd);
+        if self.tw.is_empty() {
+            return (c, c);
+        }
+        (c, self.rational(&b, &self.tw, nd))
+    }
+
+    /// |C'(u)|: the parametric speed, the integrand of arc length.
+    pub fn speed(&self, u: f64) -> f64 {
+        self.cutter(u, 1).d1.norm()
+    }
+}
+
+fn homogeneous(p: [f64; 3], w: f64) -> Option<Vector4<f64>> {
+    let v = Vector4::new(p[0] * w, p[1] * w, p[2] * w, w);
+    v.iter().all(|x| x.is_finite()).then_some(v)
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// Cox-de Boor recursion (paper eq. 4), written independently of A2.2/A2.3.
+    fn n_rec(i: usize, p: usize, u: f64, k: &[f64]) -> f64 {
+        if p == 0 {
+            let last = k[k.len() - 1];
+            // Close the last non-empty span on the right so u = u_max evaluates.
+            let in_span = (k[i] <= u && u < k[i + 1]) || (u == last && k[i] < u && k[i + 1] == last);
+            return if in_span { 1.0 } else { 0.0 };
+        }
+        let mut v = 0.0;
+        if k[i + p] > k[i] {
+            v += (u - k[i]) / (k[i + p] - k[i]) * n_rec(i, p - 1, u, k);
+        }
+        if k[i + p + 1] > k[i + 1] {
+            v += (k[i + p + 1] - u) / (k[i + p + 1] - k[i + 1]) * n_rec(i + 1, p - 1, u, k);
+        }
+        v
+    }
+
+    fn rec_point(p: usize, ctrl: &[[f64; 3]], w: &[f64], k: &[f64], u: f64) -> [f64; 3] {
+        let mut num = [0.0; 3];
+        let mut den = 0.0;
+        for i in 0..ctrl.len() {
+            let b = n_rec(i, p, u, k) * w[i];
+            den += b;
+            for a in 0..3 {
+                num[a] += b * ctrl[i][a];
+            }
+        }
+        [num[0] / den, num[1] / den, num[2] / den]
+    }
+
+    /// The paper's block (design.md section 1).
+    pub(crate) fn paper() -> DoubleNurbs {
+        let c = [
+            [47.7773, 71.0202, 58.8006],
+            [44.3229, 75.6066, 54.4778],
+            [37.2164, 84.6443, 44.5755],
+            [28.7567, 101.5653, 29.7151],
+            [-1.6963, 163.6796, 5.8369],
+        ];
+        let t = [
+            [47.8066, 71.9791, 59.0828],
+            [44.3651, 76.5494, 54.8138],
+            [37.2554, 85.5421, 45.0342],
+            [28.7081, 102.3535, 30.3361],
+            [-1.8572, 163.9906, 6.7762],
+        ];
+        let k = [0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0];
+        DoubleNurbs::new(3, &c, &t, &[1.0; 5], &k).unwrap()
+    }
+
+    /// Quarter circle as a rational quadratic: exact radius 1 for every u.
+    fn quarter_circle() -> DoubleNurbs {
+        let s = core::f64::consts::FRAC_1_SQRT_2;
+        DoubleNurbs::new(
+            2,
+            &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            &[],
+            &[1.0, s, 1.0],
+            &[0.0, 0.0, 0.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn rational_quadratic_is_an_exact_circle() {
+        let c = quarter_circle();
+        for i in 0..=100 {
+            let u = i as f64 / 100.0;
+            let d = c.cutter(u, 2);
+            assert!((d.p.norm() - 1.0).abs() < 1e-14, "u={u} r={}", d.p.norm());
+            // Tangent is perpendicular to the radius; curvature of a unit circle is 1.
+            assert!(d.p.dot(&d.d1).abs() < 1e-13);
+            let kappa = d.d1.cross(&d.d2).norm() / d.d1.norm().powi(3);
+            assert!((kappa - 1.0).abs() < 1e-12, "u={u} kappa={kappa}");
+        }
+        // Known values: u=1/2 lies at 45 degrees.
+        let m = c.cutter(0.5, 0).p;
+        assert!((m.x - m.y).abs() < 1e-15 && (m.x - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15);
+    }
+
+    #[test]
+    fn hand_checked_linear_and_bezier_cases() {
+        // Degree 1: a polyline; u=0.25 is halfway along the first leg.
+        let l = DoubleNurbs::new(
+            1,
+            &[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 4.0, 0.0]],
+            &[],
+            &[1.0; 3],
+            &[0.0, 0.0, 0.5, 1.0, 1.0],
+        )
+        .unwrap();
+        assert_eq!(l.cutter(0.25, 1).p, Vector3::new(1.0, 0.0, 0.0));
+        assert_eq!(l.cutter(0.25, 1).d1, Vector3::new(4.0, 0.0, 0.0));
+        assert_eq!(l.cutter(0.75, 0).p, Vector3::new(2.0, 2.0, 0.0));
+        // Cubic Bezier 0,0 / 1,2 / 3,2 / 4,0 at u=1/2: (0+3+9+4)/8 = 2, (0+6+6+0)/8 = 1.5.
+        let b = DoubleNurbs::new(
+            3,
+            &[[0.0, 0.0, 0.0], [1.0, 2.0, 0.0], [3.0, 2.0, 0.0], [4.0, 0.0, 0.0]],
+            &[],
+            &[1.0; 4],
+            &[0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        )
+        .unwrap();
+        let d = b.cutter(0.5, 2);
+        assert!((d.p - Vector3::new(2.0, 1.5, 0.0)).norm() < 1e-15);
+        // B'(1/2) = 3/4 (P1-P0) + 6/4 (P2-P1) + 3/4 (P3-P2): x = 0.75 + 3 + 0.75 = 4.5, y = 1.5 + 0 - 1.5 = 0.
+        assert!((d.d1 - Vector3::new(4.5, 0.0, 0.0)).norm() < 1e-14, "{:?}", d.d1);
+        // B''(1/2) = 6 (1/2 (P2 - 2P1 + P0) + 1/2 (P3 - 2P2 + P1)) = 3(P3 - P2 - P1 + P0)
+        assert!((d.d2 - Vector3::new(0.0, -12.0, 0.0)).norm() < 1e-13, "{:?}", d.d2);
+    }
+
+    #[test]
+    fn paper_block_matches_cox_de_boor_and_interpolates_ends() {
+        let c = paper();
+        let cp = [
+            [47.7773, 71.0202, 58.8006],
+            [44.3229, 75.6066, 54.4778],
+            [37.2164, 84.6443, 44.5755],
+            [28.7567, 101.5653, 29.7151],
+            [-1.6963, 163.6796, 5.8369],
+        ];
+        let k = c.knots().to_vec();
+        for i in 0..=200 {
+            let u = i as f64 / 200.0;
+            let got = c.cutter(u, 0).p;
+            let want = rec_point(3, &cp, &[1.0; 5], &k, u);
+            for a in 0..3 {
+                assert!((got[a] - want[a]).abs() < 1e-11, "u={u} axis {a}");
+            }
+        }
+        // A clamped curve starts and ends at its end control points.
+        assert!((c.cutter(0.0, 0).p - Vector3::from(cp[0])).norm() < 1e-12);
+        assert!((c.cutter(1.0, 0).p - Vector3::from(cp[4])).norm() < 1e-12);
+    }
+
+    #[test]
+    fn derivatives_match_central_differences() {
+        let c = paper();
+        let h = 1e-5;
+        for &u in &[0.05, 0.3, 0.5, 0.51, 0.8, 0.95] {
+            let (d, t) = c.both(u, 2);
+            let (dp, tp) = c.both(u + h, 1);
+            let (dm, tm) = c.both(u - h, 1);
+            let fd1 = (dp.p - dm.p) / (2.0 * h);
+            let fd2 = (dp.d1 - dm.d1) / (2.0 * h);
+            assert!((fd1 - d.d1).norm() < 1e-6 * d.d1.norm(), "u={u}");
+            assert!((fd2 - d.d2).norm() < 1e-5 * d.d2.norm().max(1.0), "u={u}");
+            let tfd1 = (tp.p - tm.p) / (2.0 * h);
+            assert!((tfd1 - t.d1).norm() < 1e-6 * t.d1.norm(), "u={u}");
+        }
+    }
+
+    #[test]
+    fn rational_weights_against_recursion() {
+        let cp = [[0.0, 0.0, 0.0], [1.0, 3.0, 1.0], [4.0, 3.0, -1.0], [6.0, 0.0, 2.0], [8.0, 1.0, 0.0]];
+        let w = [1.0, 2.5, 0.4, 1.7, 1.0];
+        let k = [0.0, 0.0, 0.0, 0.3, 0.7, 1.0, 1.0, 1.0];
+        let c = DoubleNurbs::new(2, &cp, &[], &w, &k).unwrap();
+        for i in 0..=100 {
+            let u = i as f64 / 100.0;
+            let got = c.cutter(u, 0).p;
+            let want = rec_point(2, &cp, &w, &k, u);
+            for a in 0..3 {
+                assert!((got[a] - want[a]).abs() < 1e-12, "u={u}");
+            }
+        }
+    }
+
+    #[test]
+    fn constructor_rejects_bad_nets() {
+        let cp = [[0.0; 3]; 4];
+        let k = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        assert_eq!(DoubleNurbs::new(0, &cp, &[], &[1.0; 4], &k), Err(CurveError::Degree(0)));
+        assert!(matches!(
+            DoubleNurbs::new(3, &cp, &[], &[1.0; 4], &k[..7]),
+            Err(CurveError::KnotCount { .. })
+        ));
+        assert_eq!(
+            DoubleNurbs::new(3, &cp, &[], &[1.0, 1.0, -1.0, 1.0], &k),
+            Err(CurveError::Weight(-1.0))
+        );
+        let unclamped = [0.0, 0.0, 0.0, 0.1, 0.9, 1.0, 1.0, 1.0];
+        assert_eq!(DoubleNurbs::new(3, &cp, &[], &[1.0; 4], &unclamped), Err(CurveError::Knots));
+    }
+}
