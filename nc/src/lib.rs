@@ -3,5 +3,6 @@
 #![forbid(unsafe_code)]
 
 pub mod arclen;
+pub mod kinematics;
 pub mod nurbs;
 pub mod program;
