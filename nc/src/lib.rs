@@ -3,6 +3,10 @@
 #![forbid(unsafe_code)]
 
 pub mod arclen;
+pub mod interp;
 pub mod kinematics;
 pub mod nurbs;
+pub mod plan;
 pub mod program;
+pub mod scurve;
+pub mod segment;

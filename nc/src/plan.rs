@@ -1,0 +1,367 @@
+//! Feed planning with look-ahead over the whole path, done once outside the real-time thread.
+//!
+//! 1. **Stations.** Each segment is sampled at stations about one period of travel apart
+//!    (16..=4096 per segment). At each station the machine joints q(s) are computed through
+//!    the kinematics (with rotary continuity), and dq/ds, d2q/ds2 by finite differences.
+//! 2. **Velocity ceiling** at each station, the least of: the programmed feed; the chord-error
+//!    limit `2 sqrt(2 rho delta - delta^2) / Ts` (rho = 1/curvature, delta = tolerance); the
+//!    centripetal limit `sqrt(A / curvature)`; for every axis j `vmax_j / |dq_j/ds|` and
+//!    `sqrt(amax_j / (2 |d2q_j/ds2|))` (half the axis acceleration is left for the path
+//!    acceleration, see 4). Near the vertical tool dC/ds grows like 1/sin(A), so this is what
+//!    slows the path and keeps the C axis within its limits.
+//! 3. **Corners.** Where segments meet with a kink in some axis (dq/ds jumps by d_j), the
+//!    joint is passed at `min_j amax_j Ts / d_j`: each axis's velocity then changes by at
+//!    most one period's worth of its acceleration. A G2-continuous joint has d = 0 and is
+//!    passed at speed. The path starts and ends at rest.
+//! 4. **S-curves between critical points.** Critical points are the start, the end, the
+//!    joints and the local minima of the ceiling. Backward and forward passes make each
+//!    point's speed reachable from its neighbours; then each section gets a jerk-limited
+//!    accelerate / cruise / decelerate profile with the highest cruise speed that fits. Each
+//!    section's path acceleration and jerk are capped so that `|dq_j/ds| * A <= amax_j / 2`
+//!    (and likewise for jerk) over the section. Wherever a section's speed exceeds the
+//!    ceiling at a station, that station becomes a critical point and the plan is redone.
+//!
+//! The result is a [`FeedProfile`]: constant-jerk phases over the whole path, evaluated per
+//! period without allocation.
+
+use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
+use crate::scurve::{change_dist, push_change, reachable, Motion, Phase};
+use crate::segment::{Geometry, Path, Segment};
+
+/// Limits of one machine axis, in mm or radians and seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AxisLimit {
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub jerk: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanConfig {
+    /// Interpolation period, s.
+    pub period: f64,
+    /// Chord tolerance, mm.
+    pub chord_tol: f64,
+    /// Path acceleration and jerk, mm/s^2 and mm/s^3.
+    pub path_acc: f64,
+    pub path_jerk: f64,
+    /// X, Y, Z, tilt, C.
+    pub axes: [AxisLimit; 5],
+    pub rotary: RotaryLimits,
+}
+
+/// Slowest speed the planner schedules where a ceiling would be lower (path units/s), so
+/// that every section ends in finite time.
+const V_FLOOR: f64 = 1e-3;
+/// Likewise for a section's path acceleration and jerk.
+const A_FLOOR: f64 = 1e-3;
+/// Replanning rounds before every violating station is made critical at once.
+const ROUNDS_WORST_ONLY: usize = 60;
+const ROUNDS_MAX: usize = 400;
+
+/// A sample of the path used by the planner.
+#[derive(Clone, Copy, Debug)]
+struct Station {
+    s: f64,
+    vlim: f64,
+    /// |dq_j/ds|.
+    dq: [f64; 5],
+}
+
+/// The planned feed along the whole path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FeedProfile {
+    pub phases: Vec<Phase>,
+    /// Path position where each segment starts (segment k spans seg_start[k]..seg_start[k+1]).
+    pub seg_start: Vec<f64>,
+    pub length: f64,
+    pub duration: f64,
+}
+
+impl FeedProfile {
+    /// Path state at time t. `cursor` remembers the phase between calls (monotonic time);
+    /// each call advances it at most over the phases that ended. Allocation-free.
+    pub fn at(&self, t: f64, cursor: &mut usize) -> Motion {
+        if t >= self.duration || self.phases.is_empty() {
+            return Motion {
+                s: self.length,
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        let n = self.phases.len();
+        while *cursor + 1 < n && t >= self.phases[*cursor + 1].t0 {
+            *cursor += 1;
+        }
+        let ph = &self.phases[(*cursor).min(n - 1)];
+        let mut m = ph.at((t - ph.t0).clamp(0.0, ph.dur));
+        m.s = m.s.clamp(0.0, self.length);
+        m.v = m.v.max(0.0);
+        m
+    }
+}
+
+fn joint_derivatives(q: &[Joints], h: f64, i: usize) -> ([f64; 5], [f64; 5]) {
+    let n = q.len();
+    let (a, b, c) = if i == 0 {
+        (0, 1, 2.min(n - 1))
+    } else if i + 1 == n {
+        (n.saturating_sub(3), n - 2, n - 1)
+    } else {
+        (i - 1, i, i + 1)
+    };
+    let mut d1 = [0.0; 5];
+    let mut d2 = [0.0; 5];
+    for j in 0..5 {
+        d1[j] = if i == 0 {
+            (q[b][j] - q[a][j]) / h
+        } else if i + 1 == n {
+            (q[c][j] - q[b][j]) / h
+        } else {
+            (q[c][j] - q[a][j]) / (2.0 * h)
+        };
+        d2[j] = if c > b && b > a {
+            (q[c][j] - 2.0 * q[b][j] + q[a][j]) / (h * h)
+        } else {
+            0.0
+        };
+    }
+    (d1, d2)
+}
+
+fn curvature(seg: &Segment, s: f64) -> f64 {
+    match &seg.geometry {
+        Geometry::Line { .. } => 0.0,
+        Geometry::Nurbs { curve, table } => {
+            let d = curve.cutter(table.u_of_s(curve, s), 2);
+            let sp = d.d1.norm();
+            if sp < 1e-12 {
+                0.0
+            } else {
+                d.d1.cross(&d.d2).norm() / (sp * sp * sp)
+            }
+        }
+    }
+}
+
+/// Sample every segment; returns the stations and, per segment, the index of its first
+/// station (the joint with the previous segment) and the one-sided dq/ds at both ends.
+fn stations(
+    path: &Path,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+) -> (Vec<Station>, Vec<usize>) {
+    let mut out: Vec<Station> = Vec::new();
+    let mut starts = Vec::with_capacity(path.segments.len() + 1);
+    let mut prev = path.start_joints;
+    let mut s0 = 0.0;
+    let mut prev_end: Option<([f64; 5], bool)> = None;
+    for seg in &path.segments {
+        let n = ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize).clamp(16, 4096);
+        let h = seg.length / n as f64;
+        let mut q = Vec::with_capacity(n + 1);
+        for i in 0..=n {
+            let j = seg.pose(h * i as f64).joints(kin, &prev, &cfg.rotary);
+            prev = j;
+            q.push(j);
+        }
+        let mut last_d1 = [0.0; 5];
+        for i in 0..=n {
+            let s_loc = h * i as f64;
+            let (d1, d2) = joint_derivatives(&q, h, i);
+            if i == n {
+                last_d1 = d1;
+            }
+            let mut v = seg.feed;
+            let kappa = curvature(seg, s_loc);
+            if kappa > 1e-12 {
+                let rho = 1.0 / kappa;
+                let d = cfg.chord_tol.min(rho);
+                v = v.min(2.0 * (2.0 * rho * d - d * d).sqrt() / cfg.period);
+                v = v.min((cfg.path_acc / kappa).sqrt());
+            }
+            for (j, ax) in cfg.axes.iter().enumerate() {
+                if d1[j].abs() > 1e-15 {
+                    v = v.min(ax.velocity / d1[j].abs());
+                }
+                if d2[j].abs() > 1e-15 {
+                    v = v.min((ax.acceleration / (2.0 * d2[j].abs())).sqrt());
+                }
+            }
+            let st = Station {
+                s: s0 + s_loc,
+                vlim: v.max(V_FLOOR),
+                dq: d1.map(f64::abs),
+            };
+            if i == 0 {
+                if let Some(last) = out.last_mut() {
+                    // The joint with the previous segment: one station, both sides' limits.
+                    let (pd1, prev_rotary) = prev_end.unwrap_or(([0.0; 5], seg.rotary_only));
+                    let mut vc = last.vlim.min(st.vlim);
+                    if prev_rotary != seg.rotary_only {
+                        vc = 0.0; // path units change (mm <-> degrees): stop between
+                    }
+                    for (j, ax) in cfg.axes.iter().enumerate() {
+                        let jump = (d1[j] - pd1[j]).abs();
+                        if jump > 1e-9 {
+                            vc = vc.min(ax.acceleration * cfg.period / jump);
+                        }
+                        last.dq[j] = last.dq[j].max(st.dq[j]);
+                    }
+                    last.vlim = vc.max(V_FLOOR);
+                    starts.push(out.len() - 1);
+                    continue;
+                }
+                starts.push(0);
+            }
+            out.push(st);
+        }
+        prev_end = Some((last_d1, seg.rotary_only));
+        s0 += seg.length;
+    }
+    (out, starts)
+}
+
+/// Path acceleration and jerk allowed over stations `a..=b`.
+fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64, f64) {
+    let mut acc = cfg.path_acc;
+    let mut jerk = cfg.path_jerk;
+    for s in &st[a..=b] {
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            if s.dq[j] > 1e-15 {
+                acc = acc.min(ax.acceleration / (2.0 * s.dq[j]));
+                jerk = jerk.min(ax.jerk / (2.0 * s.dq[j]));
+            }
+        }
+    }
+    (acc.max(A_FLOOR), jerk.max(A_FLOOR))
+}
+
+/// Phases of one section from `va` to `vb` over `len`, cruising at most at `vmax`.
+fn section(out: &mut Vec<Phase>, t0: f64, s0: f64, (va, vb): (f64, f64), len: f64, vmax: f64, (acc, jerk): (f64, f64)) -> f64 {
+    let lo = va.max(vb);
+    let fits = |vc: f64| change_dist(va, vc, acc, jerk) + change_dist(vc, vb, acc, jerk) <= len;
+    let vc = if vmax <= lo {
+        lo
+    } else if fits(vmax) {
+        vmax
+    } else {
+        let (mut l, mut h) = (lo, vmax);
+        for _ in 0..80 {
+            let m = 0.5 * (l + h);
+            if fits(m) {
+                l = m;
+            } else {
+                h = m;
+            }
+        }
+        l
+    };
+    let start = Motion { s: s0, v: va, a: 0.0 };
+    let (t1, m1) = push_change(out, t0, start, vc, acc, jerk);
+    let d2 = change_dist(vc, vb, acc, jerk);
+    let cruise = (len - (m1.s - s0) - d2).max(0.0);
+    let mut t = t1;
+    let mut m = m1;
+    if cruise > 0.0 && vc > 0.0 {
+        let ph = Phase { t0: t, dur: cruise / vc, s0: m.s, v0: vc, a0: 0.0, j: 0.0 };
+        out.push(ph);
+        t += ph.dur;
+        m = ph.end();
+    }
+    let (t2, _) = push_change(out, t, m, vb, acc, jerk);
+    t2
+}
+
+/// Speed of a section's phases at path position `s` (bisection in time inside the phase).
+fn speed_at(phases: &[Phase], s: f64) -> f64 {
+    let i = phases.partition_point(|p| p.s0 <= s).saturating_sub(1);
+    let Some(p) = phases.get(i) else { return 0.0 };
+    let (mut lo, mut hi) = (0.0, p.dur);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if p.at(mid).s < s {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    p.at(0.5 * (lo + hi)).v
+}
+
+/// Plan the feed over the whole path.
+pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfile {
+    let mut seg_start = Vec::with_capacity(path.segments.len() + 1);
+    let mut total = 0.0;
+    for seg in &path.segments {
+        seg_start.push(total);
+        total += seg.length;
+    }
+    seg_start.push(total);
+    if path.segments.is_empty() {
+        return FeedProfile { phases: Vec::new(), seg_start, length: 0.0, duration: 0.0 };
+    }
+    let (st, starts) = stations(path, kin, cfg);
+    let last = st.len() - 1;
+    // Critical points: (station index, speed).
+    let mut crit: Vec<(usize, f64)> = vec![(0, 0.0)];
+    for i in 1..last {
+        let is_joint = starts.binary_search(&i).is_ok();
+        let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
+        if is_joint || is_min {
+            crit.push((i, st[i].vlim));
+        }
+    }
+    crit.push((last, 0.0));
+
+    let mut phases = Vec::new();
+    for round in 0..ROUNDS_MAX {
+        let limits: Vec<(f64, f64)> = crit.windows(2).map(|w| section_limits(&st, w[0].0, w[1].0, cfg)).collect();
+        // Backward then forward: every point's speed reachable within its sections.
+        for k in (0..crit.len() - 1).rev() {
+            let len = st[crit[k + 1].0].s - st[crit[k].0].s;
+            let (a, j) = limits[k];
+            crit[k].1 = crit[k].1.min(reachable(crit[k + 1].1, len, a, j));
+        }
+        for k in 1..crit.len() {
+            let len = st[crit[k].0].s - st[crit[k - 1].0].s;
+            let (a, j) = limits[k - 1];
+            crit[k].1 = crit[k].1.min(reachable(crit[k - 1].1, len, a, j));
+        }
+        phases.clear();
+        let mut t = 0.0;
+        let mut inserts = Vec::new();
+        for (k, w) in crit.windows(2).enumerate() {
+            let ((ia, va), (ib, vb)) = (w[0], w[1]);
+            let vmax = st[ia..=ib].iter().map(|x| x.vlim).fold(0.0, f64::max);
+            let first = phases.len();
+            t = section(&mut phases, t, st[ia].s, (va, vb), st[ib].s - st[ia].s, vmax, limits[k]);
+            let sec = &phases[first..];
+            let vc = sec.iter().map(|p| p.v0).fold(va.max(vb), f64::max);
+            let mut worst: Option<(usize, f64)> = None;
+            for (i, x) in st.iter().enumerate().take(ib).skip(ia + 1) {
+                if x.vlim >= vc {
+                    continue;
+                }
+                let excess = speed_at(sec, x.s) - x.vlim;
+                if excess > 1e-9 * x.vlim.max(1.0) {
+                    if round >= ROUNDS_WORST_ONLY {
+                        inserts.push(i);
+                    } else if worst.is_none_or(|(_, e)| excess > e) {
+                        worst = Some((i, excess));
+                    }
+                }
+            }
+            inserts.extend(worst.map(|w| w.0));
+        }
+        if inserts.is_empty() {
+            break;
+        }
+        for i in inserts {
+            let pos = crit.partition_point(|c| c.0 < i);
+            crit.insert(pos, (i, st[i].vlim));
+        }
+    }
+    let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
+    FeedProfile { phases, seg_start, length: total, duration }
+}

@@ -1,0 +1,151 @@
+//! Jerk-limited velocity changes: the building block of the feed profile.
+//!
+//! A change from v0 to v1 starts and ends at zero acceleration and uses jerk +-J and at most
+//! acceleration A: three phases (jerk, constant acceleration, jerk) when |dv| >= A^2/J, two
+//! otherwise (the acceleration peaks at sqrt(|dv| J)). The velocity curve is point-symmetric
+//! about its midpoint, so the distance covered is exactly `(v0 + v1) / 2 * T`.
+
+/// One piece of the feed profile with constant jerk. Time and path position are absolute.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Phase {
+    pub t0: f64,
+    pub dur: f64,
+    pub s0: f64,
+    pub v0: f64,
+    pub a0: f64,
+    pub j: f64,
+}
+
+/// Path position, velocity and acceleration at one instant.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    pub s: f64,
+    pub v: f64,
+    pub a: f64,
+}
+
+impl Phase {
+    /// State at `tau` seconds into the phase (not clamped).
+    pub fn at(&self, tau: f64) -> Motion {
+        Motion {
+            s: self.s0 + tau * (self.v0 + tau * (self.a0 / 2.0 + tau * self.j / 6.0)),
+            v: self.v0 + tau * (self.a0 + tau * self.j / 2.0),
+            a: self.a0 + tau * self.j,
+        }
+    }
+
+    pub fn end(&self) -> Motion {
+        self.at(self.dur)
+    }
+}
+
+/// Duration of a jerk-limited velocity change by `dv` (sign ignored).
+pub fn change_time(dv: f64, a: f64, j: f64) -> f64 {
+    let dv = dv.abs();
+    if dv >= a * a / j {
+        dv / a + a / j
+    } else {
+        2.0 * (dv / j).sqrt()
+    }
+}
+
+/// Distance covered by a jerk-limited change from `v0` to `v1`.
+pub fn change_dist(v0: f64, v1: f64, a: f64, j: f64) -> f64 {
+    0.5 * (v0 + v1) * change_time(v1 - v0, a, j)
+}
+
+/// Highest speed from which `v_end` can be reached within `dist` (or, symmetrically, the
+/// highest speed reachable from `v_end` within `dist`).
+pub fn reachable(v_end: f64, dist: f64, a: f64, j: f64) -> f64 {
+    if dist <= 0.0 {
+        return v_end;
+    }
+    // change_dist >= dv * T / 2 bounds dv by sqrt(2 a d) or (d^2 j)^(1/3).
+    let mut hi = v_end + (2.0 * a * dist).sqrt().max((dist * dist * j).cbrt()) + 1e-9;
+    let mut lo = v_end;
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if change_dist(mid, v_end, a, j) <= dist {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// Append the phases of a change from `start` (with zero acceleration) to `v1`. Returns the
+/// state at its end (acceleration zero again).
+pub fn push_change(out: &mut Vec<Phase>, t0: f64, start: Motion, v1: f64, a: f64, j: f64) -> (f64, Motion) {
+    let dv = v1 - start.v;
+    if dv == 0.0 {
+        return (t0, start);
+    }
+    let sign = dv.signum();
+    let (t_jerk, t_const) = if dv.abs() >= a * a / j {
+        (a / j, dv.abs() / a - a / j)
+    } else {
+        ((dv.abs() / j).sqrt(), 0.0)
+    };
+    let mut t = t0;
+    let mut m = Motion { a: 0.0, ..start };
+    for (dur, jerk) in [(t_jerk, sign * j), (t_const, 0.0), (t_jerk, -sign * j)] {
+        if dur <= 0.0 {
+            continue;
+        }
+        let ph = Phase {
+            t0: t,
+            dur,
+            s0: m.s,
+            v0: m.v,
+            a0: m.a,
+            j: jerk,
+        };
+        out.push(ph);
+        m = ph.end();
+        t += dur;
+    }
+    // Remove rounding: the change ends exactly at v1 with zero acceleration.
+    m.v = v1;
+    m.a = 0.0;
+    (t, m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn change_reaches_target_with_its_predicted_distance() {
+        for &(v0, v1, a, j) in &[
+            (0.0, 100.0, 1000.0, 20000.0), // long: constant-acceleration phase
+            (50.0, 52.0, 1000.0, 20000.0), // short: triangular acceleration
+            (80.0, 10.0, 500.0, 5000.0),
+        ] {
+            let mut ph = Vec::new();
+            let start = Motion { s: 3.0, v: v0, a: 0.0 };
+            let (t, end) = push_change(&mut ph, 1.0, start, v1, a, j);
+            let last = ph.last().unwrap().end();
+            assert!((last.v - v1).abs() < 1e-9, "{last:?}");
+            assert!(last.a.abs() < 1e-9);
+            assert!((t - 1.0 - change_time(v1 - v0, a, j)).abs() < 1e-12);
+            assert!((last.s - 3.0 - change_dist(v0, v1, a, j)).abs() < 1e-9);
+            assert_eq!(end.v, v1);
+            // Limits hold at every phase boundary (extrema of a are at boundaries).
+            for p in &ph {
+                assert!(p.a0.abs() <= a * (1.0 + 1e-12) && p.end().a.abs() <= a * (1.0 + 1e-12));
+                assert!(p.j.abs() <= j);
+            }
+        }
+    }
+
+    #[test]
+    fn reachable_inverts_change_dist() {
+        let (a, j) = (1000.0, 20000.0);
+        for &d in &[0.001, 0.1, 5.0, 200.0] {
+            let v = reachable(20.0, d, a, j);
+            assert!((change_dist(v, 20.0, a, j) - d).abs() < 1e-9 * d.max(1.0), "d={d}");
+        }
+        assert_eq!(reachable(7.0, 0.0, a, j), 7.0);
+    }
+}

@@ -1,0 +1,375 @@
+//! Segments: the parsed blocks turned into geometry that can be evaluated at a path position.
+//!
+//! Each motion block becomes one [`Segment`] measured by its own path length `s`:
+//! * a NURBS block by the arc length of its cutter curve (with an [`ArcTable`]);
+//! * a `G00`/`G01` by its straight length in mm. A move that turns the tool without moving the
+//!   cutter centre ("rotary only") is measured in degrees of tool rotation instead, and its
+//!   feed is read as degrees per minute, as CNC controls conventionally do.
+//!
+//! The builder checks what needs the geometry (the parser checked the syntax and the nets):
+//! the orientation curve stays away from the cutter curve along the whole block, the tool
+//! axis at a block's start equals the current one (a difference would be a jump of the
+//! rotary axes), and angle words suit the machine's tilt axis.
+
+use crate::arclen::ArcTable;
+use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt};
+use crate::nurbs::DoubleNurbs;
+use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
+use nalgebra::Vector3;
+
+/// Smallest allowed |CT(u) - C(u)| along a G06.5 block, mm.
+pub const MIN_TOOL_VECTOR_MM: f64 = 1e-3;
+/// Largest allowed difference between the tool axis a block starts with and the current one.
+pub const MAX_ORIENTATION_STEP_DEG: f64 = 0.01;
+/// Moves shorter than this (mm, and degrees for the tool) are no motion at all.
+const NULL_MOVE: f64 = 1e-9;
+
+/// How a segment's tool orientation varies.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Tooling {
+    /// Rotary angles (radians) interpolated linearly (`G01 A_ C_`).
+    Angles { from: (f64, f64), to: (f64, f64) },
+    /// Unit tool axis along the great circle (`G01 I_ J_ K_`), `angle` between the ends.
+    Slerp {
+        from: Vector3<f64>,
+        to: Vector3<f64>,
+        angle: f64,
+    },
+    /// Constant tool axis (G06.2 and moves that keep the orientation).
+    Fixed(Vector3<f64>),
+    /// The block's own orientation curve (G06.5).
+    Curve,
+}
+
+/// Where the segment's cutter point comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Geometry {
+    Line {
+        from: Vector3<f64>,
+        to: Vector3<f64>,
+    },
+    Nurbs {
+        curve: Box<DoubleNurbs>,
+        table: Box<ArcTable>,
+    },
+}
+
+/// The tool orientation at a point: a unit vector in the workpiece frame, or machine angles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tool {
+    Axis(Vector3<f64>),
+    Angles(f64, f64),
+}
+
+/// A point of the path: cutter centre, tool, and the curve parameter for NURBS segments.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pose {
+    pub p: Vector3<f64>,
+    pub tool: Tool,
+    pub u: Option<f64>,
+}
+
+impl Pose {
+    /// Machine joints for this pose; `prev` picks the rotary solution.
+    pub fn joints(&self, kin: &MachineKinematics, prev: &Joints, lim: &RotaryLimits) -> Joints {
+        match self.tool {
+            Tool::Axis(t) => kin.inverse(&self.p, &t, prev, lim),
+            Tool::Angles(a, c) => {
+                let m = kin.place(&self.p, a, c);
+                [m.x, m.y, m.z, a, c]
+            }
+        }
+    }
+
+    /// The unit tool axis in the workpiece frame.
+    pub fn axis(&self, kin: &MachineKinematics) -> Vector3<f64> {
+        match self.tool {
+            Tool::Axis(t) => t,
+            Tool::Angles(a, c) => kin.tool_axis(a, c),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Segment {
+    /// 1-based index of the NC block in the program (block 1 is the start pose).
+    pub block: u32,
+    pub src: SrcPos,
+    /// Path length: mm, or degrees of tool rotation when `rotary_only`.
+    pub length: f64,
+    /// Programmed feed in path units per second.
+    pub feed: f64,
+    pub rapid: bool,
+    pub rotary_only: bool,
+    pub geometry: Geometry,
+    pub tooling: Tooling,
+}
+
+impl Segment {
+    /// Pose at path position `s` in [0, length] (clamped). Allocation-free.
+    pub fn pose(&self, s: f64) -> Pose {
+        let s = s.clamp(0.0, self.length);
+        let f = if self.length > 0.0 { s / self.length } else { 1.0 };
+        match &self.geometry {
+            Geometry::Line { from, to } => Pose {
+                p: from + (to - from) * f,
+                tool: self.tool_at(f, None),
+                u: None,
+            },
+            Geometry::Nurbs { curve, table } => self.pose_u(curve, table.u_of_s(curve, s)),
+        }
+    }
+
+    /// Pose of a NURBS segment at curve parameter `u` (for the Taylor methods).
+    pub fn pose_u(&self, curve: &DoubleNurbs, u: f64) -> Pose {
+        let (c, ct) = curve.both(u, 0);
+        let tool = match self.tooling {
+            Tooling::Curve => self.tool_at(0.0, Some((ct.p - c.p).normalize())),
+            _ => self.tool_at(0.0, None),
+        };
+        Pose {
+            p: c.p,
+            tool,
+            u: Some(u),
+        }
+    }
+
+    fn tool_at(&self, f: f64, curve_axis: Option<Vector3<f64>>) -> Tool {
+        match &self.tooling {
+            Tooling::Angles { from, to } => {
+                Tool::Angles(from.0 + (to.0 - from.0) * f, from.1 + (to.1 - from.1) * f)
+            }
+            Tooling::Slerp { from, to, angle } => {
+                if *angle < NULL_MOVE {
+                    return Tool::Axis(*to);
+                }
+                let sa = angle.sin();
+                Tool::Axis(from * (((1.0 - f) * angle).sin() / sa) + to * ((f * angle).sin() / sa))
+            }
+            Tooling::Fixed(t) => Tool::Axis(*t),
+            Tooling::Curve => Tool::Axis(curve_axis.unwrap_or_else(Vector3::z)),
+        }
+    }
+
+    pub fn nurbs(&self) -> Option<(&DoubleNurbs, &ArcTable)> {
+        match &self.geometry {
+            Geometry::Nurbs { curve, table } => Some((curve, table)),
+            Geometry::Line { .. } => None,
+        }
+    }
+}
+
+/// A geometric rule the parser could not check.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum BuildErrorKind {
+    #[error("the program has no motion block: the first block must be G00/G01 with X Y Z (the start pose)")]
+    NoStart,
+    #[error("the first block must be a G00/G01 start pose, not a NURBS block")]
+    NurbsFirst,
+    #[error("{0} angle words on a machine whose tilting axis is {1}")]
+    WrongTilt(&'static str, &'static str),
+    #[error("the orientation curve comes within {dist:.3e} mm of the cutter curve at u = {u:.6} (minimum {MIN_TOOL_VECTOR_MM} mm): the tool axis is undefined there")]
+    ToolVectorTooShort { u: f64, dist: f64 },
+    #[error("the tool axis at the start of the block differs from the current tool axis by {deg:.4} deg (at most {MAX_ORIENTATION_STEP_DEG} deg): the rotary axes would jump")]
+    OrientationJump { deg: f64 },
+    #[error("the tool axis turns by 180 degrees in one linear move: the great circle between opposite axes is undefined")]
+    OppositeAxes,
+    #[error("{0}")]
+    Curve(#[from] crate::nurbs::CurveError),
+}
+
+/// A [`BuildErrorKind`] at the position of the block that broke it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{pos}: {kind}")]
+pub struct BuildError {
+    pub pos: SrcPos,
+    pub kind: BuildErrorKind,
+}
+
+/// Feeds for the segment builder, from the machine file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildLimits {
+    pub rapid_mm_s: f64,
+    pub max_feed_mm_s: f64,
+    pub rotary: RotaryLimits,
+}
+
+/// The start pose and the segments of a program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Path {
+    pub start: Pose,
+    pub start_joints: Joints,
+    pub segments: Vec<Segment>,
+}
+
+/// Turn a parsed program into segments for the given machine.
+pub fn build(
+    program: &Program,
+    kin: &MachineKinematics,
+    limits: &BuildLimits,
+) -> Result<Path, BuildError> {
+    let err = |pos, kind| BuildError { pos, kind };
+    let first = match program.blocks.first() {
+        None => return Err(err(SrcPos::default(), BuildErrorKind::NoStart)),
+        Some(Block::Nurbs(b)) => return Err(err(b.pos, BuildErrorKind::NurbsFirst)),
+        Some(Block::Linear(m)) => m,
+    };
+    let lim = &limits.rotary;
+    let mut pose = Pose {
+        p: Vector3::from(first.end),
+        tool: linear_tool(first),
+        u: None,
+    };
+    let mut joints = pose.joints(kin, &[0.0; 5], lim);
+    let start = pose;
+    let start_joints = joints;
+    let mut segments = Vec::with_capacity(program.blocks.len());
+    for (i, block) in program.blocks.iter().enumerate().skip(1) {
+        let index = (i + 1) as u32;
+        let seg = match block {
+            Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?,
+            Block::Nurbs(b) => Some(nurbs(index, b, &pose, kin, limits)?),
+        };
+        if let Some(seg) = seg {
+            let end = seg.pose(seg.length);
+            joints = end.joints(kin, &joints, lim);
+            pose = end;
+            segments.push(seg);
+        }
+    }
+    Ok(Path {
+        start,
+        start_joints,
+        segments,
+    })
+}
+
+fn linear_tool(m: &LinearMove) -> Tool {
+    match m.orientation {
+        Orientation::Vector(v) => Tool::Axis(Vector3::from(v).normalize()),
+        Orientation::Angles { r1_deg, r2_deg } => {
+            Tool::Angles(r1_deg.to_radians(), r2_deg.to_radians())
+        }
+    }
+}
+
+fn linear(
+    block: u32,
+    m: &LinearMove,
+    pose: &Pose,
+    joints: &Joints,
+    kin: &MachineKinematics,
+    limits: &BuildLimits,
+) -> Result<Option<Segment>, BuildError> {
+    let from = pose.p;
+    let to = Vector3::from(m.end);
+    let dist = (to - from).norm();
+    let (tooling, turn_deg) = match m.orientation {
+        Orientation::Angles { r1_deg, r2_deg } => {
+            let a = (joints[3], joints[4]);
+            let b = (r1_deg.to_radians(), r2_deg.to_radians());
+            let turn = (b.0 - a.0).abs().max((b.1 - a.1).abs()).to_degrees();
+            (Tooling::Angles { from: a, to: b }, turn)
+        }
+        Orientation::Vector(v) => {
+            let a = pose.axis(kin);
+            let b = Vector3::from(v).normalize();
+            let angle = a.cross(&b).norm().atan2(a.dot(&b));
+            if angle > core::f64::consts::PI - 1e-6 {
+                return Err(BuildError {
+                    pos: m.pos,
+                    kind: BuildErrorKind::OppositeAxes,
+                });
+            }
+            let tooling = if angle < NULL_MOVE {
+                Tooling::Fixed(b)
+            } else {
+                Tooling::Slerp {
+                    from: a,
+                    to: b,
+                    angle,
+                }
+            };
+            (tooling, angle.to_degrees())
+        }
+    };
+    let rotary_only = dist < NULL_MOVE;
+    if rotary_only && turn_deg < NULL_MOVE {
+        return Ok(None);
+    }
+    let length = if rotary_only { turn_deg } else { dist };
+    let feed = if m.rapid {
+        limits.rapid_mm_s
+    } else {
+        (m.feed_mm_min / 60.0).min(limits.max_feed_mm_s)
+    };
+    Ok(Some(Segment {
+        block,
+        src: m.pos,
+        length,
+        feed,
+        rapid: m.rapid,
+        rotary_only,
+        geometry: Geometry::Line { from, to },
+        tooling,
+    }))
+}
+
+fn nurbs(
+    block: u32,
+    b: &NurbsBlock,
+    pose: &Pose,
+    kin: &MachineKinematics,
+    limits: &BuildLimits,
+) -> Result<Segment, BuildError> {
+    let err = |kind| BuildError { pos: b.pos, kind };
+    let curve = DoubleNurbs::new(b.degree as usize, &b.ctrl, &b.tool_ctrl, &b.weights, &b.knots)
+        .map_err(|e| err(e.into()))?;
+    let table = ArcTable::new(&curve);
+    let current = pose.axis(kin);
+    let tooling = match b.kind {
+        NurbsKind::G062 => Tooling::Fixed(current),
+        NurbsKind::G065 => {
+            // The orientation curve must stay clear of the cutter curve everywhere, not only
+            // at the control points the parser saw.
+            let (u0, u1) = curve.range();
+            let n = 2048;
+            for i in 0..=n {
+                let u = u0 + (u1 - u0) * i as f64 / n as f64;
+                let (c, t) = curve.both(u, 0);
+                let dist = (t.p - c.p).norm();
+                if !(dist >= MIN_TOOL_VECTOR_MM) {
+                    return Err(err(BuildErrorKind::ToolVectorTooShort { u, dist }));
+                }
+            }
+            let (c, t) = curve.both(u0, 0);
+            let start = (t.p - c.p).normalize();
+            let deg = current.cross(&start).norm().atan2(current.dot(&start)).to_degrees();
+            if deg > MAX_ORIENTATION_STEP_DEG {
+                return Err(err(BuildErrorKind::OrientationJump { deg }));
+            }
+            Tooling::Curve
+        }
+    };
+    Ok(Segment {
+        block,
+        src: b.pos,
+        length: table.length(),
+        feed: (b.feed_mm_min / 60.0).min(limits.max_feed_mm_s),
+        rapid: false,
+        rotary_only: false,
+        geometry: Geometry::Nurbs {
+            curve: Box::new(curve),
+            table: Box::new(table),
+        },
+        tooling,
+    })
+}
+
+/// The tilt letter of a machine, for messages.
+pub fn tilt_letter(t: Tilt) -> &'static str {
+    match t {
+        Tilt::A => "A",
+        Tilt::B => "B",
+    }
+}
