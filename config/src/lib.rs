@@ -1,1 +1,92 @@
-//! Machine configuration.
+//! Machine configuration: a TOML file read once at start-up into validated types.
+//!
+//! # Two stages
+//!
+//! 1. **Raw** (`raw.rs`): serde structs that mirror the TOML exactly, one struct per table,
+//!    with `#[serde(deny_unknown_fields)]` everywhere, so a misspelt key is an error instead of
+//!    a silently used default. Syntax, unknown/missing keys and wrong value types fail here.
+//! 2. **Validated** ([`Machine`] and the types in `machine.rs`): built once from the raw
+//!    structs by `validate.rs`, which checks every range. The rest of the program (and all
+//!    real-time code) sees only these types, whose invariants it may rely on: every number
+//!    finite (except `±inf` travel of a continuous C table), `min < max`, rates `> 0`.
+//!
+//! The text is parsed once into toml's span-carrying tree (`source.rs`), which is kept so
+//! that every error can say where it is: [`ConfigError`]'s `Display` names the file, the
+//! line:col, the dotted key path, the value as written and the allowed range with its unit:
+//!
+//! ```text
+//! machines/foo.toml:14:12: axes.x.velocity = -3: must be finite and > 0 (mm/s)
+//! ```
+//!
+//! # Units
+//!
+//! | keys | unit |
+//! |---|---|
+//! | `[machine] period_ms` | ms (stored as [`Machine::period_s`] in s) |
+//! | `[kinematics] *_axis_point` | mm, machine frame |
+//! | `[axes.x/y/z]` `min`, `max`, `velocity`, `acceleration`, `jerk` | mm, mm/s, mm/s^2, mm/s^3 |
+//! | `[axes.a/b/c]` same keys | deg, deg/s, deg/s^2, deg/s^3 |
+//! | `[interpolation] chord_tolerance_mm` | mm |
+//! | `[interpolation] path_acceleration`, `path_jerk` | mm/s^2, mm/s^3 |
+//! | `[interpolation] max_feed_mm_min`, `rapid_feed_mm_min` | mm/min |
+//!
+//! # File layout
+//!
+//! ```toml
+//! [machine]
+//! name = "paper-ac-table"   # required, non-empty
+//! period_ms = 2.0           # optional, default 2.0, allowed 0.1..=100
+//!
+//! [kinematics]
+//! kind = "paper"            # "paper" | "xyzac-trt" | "xyzbc-trt"
+//! # xyzac-trt: a_axis_point = [x, y, z], c_axis_point = [x, y, z]
+//! # xyzbc-trt: b_axis_point = [x, y, z], c_axis_point = [x, y, z]
+//!
+//! [interpolation]           # optional, as is every key in it
+//! method = "arclength"      # "arclength" | "taylor1" | "taylor2"
+//! chord_tolerance_mm = 0.001
+//! path_acceleration = 1000.0
+//! path_jerk = 20000.0
+//! max_feed_mm_min = 10000.0
+//! rapid_feed_mm_min = 10000.0   # default: max_feed_mm_min
+//!
+//! [axes.x]                  # also [axes.y], [axes.z]
+//! min = -300.0
+//! max = 300.0
+//! velocity = 250.0
+//! acceleration = 2500.0
+//! jerk = 50000.0
+//! # [axes.a] (paper, xyzac-trt) or [axes.b] (xyzbc-trt): same keys, required.
+//! # [axes.c]: same keys; min and max may both be omitted for a continuous table.
+//! ```
+//!
+//! Example files: `config/machines/*.toml`.
+
+mod error;
+mod machine;
+mod raw;
+mod source;
+mod validate;
+
+use std::path::Path;
+
+pub use error::{ConfigError, LineCol, Location};
+pub use machine::{
+    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, RotaryName, UnknownMethod,
+};
+
+/// Reads and validates the machine configuration file at `path`.
+pub fn load(path: &Path) -> Result<Machine, ConfigError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    from_str(&text, path)
+}
+
+/// Parses and validates a machine configuration held in `text`; `origin` names it in errors.
+pub fn from_str(text: &str, origin: &Path) -> Result<Machine, ConfigError> {
+    let src = source::Source::parse(text, origin)?;
+    let raw = src.raw()?;
+    validate::machine(raw, &src)
+}

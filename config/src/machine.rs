@@ -1,0 +1,282 @@
+//! Stage 2: the validated machine description the rest of the program uses.
+//!
+//! A value of these types has passed every check in `validate.rs`: all numbers are finite
+//! (except the `±inf` travel of a continuous C table), `min < max`, and every rate limit is
+//! `> 0`. Units are the machine's: linear axes in mm, mm/s, mm/s^2, mm/s^3; rotary axes in
+//! deg, deg/s, deg/s^2, deg/s^3; the period in seconds.
+
+use std::fmt;
+use std::str::FromStr;
+
+/// A validated machine configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Machine {
+    /// `[machine] name`, never empty.
+    pub name: String,
+    /// Interpolation period in seconds (`[machine] period_ms / 1000`), in `1e-4..=0.1`.
+    pub period_s: f64,
+    pub kinematics: Kinematics,
+    pub axes: Axes,
+    pub interpolation: Interpolation,
+}
+
+impl Machine {
+    /// `[machine] period_ms` when omitted.
+    pub const DEFAULT_PERIOD_MS: f64 = 2.0;
+    /// Smallest allowed `period_ms`.
+    pub const MIN_PERIOD_MS: f64 = 0.1;
+    /// Largest allowed `period_ms`.
+    pub const MAX_PERIOD_MS: f64 = 100.0;
+}
+
+/// Which kinematic transformation maps workpiece coordinates and tool axis to machine axes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Kinematics {
+    /// Paper: machine XYZ = workpiece XYZ (no tool-centre-point compensation), rotary A about X
+    /// and C about Z.
+    Paper,
+    /// A tilting table (about machine X) carrying a C rotary table (about the table normal,
+    /// machine Z at A=0). Points in mm, machine frame.
+    XyzacTrt {
+        /// A point on the A axis.
+        a_axis_point: [f64; 3],
+        /// A point on the C axis at A = 0.
+        c_axis_point: [f64; 3],
+    },
+    /// B tilting table (about machine Y) carrying a C rotary table. Points in mm, machine frame.
+    XyzbcTrt {
+        /// A point on the B axis.
+        b_axis_point: [f64; 3],
+        /// A point on the C axis at B = 0.
+        c_axis_point: [f64; 3],
+    },
+}
+
+impl Kinematics {
+    /// The `kind` names accepted in `[kinematics]`, in the order of the variants.
+    pub const KINDS: [&'static str; 3] = ["paper", "xyzac-trt", "xyzbc-trt"];
+
+    /// The `kind` name as written in the TOML file.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Kinematics::Paper => Self::KINDS[0],
+            Kinematics::XyzacTrt { .. } => Self::KINDS[1],
+            Kinematics::XyzbcTrt { .. } => Self::KINDS[2],
+        }
+    }
+
+    /// The tilting rotary axis this kinematics has (A or B).
+    pub fn tilt_name(&self) -> RotaryName {
+        match self {
+            Kinematics::Paper | Kinematics::XyzacTrt { .. } => RotaryName::A,
+            Kinematics::XyzbcTrt { .. } => RotaryName::B,
+        }
+    }
+}
+
+/// Name of the tilting rotary axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum RotaryName {
+    /// Tilts about machine X.
+    A,
+    /// Tilts about machine Y.
+    B,
+}
+
+impl RotaryName {
+    /// Upper-case axis letter, as in NC programs: `"A"` or `"B"`.
+    pub fn letter(self) -> &'static str {
+        match self {
+            RotaryName::A => "A",
+            RotaryName::B => "B",
+        }
+    }
+
+    /// The table key under `[axes]`: `"a"` or `"b"`.
+    pub fn key(self) -> &'static str {
+        match self {
+            RotaryName::A => "a",
+            RotaryName::B => "b",
+        }
+    }
+}
+
+impl fmt::Display for RotaryName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.letter())
+    }
+}
+
+/// Travel and rate limits of one axis (mm or deg, per s, s^2, s^3).
+#[derive(Clone, Debug, PartialEq)]
+pub struct AxisLimits {
+    /// Lower travel limit; `-inf` only for a continuous C table.
+    pub min: f64,
+    /// Upper travel limit, `> min`; `+inf` only for a continuous C table.
+    pub max: f64,
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub jerk: f64,
+}
+
+impl AxisLimits {
+    /// True when the axis has no travel limits (a continuous rotary table).
+    pub fn is_unlimited(&self) -> bool {
+        self.min == f64::NEG_INFINITY && self.max == f64::INFINITY
+    }
+}
+
+/// The five axes. The tilting axis is A or B as [`Axes::tilt_name`] says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axes {
+    pub x: AxisLimits,
+    pub y: AxisLimits,
+    pub z: AxisLimits,
+    pub tilt_name: RotaryName,
+    pub tilt: AxisLimits,
+    pub c: AxisLimits,
+}
+
+impl Axes {
+    /// All axes with their NC letters, in the order X, Y, Z, A/B, C.
+    pub fn all(&self) -> [(&'static str, &AxisLimits); 5] {
+        [
+            ("X", &self.x),
+            ("Y", &self.y),
+            ("Z", &self.z),
+            (self.tilt_name.letter(), &self.tilt),
+            ("C", &self.c),
+        ]
+    }
+}
+
+/// Parameter-update method of the interpolator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum Method {
+    /// Arc-length parametrisation (lowest feed fluctuation).
+    #[default]
+    Arclength,
+    /// First-order Taylor update (paper eq. 9).
+    Taylor1,
+    /// Second-order Taylor update (paper eq. 10).
+    Taylor2,
+}
+
+impl Method {
+    /// Every method, in declaration order.
+    pub const ALL: [Method; 3] = [Method::Arclength, Method::Taylor1, Method::Taylor2];
+
+    /// The name used in the TOML file and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Arclength => "arclength",
+            Method::Taylor1 => "taylor1",
+            Method::Taylor2 => "taylor2",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A string that names no [`Method`].
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "unknown interpolation method {0:?}: expected one of \"arclength\", \"taylor1\", \"taylor2\""
+)]
+pub struct UnknownMethod(pub String);
+
+impl FromStr for Method {
+    type Err = UnknownMethod;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Method::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| UnknownMethod(s.to_owned()))
+    }
+}
+
+/// Path-level interpolation settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Interpolation {
+    pub method: Method,
+    /// Maximum chord error, mm, in `(0, 1]`.
+    pub chord_tolerance_mm: f64,
+    /// Tangential acceleration limit, mm/s^2.
+    pub path_acceleration: f64,
+    /// Tangential jerk limit, mm/s^3.
+    pub path_jerk: f64,
+    /// Highest programmable feed, mm/min.
+    pub max_feed_mm_min: f64,
+    /// Feed for rapid moves, mm/min.
+    pub rapid_feed_mm_min: f64,
+}
+
+impl Interpolation {
+    /// Largest allowed `chord_tolerance_mm` (the lower bound, 0, is exclusive).
+    pub const MAX_CHORD_TOLERANCE_MM: f64 = 1.0;
+    /// Default `chord_tolerance_mm` (1 um, the design target).
+    pub const DEFAULT_CHORD_TOLERANCE_MM: f64 = 0.001;
+    /// Default `path_acceleration`, mm/s^2.
+    pub const DEFAULT_PATH_ACCELERATION: f64 = 1000.0;
+    /// Default `path_jerk`, mm/s^3.
+    pub const DEFAULT_PATH_JERK: f64 = 20000.0;
+    /// Default `max_feed_mm_min`; `rapid_feed_mm_min` defaults to `max_feed_mm_min`.
+    pub const DEFAULT_MAX_FEED_MM_MIN: f64 = 10000.0;
+}
+
+impl Default for Interpolation {
+    /// The values used when `[interpolation]` or one of its keys is omitted.
+    fn default() -> Self {
+        Interpolation {
+            method: Method::default(),
+            chord_tolerance_mm: Self::DEFAULT_CHORD_TOLERANCE_MM,
+            path_acceleration: Self::DEFAULT_PATH_ACCELERATION,
+            path_jerk: Self::DEFAULT_PATH_JERK,
+            max_feed_mm_min: Self::DEFAULT_MAX_FEED_MM_MIN,
+            rapid_feed_mm_min: Self::DEFAULT_MAX_FEED_MM_MIN,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn method_names_round_trip() {
+        for m in Method::ALL {
+            assert_eq!(m.to_string().parse::<Method>(), Ok(m));
+        }
+        let err = "taylor3".parse::<Method>().unwrap_err().to_string();
+        assert!(
+            err.contains("\"taylor3\"") && err.contains("taylor2"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn all_names_the_tilt_axis() {
+        let l = AxisLimits {
+            min: -1.0,
+            max: 1.0,
+            velocity: 1.0,
+            acceleration: 1.0,
+            jerk: 1.0,
+        };
+        let axes = Axes {
+            x: l.clone(),
+            y: l.clone(),
+            z: l.clone(),
+            tilt_name: RotaryName::B,
+            tilt: l.clone(),
+            c: l,
+        };
+        let names = axes.all().map(|(n, _)| n);
+        assert_eq!(names, ["X", "Y", "Z", "B", "C"]);
+    }
+}

@@ -1,0 +1,82 @@
+//! Stage 1: serde types that mirror the TOML file exactly.
+//!
+//! One struct per table, one field per key, no interpretation: numbers are plain `f64`
+//! (TOML integers are accepted, `period_ms = 2` reads as `2.0`), optional keys are `Option`,
+//! strings that name a choice (`kind`, `method`) stay strings so that [`crate::validate`]
+//! can report a bad choice with the list of allowed names. Every struct has
+//! `#[serde(deny_unknown_fields)]`: a misspelt key is an error, never silently ignored.
+//!
+//! Adding a section (the planned `[[bus]]`, `[drives]`, `[rt]`) is one struct here plus one
+//! field in [`RawFile`] (`Option<RawX>` or `#[serde(default)] Vec<RawX>`), then its
+//! conversion in `validate.rs`.
+
+use serde::Deserialize;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawFile {
+    pub machine: RawMachine,
+    pub kinematics: RawKinematics,
+    pub axes: RawAxes,
+    pub interpolation: Option<RawInterpolation>,
+}
+
+/// `[machine]`
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawMachine {
+    pub name: String,
+    /// Interpolation period in milliseconds.
+    pub period_ms: Option<f64>,
+}
+
+/// `[kinematics]`: `kind` selects which of the point keys are required.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawKinematics {
+    pub kind: String,
+    /// mm, machine frame; xyzac-trt only.
+    pub a_axis_point: Option<[f64; 3]>,
+    /// mm, machine frame; xyzbc-trt only.
+    pub b_axis_point: Option<[f64; 3]>,
+    /// mm, machine frame at tilt = 0; the trt kinds only.
+    pub c_axis_point: Option<[f64; 3]>,
+}
+
+/// `[axes.*]`: exactly one of `a` / `b` must be present, as the kinematics requires.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawAxes {
+    pub x: RawAxis,
+    pub y: RawAxis,
+    pub z: RawAxis,
+    pub a: Option<RawAxis>,
+    pub b: Option<RawAxis>,
+    pub c: RawAxis,
+}
+
+/// One axis. Linear: mm, mm/s, mm/s^2, mm/s^3. Rotary: deg, deg/s, deg/s^2, deg/s^3.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawAxis {
+    pub min: Option<f64>,
+    pub max: Option<f64>,
+    pub velocity: f64,
+    pub acceleration: f64,
+    pub jerk: f64,
+}
+
+/// `[interpolation]`: every key optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawInterpolation {
+    pub method: Option<String>,
+    pub chord_tolerance_mm: Option<f64>,
+    /// mm/s^2
+    pub path_acceleration: Option<f64>,
+    /// mm/s^3
+    pub path_jerk: Option<f64>,
+    pub max_feed_mm_min: Option<f64>,
+    pub rapid_feed_mm_min: Option<f64>,
+}

@@ -1,0 +1,277 @@
+//! Stage-2 errors: one test per validation rule. Each message must name the file, the
+//! line:col of the value (or of its table when the key is absent), the key, the value as
+//! written, and the allowed range with its unit.
+
+mod common;
+
+use common::{
+    assert_at, assert_mentions, fail, pos_of, remove, rename_table, set, MINIMAL, ORIGIN,
+};
+use config::ConfigError;
+
+/// Sets `table.key = value` in the minimal file, expects an `Invalid` error for that key and
+/// checks the whole message: `ORIGIN:line:col: table.key = value: rule`.
+#[track_caller]
+fn expect_invalid(table: &str, key: &str, value: &str, rule: &str) {
+    let text = set(MINIMAL, table, key, value);
+    let (err, shown) = fail(&text);
+    assert!(matches!(err, ConfigError::Invalid { .. }), "{err:?}");
+    let mut pos = pos_of(&text, &format!("{key} = {value}"));
+    pos.column += key.len() + 3;
+    let expected = format!(
+        "{ORIGIN}:{}:{}: {table}.{key} = {value}: {rule}",
+        pos.line, pos.column
+    );
+    assert_eq!(shown, expected);
+}
+
+#[test]
+fn the_documented_example_message() {
+    expect_invalid("axes.x", "velocity", "-3", "must be finite and > 0 (mm/s)");
+}
+
+#[test]
+fn machine_name_must_not_be_empty() {
+    expect_invalid("machine", "name", "\"\"", "must be a non-empty string");
+    expect_invalid("machine", "name", "\"  \"", "must be a non-empty string");
+}
+
+#[test]
+fn period_must_be_in_range() {
+    let rule = "must be finite and in 0.1..=100 (ms)";
+    for bad in ["0.05", "0", "-2.0", "100.5", "nan", "inf"] {
+        expect_invalid("machine", "period_ms", bad, rule);
+    }
+    for good in ["0.1", "100"] {
+        common::parse(&set(MINIMAL, "machine", "period_ms", good)).unwrap();
+    }
+}
+
+#[test]
+fn unknown_kinematics_kind_lists_the_three_kinds() {
+    expect_invalid(
+        "kinematics",
+        "kind",
+        "\"xyzac\"",
+        "must be one of \"paper\", \"xyzac-trt\", \"xyzbc-trt\"",
+    );
+}
+
+#[test]
+fn trt_kinds_require_their_points() {
+    let text = set(MINIMAL, "kinematics", "kind", "\"xyzac-trt\"");
+    let text = set(&text, "kinematics", "c_axis_point", "[0, 0, 0]");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("kinematics.a_axis_point"));
+    // An absent key points at its table.
+    assert_at(&shown, pos_of(&text, "kinematics]"));
+    assert_mentions(
+        &shown,
+        &["missing", "xyzac-trt", "A axis", "(mm, machine frame)"],
+    );
+
+    let text = set(MINIMAL, "kinematics", "kind", "\"xyzbc-trt\"");
+    let text = set(&text, "kinematics", "b_axis_point", "[0, 0, 0]");
+    let text = rename_table(&text, "axes.a", "axes.b");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("kinematics.c_axis_point"));
+    assert_mentions(&shown, &["missing", "xyzbc-trt", "C (at B = 0) axis"]);
+}
+
+#[test]
+fn kinematics_points_must_be_finite() {
+    let text = set(MINIMAL, "kinematics", "kind", "\"xyzac-trt\"");
+    let text = set(&text, "kinematics", "a_axis_point", "[0, 0, -50]");
+    let text = set(&text, "kinematics", "c_axis_point", "[0, nan, 0]");
+    let (err, shown) = fail(&text);
+    assert!(matches!(err, ConfigError::Invalid { .. }), "{err:?}");
+    assert_at(&shown, pos_of(&text, "[0, nan, 0]"));
+    assert_mentions(
+        &shown,
+        &["kinematics.c_axis_point = [0, nan, 0]: must be [x, y, z] with finite coordinates (mm"],
+    );
+}
+
+#[test]
+fn points_not_taken_by_the_kind_are_errors() {
+    let text = set(MINIMAL, "kinematics", "a_axis_point", "[0, 0, -50]");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("kinematics.a_axis_point"));
+    assert_mentions(
+        &shown,
+        &["not a key of kind \"paper\", which takes no points"],
+    );
+
+    let text = set(MINIMAL, "kinematics", "kind", "\"xyzac-trt\"");
+    let text = set(&text, "kinematics", "a_axis_point", "[0, 0, -50]");
+    let text = set(&text, "kinematics", "c_axis_point", "[0, 0, 0]");
+    let text = set(&text, "kinematics", "b_axis_point", "[0, 0, 0]");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("kinematics.b_axis_point"));
+    assert_mentions(&shown, &["takes a_axis_point and c_axis_point"]);
+}
+
+#[test]
+fn rates_must_be_finite_and_positive_with_units() {
+    expect_invalid(
+        "axes.y",
+        "acceleration",
+        "0",
+        "must be finite and > 0 (mm/s^2)",
+    );
+    expect_invalid("axes.z", "jerk", "inf", "must be finite and > 0 (mm/s^3)");
+    expect_invalid(
+        "axes.a",
+        "velocity",
+        "-90",
+        "must be finite and > 0 (deg/s)",
+    );
+    expect_invalid(
+        "axes.c",
+        "acceleration",
+        "nan",
+        "must be finite and > 0 (deg/s^2)",
+    );
+    expect_invalid("axes.c", "jerk", "-inf", "must be finite and > 0 (deg/s^3)");
+}
+
+#[test]
+fn travel_limits_must_be_finite() {
+    expect_invalid("axes.x", "min", "-inf", "must be finite (mm)");
+    expect_invalid("axes.a", "max", "nan", "must be finite (deg)");
+}
+
+#[test]
+fn min_must_be_below_max() {
+    expect_invalid(
+        "axes.y",
+        "max",
+        "-100.0",
+        "must be > axes.y.min = -100.0 (mm)",
+    );
+    expect_invalid("axes.a", "max", "-95", "must be > axes.a.min = -90.0 (deg)");
+}
+
+#[test]
+fn linear_and_tilt_axes_need_both_limits() {
+    let text = remove(MINIMAL, "axes.x", "min");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.x.min"));
+    assert_at(&shown, pos_of(&text, "x]"));
+    assert_mentions(
+        &shown,
+        &["missing", "needs min and max (mm)", "only C may omit both"],
+    );
+
+    let text = remove(&remove(MINIMAL, "axes.a", "min"), "axes.a", "max");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.a.min"));
+    assert_mentions(&shown, &["needs min and max (deg)"]);
+}
+
+#[test]
+fn c_axis_needs_both_limits_or_neither() {
+    let text = set(MINIMAL, "axes.c", "min", "-720");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.c.max"));
+    assert_at(&shown, pos_of(&text, "c]"));
+    assert_mentions(
+        &shown,
+        &[
+            "missing while axes.c.min is given",
+            "(deg)",
+            "omit both for unlimited rotation",
+        ],
+    );
+}
+
+#[test]
+fn wrong_tilt_key_for_the_kind_names_the_expected_one() {
+    let text = rename_table(MINIMAL, "axes.a", "axes.b");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.b"));
+    assert_at(&shown, pos_of(&text, "b]"));
+    assert_mentions(
+        &shown,
+        &["kind \"paper\" has no B axis", "configured as [axes.a]"],
+    );
+
+    let text = set(MINIMAL, "kinematics", "kind", "\"xyzbc-trt\"");
+    let text = set(&text, "kinematics", "b_axis_point", "[0, 0, -50]");
+    let text = set(&text, "kinematics", "c_axis_point", "[0, 0, 0]");
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.a"));
+    assert_mentions(
+        &shown,
+        &["kind \"xyzbc-trt\" has no A axis", "configured as [axes.b]"],
+    );
+}
+
+#[test]
+fn missing_tilt_table_names_the_expected_one() {
+    let start = MINIMAL.find("[axes.a]").unwrap();
+    let end = MINIMAL.find("[axes.c]").unwrap();
+    let text = format!("{}{}", &MINIMAL[..start], &MINIMAL[end..]);
+    let (err, shown) = fail(&text);
+    assert_eq!(err.key(), Some("axes.a"));
+    assert_mentions(
+        &shown,
+        &[ORIGIN, "missing", "needs [axes.a]", "tilting A axis (deg"],
+    );
+}
+
+fn with_interpolation(key: &str, value: &str) -> String {
+    format!("{MINIMAL}\n[interpolation]\n{key} = {value}\n")
+}
+
+#[test]
+fn unknown_method_lists_the_methods() {
+    let text = with_interpolation("method", "\"taylor3\"");
+    let (_, shown) = fail(&text);
+    assert_at(&shown, pos_of(&text, "\"taylor3\""));
+    assert_mentions(
+        &shown,
+        &["interpolation.method = \"taylor3\": must be one of \"arclength\", \"taylor1\", \"taylor2\""],
+    );
+    for name in ["arclength", "taylor1", "taylor2"] {
+        let m = common::parse(&with_interpolation("method", &format!("\"{name}\""))).unwrap();
+        assert_eq!(m.interpolation.method.to_string(), name);
+    }
+}
+
+#[test]
+fn chord_tolerance_must_be_in_range() {
+    for bad in ["0", "-0.001", "1.5", "nan"] {
+        let text = with_interpolation("chord_tolerance_mm", bad);
+        let (_, shown) = fail(&text);
+        let mut pos = pos_of(&text, &format!("= {bad}\n"));
+        pos.column += 2;
+        assert_at(&shown, pos);
+        assert_mentions(
+            &shown,
+            &[&format!(
+                "interpolation.chord_tolerance_mm = {bad}: must be finite and in (0, 1] (mm)"
+            )],
+        );
+    }
+    let m = common::parse(&with_interpolation("chord_tolerance_mm", "1")).unwrap();
+    assert_eq!(m.interpolation.chord_tolerance_mm, 1.0);
+}
+
+#[test]
+fn path_limits_and_feeds_must_be_positive() {
+    for (key, unit) in [
+        ("path_acceleration", "mm/s^2"),
+        ("path_jerk", "mm/s^3"),
+        ("max_feed_mm_min", "mm/min"),
+        ("rapid_feed_mm_min", "mm/min"),
+    ] {
+        let text = with_interpolation(key, "-1");
+        let (err, shown) = fail(&text);
+        assert_eq!(err.key(), Some(format!("interpolation.{key}").as_str()));
+        assert_mentions(
+            &shown,
+            &[&format!("{key} = -1: must be finite and > 0 ({unit})")],
+        );
+    }
+}
