@@ -23,6 +23,7 @@
 //! bounded by the number of segments and phases.
 
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
+use crate::nurbs::Ders;
 use crate::plan::FeedProfile;
 use crate::scurve::Motion;
 use crate::segment::{Geometry, Path, Pose};
@@ -67,6 +68,20 @@ pub struct Setpoint {
     pub joints: Joints,
     /// The program's end point has been reached; this is the last setpoint.
     pub done: bool,
+}
+
+/// Parameter increment over one period by a Taylor method (paper eq. 9 / eq. 10 with the
+/// feed-acceleration term), from C' and C'' at the current u, feed `v` and its rate `a`.
+/// `ArcLength` is treated as `Taylor2` here (it does not use this function).
+pub fn taylor_du(method: Method, d: &Ders, v: f64, a: f64, ts: f64) -> f64 {
+    let sp = d.d1.norm().max(1e-12);
+    let vt = v * ts;
+    match method {
+        Method::Taylor1 => vt / sp,
+        Method::Taylor2 | Method::ArcLength => {
+            vt / sp + a * ts * ts / (2.0 * sp) - vt * vt * d.d1.dot(&d.d2) / (2.0 * sp.powi(4))
+        }
+    }
 }
 
 /// The interpolator's state between periods.
@@ -194,15 +209,9 @@ impl<'a> Interpolator<'a> {
                 (Geometry::Nurbs { curve, .. }, c) => {
                     let (u0, u1) = curve.range();
                     let d = curve.cutter(self.u, 2);
-                    let sp = d.d1.norm().max(1e-12);
-                    let du = match (c, self.method) {
-                        (Some(dist), _) => dist / sp,
-                        (None, Method::Taylor1) => m.v * ts / sp,
-                        (None, _) => {
-                            let vt = m.v * ts;
-                            vt / sp + m.a * ts * ts / (2.0 * sp)
-                                - vt * vt * d.d1.dot(&d.d2) / (2.0 * sp.powi(4))
-                        }
+                    let du = match c {
+                        Some(dist) => dist / d.d1.norm().max(1e-12),
+                        None => taylor_du(self.method, &d, m.v, m.a, ts),
                     };
                     self.u = (self.u + du.max(0.0)).max(u0);
                     if self.u >= u1 {
@@ -237,5 +246,211 @@ impl<'a> Interpolator<'a> {
             Geometry::Nurbs { curve, .. } => seg.pose_u(curve, self.u),
             Geometry::Line { .. } => seg.pose(self.line_s),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::arclen::ArcTable;
+    use crate::kinematics::Kinematics;
+    use crate::nurbs::tests::paper;
+    use crate::plan::{plan, AxisLimit, PlanConfig};
+    use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
+    use crate::segment::{build, BuildLimits};
+
+    /// The paper's example as the parser produces it (built by hand here so these tests do
+    /// not depend on the parser).
+    pub(crate) fn paper_program() -> Program {
+        let c = [
+            [47.7773, 71.0202, 58.8006],
+            [44.3229, 75.6066, 54.4778],
+            [37.2164, 84.6443, 44.5755],
+            [28.7567, 101.5653, 29.7151],
+            [-1.6963, 163.6796, 5.8369],
+        ];
+        let t = [
+            [47.8066, 71.9791, 59.0828],
+            [44.3651, 76.5494, 54.8138],
+            [37.2554, 85.5421, 45.0342],
+            [28.7081, 102.3535, 30.3361],
+            [-1.8572, 163.9906, 6.7762],
+        ];
+        let mut b = NurbsBlock {
+            pos: SrcPos { line: 2, col: 1 },
+            n: Some(30),
+            kind: NurbsKind::G065,
+            degree: 3,
+            ctrl: Default::default(),
+            tool_ctrl: Default::default(),
+            ctrl_pos: Default::default(),
+            weights: Default::default(),
+            knots: Default::default(),
+            feed_mm_min: 400.0,
+        };
+        for i in 0..5 {
+            b.ctrl.push(c[i]).unwrap();
+            b.tool_ctrl.push(t[i]).unwrap();
+            b.weights.push(1.0).unwrap();
+            b.ctrl_pos.push(SrcPos::default()).unwrap();
+        }
+        b.knots.extend_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0]).unwrap();
+        let dir = [t[0][0] - c[0][0], t[0][1] - c[0][1], t[0][2] - c[0][2]];
+        let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
+        Program {
+            blocks: vec![
+                Block::Linear(LinearMove {
+                    pos: SrcPos { line: 1, col: 1 },
+                    n: Some(20),
+                    rapid: false,
+                    end: c[0],
+                    orientation: Orientation::Vector([dir[0] / n, dir[1] / n, dir[2] / n]),
+                    feed_mm_min: 400.0,
+                }),
+                Block::Nurbs(b),
+            ],
+            end: None,
+        }
+    }
+
+    pub(crate) fn machine() -> (MachineKinematics, PlanConfig, BuildLimits) {
+        let lin = AxisLimit { velocity: 250.0, acceleration: 2500.0, jerk: 50000.0 };
+        let rot = AxisLimit {
+            velocity: 90f64.to_radians(),
+            acceleration: 900f64.to_radians(),
+            jerk: 20000f64.to_radians(),
+        };
+        let cfg = PlanConfig {
+            period: 0.002,
+            chord_tol: 0.001,
+            path_acc: 1000.0,
+            path_jerk: 20000.0,
+            axes: [lin, lin, lin, rot, rot],
+            rotary: RotaryLimits::UNLIMITED,
+        };
+        let bl = BuildLimits { rapid_mm_s: 250.0, max_feed_mm_s: 10000.0 / 60.0, rotary: RotaryLimits::UNLIMITED };
+        (MachineKinematics::Paper, cfg, bl)
+    }
+
+    fn run(method: Method) -> (Path, FeedProfile, Vec<Setpoint>) {
+        let (kin, cfg, bl) = machine();
+        let path = build(&paper_program(), &kin, &bl).unwrap();
+        let profile = plan(&path, &kin, &cfg);
+        let mut out = Vec::new();
+        {
+            let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, cfg.path_acc * cfg.period);
+            for _ in 0..100_000 {
+                let sp = ip.step();
+                out.push(sp);
+                if sp.done {
+                    break;
+                }
+            }
+        }
+        (path, profile, out)
+    }
+
+    /// Largest relative difference between the arc length per period and feed x period,
+    /// over periods at constant commanded feed.
+    fn fluctuation(path: &Path, sps: &[Setpoint]) -> (f64, usize) {
+        let (curve, table) = path.segments[0].nurbs().unwrap();
+        let mut worst = 0.0f64;
+        let mut n = 0;
+        for w in sps.windows(2) {
+            if let (Some(ua), Some(ub)) = (w[0].u, w[1].u) {
+                if w[0].feed == w[1].feed && w[1].feed > 0.0 && !w[1].done {
+                    let ds = table.s_of_u(curve, ub) - table.s_of_u(curve, ua);
+                    worst = worst.max((ds - w[1].feed * 0.002).abs() / (w[1].feed * 0.002));
+                    n += 1;
+                }
+            }
+        }
+        (worst, n)
+    }
+
+    #[test]
+    fn arclength_keeps_the_feed_within_1e4_and_ends_on_the_end_point() {
+        let (path, profile, sps) = run(Method::ArcLength);
+        let (worst, n) = fluctuation(&path, &sps);
+        assert!(n > 1000, "too few constant-feed periods: {n}");
+        assert!(worst < 1e-4, "feed fluctuation {worst:e}");
+        let last = sps.last().unwrap();
+        assert!(last.done);
+        let end = path.segments[0].pose(path.segments[0].length).p;
+        assert!((last.p - end).norm() < 1e-9, "{} vs {end}", last.p);
+        assert!((last.p - nalgebra::Vector3::new(-1.6963, 163.6796, 5.8369)).norm() < 1e-9);
+        // Starts at the start pose, at rest.
+        assert_eq!(sps[0].p, path.start.p);
+        assert_eq!(sps[0].feed, 0.0);
+        // Never faster than programmed.
+        assert!(sps.iter().all(|s| s.feed <= 400.0 / 60.0 + 1e-9));
+        assert!((profile.length - path.segments[0].length).abs() < 1e-12);
+    }
+
+    #[test]
+    fn setpoints_lie_on_both_curves() {
+        let (_, _, sps) = run(Method::ArcLength);
+        let c = paper();
+        for sp in sps.iter().filter(|s| s.u.is_some()) {
+            let (p, t) = c.both(sp.u.unwrap(), 0);
+            assert!((sp.p - p.p).norm() < 1e-12);
+            let axis = (t.p - p.p).normalize();
+            assert!((sp.tool - axis).norm() < 1e-12);
+            // Paper kinematics: machine XYZ = workpiece XYZ, A/C reproduce the tool axis.
+            let k = MachineKinematics::Paper;
+            assert!((k.tool_axis(sp.joints[3], sp.joints[4]) - axis).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn taylor_methods_rank_as_the_paper_says() {
+        let (p1, _, s1) = run(Method::Taylor1);
+        let (p2, _, s2) = run(Method::Taylor2);
+        let (f1, _) = fluctuation(&p1, &s1);
+        let (f2, _) = fluctuation(&p2, &s2);
+        assert!(f2 < f1, "taylor2 {f2:e} should beat taylor1 {f1:e}");
+        assert!(s1.last().unwrap().done && s2.last().unwrap().done);
+        let end = nalgebra::Vector3::new(-1.6963, 163.6796, 5.8369);
+        assert!((s2.last().unwrap().p - end).norm() < 1e-9);
+    }
+
+    #[test]
+    fn taylor2_acceleration_term_is_what_a_varying_feed_needs() {
+        // One period from u0 with feed v and acceleration a: the exact step ends at arc
+        // length s(u0) + v Ts + a Ts^2 / 2. Without the a-term the error is O(a Ts^2), with
+        // it O(Ts^3).
+        let c = paper();
+        let table = ArcTable::new(&c);
+        let ts = 0.002;
+        for &(u0, v, a) in &[(0.2, 50.0, 1000.0), (0.6, 20.0, -800.0), (0.45, 100.0, 2000.0)] {
+            let d = c.cutter(u0, 2);
+            let exact = table.u_of_s(&c, table.s_of_u(&c, u0) + v * ts + a * ts * ts / 2.0) - u0;
+            let with = taylor_du(Method::Taylor2, &d, v, a, ts);
+            let without = taylor_du(Method::Taylor2, &d, v, 0.0, ts);
+            let e_with = (with - exact).abs();
+            let e_without = (without - exact).abs();
+            assert!(e_with * 20.0 < e_without, "u0={u0}: with {e_with:e}, without {e_without:e}");
+            // Taylor1 ignores curvature and acceleration alike.
+            assert!((taylor_du(Method::Taylor1, &d, v, a, ts) - exact).abs() > e_with);
+        }
+    }
+
+    #[test]
+    fn profile_respects_path_limits_and_is_continuous() {
+        let (kin, cfg, bl) = machine();
+        let path = build(&paper_program(), &kin, &bl).unwrap();
+        let p = plan(&path, &kin, &cfg);
+        for w in p.phases.windows(2) {
+            let e = w[0].end();
+            assert!((e.s - w[1].s0).abs() < 1e-9 && (e.v - w[1].v0).abs() < 1e-9 && (e.a - w[1].a0).abs() < 1e-6);
+            assert!((w[0].t0 + w[0].dur - w[1].t0).abs() < 1e-12);
+        }
+        for ph in &p.phases {
+            assert!(ph.j.abs() <= cfg.path_jerk * (1.0 + 1e-12));
+            assert!(ph.a0.abs() <= cfg.path_acc * (1.0 + 1e-9));
+            assert!(ph.v0 <= 400.0 / 60.0 + 1e-9 && ph.v0 >= -1e-9);
+        }
+        let last = p.phases.last().unwrap().end();
+        assert!((last.s - p.length).abs() < 1e-6 && last.v.abs() < 1e-9);
     }
 }
