@@ -1,0 +1,97 @@
+//! The per-period step must not touch the heap: a counting global allocator watches every
+//! `Interpolator::step` over whole programs (>= 100 000 periods in all, all three methods,
+//! paper and RTCP kinematics) and must see zero allocations, reallocations and frees.
+//!
+//! This file is its own test binary, so no other test's allocations are counted.
+
+use nalgebra::Vector3;
+use nc::interp::{Interpolator, Method};
+use nc::kinematics::{MachineKinematics, RotaryLimits, Tilt};
+use nc::plan::{plan, AxisLimit, PlanConfig};
+use nc::segment::{build, BuildLimits};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+
+struct Counting;
+
+static ARMED: AtomicBool = AtomicBool::new(false);
+static EVENTS: AtomicU64 = AtomicU64::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if ARMED.load(Ordering::Relaxed) {
+            EVENTS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if ARMED.load(Ordering::Relaxed) {
+            EVENTS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new: usize) -> *mut u8 {
+        if ARMED.load(Ordering::Relaxed) {
+            EVENTS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.realloc(ptr, layout, new) }
+    }
+}
+
+#[global_allocator]
+static ALLOC: Counting = Counting;
+
+const PROGRAMS: [&str; 3] = [
+    include_str!("../../tests/data/paper-example.nc"),
+    include_str!("../../tests/data/tight-curvature.nc"),
+    include_str!("../../tests/data/two-blocks-g2.nc"),
+];
+
+#[test]
+fn step_never_allocates() {
+    let lin = AxisLimit { velocity: 250.0, acceleration: 2500.0, jerk: 50000.0 };
+    let rot = AxisLimit {
+        velocity: 180f64.to_radians(),
+        acceleration: 1800f64.to_radians(),
+        jerk: 40000f64.to_radians(),
+    };
+    let cfg = PlanConfig {
+        period: 0.002,
+        chord_tol: 0.001,
+        path_acc: 1000.0,
+        path_jerk: 20000.0,
+        axes: [lin, lin, lin, rot, rot],
+        rotary: RotaryLimits::UNLIMITED,
+    };
+    let limits = BuildLimits { rapid_mm_s: 250.0, max_feed_mm_s: 166.0, rotary: cfg.rotary };
+    let kins = [
+        MachineKinematics::Paper,
+        MachineKinematics::Trt { tilt: Tilt::A, tilt_point: Vector3::new(0.0, 0.0, -50.0), c_point: Vector3::zeros() },
+    ];
+    let mut periods = 0u64;
+    for src in PROGRAMS {
+        let program = nc::parse::parse(src).expect("test program parses");
+        for kin in kins {
+            let path = build(&program, &kin, &limits).expect("test program builds");
+            let profile = plan(&path, &kin, &cfg);
+            for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
+                let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);
+                let mut sum = 0.0;
+                EVENTS.store(0, Ordering::SeqCst);
+                ARMED.store(true, Ordering::SeqCst);
+                loop {
+                    let sp = ip.step();
+                    sum += sp.joints[0];
+                    periods += 1;
+                    if sp.done || sp.cycle > 10_000_000 {
+                        break;
+                    }
+                }
+                ARMED.store(false, Ordering::SeqCst);
+                assert!(sum.is_finite());
+                assert_eq!(EVENTS.load(Ordering::SeqCst), 0, "heap touched during {} steps", method.name());
+            }
+        }
+    }
+    assert!(periods >= 100_000, "only {periods} periods checked");
+}

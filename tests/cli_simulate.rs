@@ -1,0 +1,138 @@
+//! `dnurbs simulate` end to end: the real binary on the programs in tests/data, its trace
+//! checked against independent evaluations (Cox-de Boor, closed-form kinematics).
+
+mod common;
+use common::*;
+
+fn f(v: &serde_json::Value, key: &str) -> f64 {
+    v[key].as_f64().unwrap_or_else(|| panic!("summary has no number {key}: {v}"))
+}
+
+fn assert_within_limits(s: &serde_json::Value) {
+    for key in ["axis_velocity_fraction", "axis_acceleration_fraction"] {
+        let m = s[key].as_object().unwrap_or_else(|| panic!("{key} missing"));
+        assert_eq!(m.len(), 5, "{key}: {m:?}");
+        for (axis, frac) in m {
+            let frac = frac.as_f64().unwrap();
+            assert!(frac <= 1.0 + 1e-6, "{key} {axis} = {frac}");
+        }
+    }
+    assert_eq!(s["axis_travel_ok"], true);
+    assert!(f(s, "chord_error_max_mm") <= f(s, "chord_tolerance_mm"), "{s}");
+}
+
+#[test]
+fn paper_example_lies_on_both_curves_with_paper_kinematics() {
+    let (s, rows) = simulate("paper-example.nc", "paper-ac-table.toml", &[]);
+    assert_eq!(s["method"], "arclength");
+    assert!(f(&s, "feed_fluctuation_max") < 1e-4, "{s}");
+    assert!(f(&s, "feed_fluctuation_periods") > 1000.0);
+    assert!(f(&s, "end_position_error_mm") < 1e-9);
+    assert!(f(&s, "tool_axis_deviation_max_deg") < 0.01, "{s}");
+    assert_within_limits(&s);
+    assert_eq!(rows[0].cycle, 0);
+    assert_eq!(rows[0].t, 0.0);
+    assert_eq!(f(&s, "cycles") as usize, rows.len());
+    let mut on_curve = 0;
+    for r in &rows {
+        // Paper kinematics: machine XYZ = workpiece XYZ; T = (-sinA sinC, sinA cosC, cosA).
+        for a in 0..3 {
+            assert!((r.axes[a] - r.p[a]).abs() < 1e-12);
+        }
+        let (a, c) = (r.axes[3].to_radians(), r.axes[4].to_radians());
+        let t = [-a.sin() * c.sin(), a.sin() * c.cos(), a.cos()];
+        assert!(dist(t, r.tool) < 1e-9, "row {}: A/C give {t:?}, tool {:?}", r.cycle, r.tool);
+        assert!(r.feed <= 400.0 + 1e-9, "row {} feed {}", r.cycle, r.feed);
+        if let Some(u) = r.u {
+            let c = nurbs_point(3, &PAPER_C, &[1.0; 5], &PAPER_K, u);
+            let ct = nurbs_point(3, &PAPER_T, &[1.0; 5], &PAPER_K, u);
+            assert!(dist(c, r.p) < 1e-9, "row {}: {c:?} vs {:?}", r.cycle, r.p);
+            let axis = unit([ct[0] - c[0], ct[1] - c[1], ct[2] - c[2]]);
+            assert!(dist(axis, r.tool) < 1e-9);
+            on_curve += 1;
+        }
+    }
+    assert!(on_curve + 2 >= rows.len(), "{on_curve} of {} rows on the curve", rows.len());
+    let last = rows.last().unwrap();
+    assert!(dist(last.p, PAPER_C[4]) < 1e-9);
+    assert_eq!(last.feed, 0.0);
+    // C stays continuous: no step bigger than the C axis can make in one period.
+    for w in rows.windows(2) {
+        assert!((w[1].axes[4] - w[0].axes[4]).abs() < 180.0 * 0.002 + 1e-9);
+    }
+}
+
+#[test]
+fn methods_rank_taylor1_taylor2_arclength() {
+    let mut fl = vec![];
+    for m in ["taylor1", "taylor2", "arclength"] {
+        let (s, rows) = simulate("paper-example.nc", "paper-ac-table.toml", &["--method", m]);
+        assert_eq!(s["method"], m);
+        let last = rows.last().unwrap();
+        assert!(dist(last.p, PAPER_C[4]) < 1e-9, "{m} ends at {:?}", last.p);
+        fl.push(f(&s, "feed_fluctuation_max"));
+    }
+    assert!(fl[0] > fl[1] && fl[1] > fl[2], "taylor1 {} taylor2 {} arclength {}", fl[0], fl[1], fl[2]);
+}
+
+#[test]
+fn tight_curvature_is_slowed_by_centripetal_and_c_axis_limits() {
+    let (s, rows) = simulate("tight-curvature.nc", "paper-ac-table.toml", &[]);
+    assert!(f(&s, "feed_fluctuation_max") < 1e-4, "{s}");
+    assert_within_limits(&s);
+    // The C axis is the binding limit on the circle: it runs close to its velocity limit.
+    let c = s["axis_velocity_fraction"]["C"].as_f64().unwrap();
+    assert!(c > 0.8, "C velocity fraction {c}");
+    let on_circle: Vec<&Row> = rows.iter().filter(|r| r.block == 3).collect();
+    assert!(on_circle.iter().all(|r| r.feed < 3000.0));
+    // The circle (radius 4 about X10 Y10) is followed exactly.
+    for r in &on_circle {
+        let rad = ((r.p[0] - 10.0).powi(2) + (r.p[1] - 10.0).powi(2)).sqrt();
+        assert!((rad - 4.0).abs() < 1e-9 && r.p[2].abs() < 1e-12, "{r:?}");
+    }
+    let last = rows.last().unwrap();
+    assert!(dist(last.p, [10.0, 6.0, 5.0]) < 1e-9);
+}
+
+#[test]
+fn a_g2_joint_is_passed_at_speed() {
+    let (s, rows) = simulate("two-blocks-g2.nc", "paper-ac-table.toml", &[]);
+    assert_within_limits(&s);
+    let first_of_2 = rows.iter().position(|r| r.block == 3).expect("second block reached");
+    let at_joint = rows[first_of_2].feed;
+    assert!(at_joint > 0.9 * 2000.0, "feed at the joint {at_joint} mm/min");
+    let last = rows.last().unwrap();
+    assert!(dist(last.p, [60.0, -10.0, 0.0]) < 1e-9 && last.feed == 0.0);
+}
+
+#[test]
+fn rtcp_machine_axes_carry_the_cutter_point() {
+    let (s, rows) = simulate("paper-example.nc", "xyzac-trt-mill.toml", &["--method", "arclength"]);
+    assert_within_limits(&s);
+    assert!(f(&s, "feed_fluctuation_max") < 1e-4);
+    // Forward kinematics written out independently: undo the A tilt about the pivot
+    // (0, 0, -50), then the C turn about the Z axis through the origin.
+    for r in &rows {
+        let (a, c) = (r.axes[3].to_radians(), r.axes[4].to_radians());
+        let m = [r.axes[0], r.axes[1], r.axes[2] + 50.0];
+        let (y, z) = (m[1] * a.cos() + m[2] * a.sin(), -m[1] * a.sin() + m[2] * a.cos());
+        let q = [m[0], y, z - 50.0];
+        let p = [q[0] * c.cos() - q[1] * c.sin(), q[0] * c.sin() + q[1] * c.cos(), q[2]];
+        assert!(dist(p, r.p) < 1e-9, "row {}: {p:?} vs {:?}", r.cycle, r.p);
+    }
+}
+
+#[test]
+fn text_summary_and_help() {
+    let prog = data("paper-example.nc");
+    let mach = machine("paper-ac-table.toml");
+    let out = dnurbs(&["simulate", prog.to_str().unwrap(), "--machine", mach.to_str().unwrap()]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    for word in ["feed fluctuation", "chord error", "axis velocity", "machining time"] {
+        assert!(text.contains(word), "{word} missing from\n{text}");
+    }
+    let help = dnurbs(&["simulate", "--help"]);
+    let help = String::from_utf8(help.stdout).unwrap();
+    assert!(help.contains("--trace") && help.contains("--method") && help.contains("taylor2"));
+}

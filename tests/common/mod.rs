@@ -1,0 +1,158 @@
+//! Helpers shared by the integration tests: run the real `dnurbs` binary, read its trace,
+//! and evaluate NURBS independently of the nc crate.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// The workspace root (tests/ sits directly under it).
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+pub fn data(name: &str) -> PathBuf {
+    root().join("tests/data").join(name)
+}
+
+pub fn machine(name: &str) -> PathBuf {
+    root().join("config/machines").join(name)
+}
+
+/// Run `dnurbs` with the given arguments.
+pub fn dnurbs(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("dnurbs runs")
+}
+
+/// A fresh path in the system temp directory.
+pub fn temp(name: &str) -> PathBuf {
+    static N: AtomicU32 = AtomicU32::new(0);
+    let n = N.fetch_add(1, Ordering::Relaxed);
+    std::env::temp_dir().join(format!("dnurbs-test-{}-{n}-{name}", std::process::id()))
+}
+
+/// One row of a `--trace` CSV.
+#[derive(Debug, Clone)]
+pub struct Row {
+    pub cycle: u64,
+    pub t: f64,
+    pub block: u32,
+    pub u: Option<f64>,
+    pub p: [f64; 3],
+    pub tool: [f64; 3],
+    pub feed: f64,
+    pub axes: [f64; 5],
+}
+
+pub const TRACE_HEADER: &str = "cycle,t,block,u,x,y,z,i,j,k,feed,X,Y,Z,A,C";
+
+pub fn read_trace(path: &std::path::Path) -> Vec<Row> {
+    let text = std::fs::read_to_string(path).expect("trace written");
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(TRACE_HEADER));
+    lines
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            assert_eq!(f.len(), 16, "row {l}");
+            let x = |i: usize| f[i].parse::<f64>().unwrap_or_else(|_| panic!("field {i} of {l}"));
+            Row {
+                cycle: f[0].parse().unwrap(),
+                t: x(1),
+                block: f[2].parse().unwrap(),
+                u: (!f[3].is_empty()).then(|| x(3)),
+                p: [x(4), x(5), x(6)],
+                tool: [x(7), x(8), x(9)],
+                feed: x(10),
+                axes: [x(11), x(12), x(13), x(14), x(15)],
+            }
+        })
+        .collect()
+}
+
+/// Run `simulate` with `--json` and a trace; returns the summary and the rows.
+pub fn simulate(program: &str, machine_file: &str, extra: &[&str]) -> (serde_json::Value, Vec<Row>) {
+    let trace = temp("trace.csv");
+    let prog = data(program);
+    let mach = machine(machine_file);
+    let mut args = vec![
+        "simulate",
+        prog.to_str().unwrap(),
+        "--machine",
+        mach.to_str().unwrap(),
+        "--json",
+        "--trace",
+        trace.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let out = dnurbs(&args);
+    assert!(
+        out.status.success(),
+        "dnurbs {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON summary");
+    let rows = read_trace(&trace);
+    let _ = std::fs::remove_file(&trace);
+    (summary, rows)
+}
+
+/// Cox-de Boor recursion (paper eq. 4), closed on the right at the end of the knot range.
+pub fn basis(i: usize, p: usize, u: f64, k: &[f64]) -> f64 {
+    if p == 0 {
+        let last = k[k.len() - 1];
+        let inside = (k[i] <= u && u < k[i + 1]) || (u >= last && k[i] < last && k[i + 1] == last);
+        return if inside { 1.0 } else { 0.0 };
+    }
+    let mut v = 0.0;
+    if k[i + p] > k[i] {
+        v += (u - k[i]) / (k[i + p] - k[i]) * basis(i, p - 1, u, k);
+    }
+    if k[i + p + 1] > k[i + 1] {
+        v += (k[i + p + 1] - u) / (k[i + p + 1] - k[i + 1]) * basis(i + 1, p - 1, u, k);
+    }
+    v
+}
+
+/// Rational curve point (paper eq. 2).
+pub fn nurbs_point(p: usize, ctrl: &[[f64; 3]], w: &[f64], k: &[f64], u: f64) -> [f64; 3] {
+    let mut num = [0.0; 3];
+    let mut den = 0.0;
+    for (i, c) in ctrl.iter().enumerate() {
+        let b = basis(i, p, u, k) * w[i];
+        den += b;
+        for a in 0..3 {
+            num[a] += b * c[a];
+        }
+    }
+    [num[0] / den, num[1] / den, num[2] / den]
+}
+
+/// The paper's block (design.md section 1): degree, C net, CT net, knots.
+pub const PAPER_C: [[f64; 3]; 5] = [
+    [47.7773, 71.0202, 58.8006],
+    [44.3229, 75.6066, 54.4778],
+    [37.2164, 84.6443, 44.5755],
+    [28.7567, 101.5653, 29.7151],
+    [-1.6963, 163.6796, 5.8369],
+];
+pub const PAPER_T: [[f64; 3]; 5] = [
+    [47.8066, 71.9791, 59.0828],
+    [44.3651, 76.5494, 54.8138],
+    [37.2554, 85.5421, 45.0342],
+    [28.7081, 102.3535, 30.3361],
+    [-1.8572, 163.9906, 6.7762],
+];
+pub const PAPER_K: [f64; 9] = [0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0];
+
+pub fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+pub fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
+}

@@ -1,0 +1,97 @@
+//! The validated machine file turned into the nc crate's types, once, before anything runs.
+//!
+//! `config` stays free of motion code and `nc` free of file formats; this is the one place
+//! where the two meet. Rotary quantities change units here: the machine file speaks degrees,
+//! the interpolator radians.
+
+use config::{Kinematics as KinConfig, Machine};
+use nalgebra::Vector3;
+use nc::interp::Method;
+use nc::kinematics::{MachineKinematics, RotaryLimits, Tilt};
+use nc::plan::{AxisLimit, PlanConfig};
+use nc::segment::BuildLimits;
+
+/// Everything the interpolator needs from the machine file, in its own units.
+#[derive(Clone, Debug)]
+pub struct MachineSetup {
+    pub name: String,
+    pub period: f64,
+    pub kin: MachineKinematics,
+    pub plan: PlanConfig,
+    pub build: BuildLimits,
+    pub method: Method,
+    /// Axis names in joint order: X Y Z, tilt (A or B), C.
+    pub axis_names: [&'static str; 5],
+    /// Axis limits as in the machine file (mm or degrees), joint order.
+    pub limits: [config::AxisLimits; 5],
+}
+
+pub fn method_of(m: config::Method) -> Method {
+    match m {
+        config::Method::Arclength => Method::ArcLength,
+        config::Method::Taylor1 => Method::Taylor1,
+        config::Method::Taylor2 => Method::Taylor2,
+    }
+}
+
+impl MachineSetup {
+    pub fn new(m: &Machine) -> MachineSetup {
+        let kin = match &m.kinematics {
+            KinConfig::Paper => MachineKinematics::Paper,
+            KinConfig::XyzacTrt {
+                a_axis_point,
+                c_axis_point,
+            } => MachineKinematics::Trt {
+                tilt: Tilt::A,
+                tilt_point: Vector3::from(*a_axis_point),
+                c_point: Vector3::from(*c_axis_point),
+            },
+            KinConfig::XyzbcTrt {
+                b_axis_point,
+                c_axis_point,
+            } => MachineKinematics::Trt {
+                tilt: Tilt::B,
+                tilt_point: Vector3::from(*b_axis_point),
+                c_point: Vector3::from(*c_axis_point),
+            },
+        };
+        let all = m.axes.all();
+        let limits = all.map(|(_, l)| l.clone());
+        let axis_names = all.map(|(n, _)| n);
+        let axes: [AxisLimit; 5] = core::array::from_fn(|j| {
+            let l = &limits[j];
+            let k = if j >= 3 { 1f64.to_radians() } else { 1.0 };
+            AxisLimit {
+                velocity: l.velocity * k,
+                acceleration: l.acceleration * k,
+                jerk: l.jerk * k,
+            }
+        });
+        let rotary = RotaryLimits {
+            tilt: (limits[3].min.to_radians(), limits[3].max.to_radians()),
+            c: (limits[4].min.to_radians(), limits[4].max.to_radians()),
+        };
+        let ip = &m.interpolation;
+        MachineSetup {
+            name: m.name.clone(),
+            period: m.period_s,
+            kin,
+            plan: PlanConfig {
+                period: m.period_s,
+                chord_tol: ip.chord_tolerance_mm,
+                path_acc: ip.path_acceleration,
+                path_jerk: ip.path_jerk,
+                axes,
+                rotary,
+            },
+            build: BuildLimits {
+                rapid_mm_s: ip.rapid_feed_mm_min / 60.0,
+                max_feed_mm_s: ip.max_feed_mm_min / 60.0,
+                rotary,
+            },
+            method: method_of(ip.method),
+            axis_names,
+            limits,
+        }
+    }
+}

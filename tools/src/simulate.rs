@@ -1,0 +1,286 @@
+//! `dnurbs simulate`: the interpolator run offline, period by period, exactly as the
+//! real-time thread will run it, and the measurements that judge the result.
+//!
+//! The measurements are made independently of the interpolator's own shortcuts: arc length
+//! per period is integrated afresh between the two setpoints' parameters (Gauss-Legendre on
+//! |C'(u)|, not the arc-length table), the chord error is measured against the curve itself,
+//! and the tool axis is recovered from the machine angles through forward kinematics.
+
+use crate::setup::MachineSetup;
+use nalgebra::Vector3;
+use nc::interp::{Interpolator, Method, Setpoint};
+use nc::kinematics::Kinematics;
+use nc::nurbs::DoubleNurbs;
+use nc::plan::{plan, FeedProfile};
+use nc::program::Program;
+use nc::segment::{build, BuildError, Path, Tooling};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// A finished offline run.
+pub struct Run {
+    pub path: Path,
+    pub profile: FeedProfile,
+    pub setpoints: Vec<Setpoint>,
+    pub method: Method,
+}
+
+/// Upper bound on simulated periods, so a degenerate plan cannot run forever (24 h at 1 ms).
+pub const MAX_CYCLES: u64 = 86_400_000;
+
+/// Plan and interpolate a whole program.
+pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Run, BuildError> {
+    let path = build(program, &setup.kin, &setup.build)?;
+    let profile = plan(&path, &setup.kin, &setup.plan);
+    let creep = setup.plan.path_acc * setup.period;
+    let mut setpoints = Vec::with_capacity((profile.duration / setup.period) as usize + 2);
+    {
+        let mut ip = Interpolator::new(
+            &path,
+            &profile,
+            setup.kin,
+            setup.plan.rotary,
+            method,
+            setup.period,
+            creep,
+        );
+        loop {
+            let sp = ip.step();
+            setpoints.push(sp);
+            if sp.done || sp.cycle >= MAX_CYCLES || path.segments.is_empty() {
+                break;
+            }
+        }
+    }
+    Ok(Run {
+        path,
+        profile,
+        setpoints,
+        method,
+    })
+}
+
+/// The summary `dnurbs simulate` prints (JSON keys documented in the README).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub machine: String,
+    pub method: &'static str,
+    pub blocks: usize,
+    pub cycles: u64,
+    pub period_s: f64,
+    pub machining_time_s: f64,
+    pub path_length: f64,
+    pub feed_fluctuation_max: f64,
+    pub feed_fluctuation_rms: f64,
+    pub feed_fluctuation_periods: u64,
+    pub chord_error_max_mm: f64,
+    pub chord_tolerance_mm: f64,
+    pub axis_velocity_fraction: BTreeMap<&'static str, f64>,
+    pub axis_acceleration_fraction: BTreeMap<&'static str, f64>,
+    pub axis_travel_ok: bool,
+    pub tool_axis_deviation_max_deg: f64,
+    pub end_position_error_mm: f64,
+}
+
+const GL8: [(f64, f64); 8] = [
+    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (-0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
+    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
+    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
+    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
+    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
+];
+
+/// Arc length of the cutter curve between two parameters, integrated directly.
+pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
+    // Split at the knots so each piece is smooth, then 8-point Gauss-Legendre per piece.
+    let (lo, hi) = (a.min(b), a.max(b));
+    let mut cuts = vec![lo];
+    cuts.extend(curve.knots().iter().copied().filter(|&k| k > lo && k < hi));
+    cuts.push(hi);
+    cuts.dedup();
+    cuts.windows(2)
+        .map(|w| {
+            let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+            GL8.iter().map(|&(x, wt)| wt * curve.speed(m + h * x)).sum::<f64>() * h
+        })
+        .sum()
+}
+
+fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let f = if l2 > 0.0 { ((p - a).dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (p - (a + ab * f)).norm()
+}
+
+pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
+    let sps = &run.setpoints;
+    let ts = setup.period;
+    let seg_of = |block: u32| run.path.segments.iter().find(|s| s.block == block);
+    let (mut fmax, mut fsq, mut fn_) = (0.0f64, 0.0f64, 0u64);
+    let mut chord = 0.0f64;
+    for w in sps.windows(2) {
+        let (a, b) = (&w[0], &w[1]);
+        if a.block != b.block || b.done {
+            continue;
+        }
+        let Some(seg) = seg_of(b.block) else { continue };
+        let ds = match (seg.nurbs(), a.u, b.u) {
+            (Some((curve, _)), Some(ua), Some(ub)) => {
+                for f in [0.25, 0.5, 0.75] {
+                    let p = curve.cutter(ua + (ub - ua) * f, 0).p;
+                    chord = chord.max(dist_to_chord(&p, &a.p, &b.p));
+                }
+                arc_between(curve, ua, ub)
+            }
+            (None, None, None) if !seg.rotary_only => (b.p - a.p).norm(),
+            _ => continue,
+        };
+        if a.feed == b.feed && b.feed > 0.0 {
+            let want = b.feed * ts;
+            let f = (ds - want).abs() / want;
+            fmax = fmax.max(f);
+            fsq += f * f;
+            fn_ += 1;
+        }
+    }
+    // Axis velocity and acceleration by finite differences (rotary in degrees).
+    let unit = |j: usize, x: f64| if j >= 3 { x.to_degrees() } else { x };
+    let mut vfrac = [0.0f64; 5];
+    let mut afrac = [0.0f64; 5];
+    let mut travel_ok = true;
+    for (k, sp) in sps.iter().enumerate() {
+        for j in 0..5 {
+            let q = unit(j, sp.joints[j]);
+            let l = &setup.limits[j];
+            travel_ok &= q >= l.min - 1e-9 && q <= l.max + 1e-9;
+            if k >= 1 {
+                let v = unit(j, sp.joints[j] - sps[k - 1].joints[j]) / ts;
+                vfrac[j] = vfrac[j].max(v.abs() / l.velocity);
+            }
+            if k >= 2 {
+                let a = unit(j, sp.joints[j] - 2.0 * sps[k - 1].joints[j] + sps[k - 2].joints[j]) / (ts * ts);
+                afrac[j] = afrac[j].max(a.abs() / l.acceleration);
+            }
+        }
+    }
+    // Tool axis at the knots: machine angles interpolated between the bracketing setpoints,
+    // through forward kinematics, against the program's own CT(u) - C(u).
+    let mut tool_dev = 0.0f64;
+    for seg in &run.path.segments {
+        let (Some((curve, _)), Tooling::Curve) = (seg.nurbs(), &seg.tooling) else { continue };
+        let mine: Vec<&Setpoint> = sps.iter().filter(|s| s.block == seg.block && s.u.is_some()).collect();
+        let mut knots: Vec<f64> = curve.knots().to_vec();
+        knots.dedup();
+        for &k in &knots {
+            let Some(w) = mine.windows(2).find(|w| w[0].u.unwrap_or(0.0) <= k && k <= w[1].u.unwrap_or(0.0)) else {
+                continue;
+            };
+            let (ua, ub) = (w[0].u.unwrap_or(0.0), w[1].u.unwrap_or(0.0));
+            let f = if ub > ua { (k - ua) / (ub - ua) } else { 0.0 };
+            let j: [f64; 5] = core::array::from_fn(|i| w[0].joints[i] + (w[1].joints[i] - w[0].joints[i]) * f);
+            let got = setup.kin.tool_axis(j[3], j[4]);
+            let (c, t) = curve.both(k, 0);
+            let want = (t.p - c.p).normalize();
+            tool_dev = tool_dev.max(got.cross(&want).norm().atan2(got.dot(&want)).to_degrees());
+        }
+    }
+    let end_err = match (sps.last(), run.path.segments.last()) {
+        (Some(sp), Some(seg)) => (sp.p - seg.pose(seg.length).p).norm(),
+        _ => 0.0,
+    };
+    let names = setup.axis_names;
+    Summary {
+        machine: setup.name.clone(),
+        method: run.method.name(),
+        blocks,
+        cycles: sps.len() as u64,
+        period_s: ts,
+        machining_time_s: sps.last().map_or(0.0, |s| s.t),
+        path_length: run.profile.length,
+        feed_fluctuation_max: fmax,
+        feed_fluctuation_rms: if fn_ > 0 { (fsq / fn_ as f64).sqrt() } else { 0.0 },
+        feed_fluctuation_periods: fn_,
+        chord_error_max_mm: chord,
+        chord_tolerance_mm: setup.plan.chord_tol,
+        axis_velocity_fraction: names.iter().copied().zip(vfrac).collect(),
+        axis_acceleration_fraction: names.iter().copied().zip(afrac).collect(),
+        axis_travel_ok: travel_ok,
+        tool_axis_deviation_max_deg: tool_dev,
+        end_position_error_mm: end_err,
+    }
+}
+
+impl Summary {
+    /// The human-readable form printed without `--json`.
+    pub fn text(&self) -> String {
+        let fr = |m: &BTreeMap<&str, f64>| {
+            m.iter().map(|(k, v)| format!("{k} {:.1}%", v * 100.0)).collect::<Vec<_>>().join("  ")
+        };
+        format!(
+            "machine            {}\n\
+             method             {}\n\
+             blocks             {}\n\
+             cycles             {} x {} ms\n\
+             machining time     {:.3} s\n\
+             path length        {:.4}\n\
+             feed fluctuation   max {:.3e}  rms {:.3e}  over {} constant-feed periods\n\
+             chord error        max {:.3e} mm (tolerance {} mm)\n\
+             axis velocity      {}  (of limit)\n\
+             axis acceleration  {}  (of limit)\n\
+             axis travel        {}\n\
+             tool axis at knots max deviation {:.3e} deg\n\
+             end position error {:.3e} mm\n",
+            self.machine,
+            self.method,
+            self.blocks,
+            self.cycles,
+            self.period_s * 1e3,
+            self.machining_time_s,
+            self.path_length,
+            self.feed_fluctuation_max,
+            self.feed_fluctuation_rms,
+            self.feed_fluctuation_periods,
+            self.chord_error_max_mm,
+            self.chord_tolerance_mm,
+            fr(&self.axis_velocity_fraction),
+            fr(&self.axis_acceleration_fraction),
+            if self.axis_travel_ok { "within limits" } else { "OUTSIDE LIMITS" },
+            self.tool_axis_deviation_max_deg,
+            self.end_position_error_mm,
+        )
+    }
+}
+
+/// Write the trace CSV (header documented in the README).
+pub fn write_trace(w: &mut impl std::io::Write, sps: &[Setpoint]) -> std::io::Result<()> {
+    writeln!(w, "cycle,t,block,u,x,y,z,i,j,k,feed,X,Y,Z,A,C")?;
+    for s in sps {
+        let u = s.u.map(|u| u.to_string()).unwrap_or_default();
+        let q = &s.joints;
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            s.cycle,
+            s.t,
+            s.block,
+            u,
+            s.p.x,
+            s.p.y,
+            s.p.z,
+            s.tool.x,
+            s.tool.y,
+            s.tool.z,
+            s.feed * 60.0,
+            q[0],
+            q[1],
+            q[2],
+            q[3].to_degrees(),
+            q[4].to_degrees()
+        )?;
+    }
+    Ok(())
+}
