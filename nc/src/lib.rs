@@ -1,11 +1,25 @@
 //! NC core: the NC language, double-NURBS evaluation, feed planning, kinematics and the
 //! allocation-free per-period interpolation step.
+//!
+//! Data flow (the paper's Fig. 6), one module per job:
+//!
+//! ```text
+//! NC text --parse--> Program --segment::build--> Path --plan::plan--> FeedProfile
+//!                                                  \                     /
+//!                                                   interp::Interpolator::step  (per period)
+//!                       profile s(t) -> u(s) (arclen) or Taylor update -> C(u), CT(u) (nurbs)
+//!                       -> tool axis -> A/C and machine XYZ (kinematics) -> Setpoint
+//! ```
+//!
+//! Everything left of `step` runs outside the real-time thread and may allocate; `step`
+//! itself allocates nothing (proved by `tests/no_alloc.rs`) and has bounded loops.
 #![forbid(unsafe_code)]
 
 pub mod arclen;
 pub mod interp;
 pub mod kinematics;
 pub mod nurbs;
+pub mod parse;
 pub mod plan;
 pub mod program;
 pub mod scurve;

@@ -68,7 +68,9 @@ pub enum NurbsKind {
 /// `G06.2` / `G06.5`: one (double) NURBS curve with shared knots and weights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct NurbsBlock {
+    /// Position of the `G06.2`/`G06.5` word.
     pub pos: SrcPos,
+    /// `N` number of the opening line, if it had one.
     pub n: Option<u32>,
     pub kind: NurbsKind,
     /// Degree p (for G06.2 the parser converts the rank P to p = P - 1).
@@ -89,6 +91,10 @@ pub struct NurbsBlock {
 
 /// One motion block of the program.
 #[derive(Clone, Debug, PartialEq)]
+#[expect(
+    clippy::large_enum_variant,
+    reason = "Block::Nurbs is large on purpose: fixed-capacity, heap-free blocks for the RT queue"
+)]
 pub enum Block {
     Linear(LinearMove),
     Nurbs(NurbsBlock),

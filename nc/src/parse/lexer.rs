@@ -1,0 +1,158 @@
+//! Lexer: source text -> logical lines of [`Word`]s.
+//!
+//! A physical line is scanned once, character by character, counting columns in characters.
+//! Comments (`( ... )` and `;` to the end of the line) and whitespace vanish here; a line that
+//! ends in `\` (spaces may follow) is joined with the next one into one logical line, each word
+//! keeping its own physical position. A `%` standing alone on a line is dropped. Numbers have
+//! no exponent (`E` is a word letter), so the only non-finite value is a digit string too long
+//! for an `f64`, which is an error.
+
+use super::error::{ParseError, ParseErrorKind};
+use crate::program::SrcPos;
+
+/// One word: an (upper-cased) letter and the number that follows it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Word {
+    pub letter: char,
+    pub value: f64,
+    /// The number as a `u32` when it is written as plain digits that fit (for `N`).
+    pub uint: Option<u32>,
+    pub pos: SrcPos,
+}
+
+/// Splits the source into logical lines.
+pub(super) struct Lexer<'a> {
+    lines: core::iter::Enumerate<core::str::Lines<'a>>,
+    /// Position just past the last character of the source (for errors at end of file).
+    eof: SrcPos,
+}
+
+impl<'a> Lexer<'a> {
+    pub fn new(src: &'a str) -> Self {
+        let (count, last) = src.lines().enumerate().last().unwrap_or((0, ""));
+        let eof = SrcPos {
+            line: to_u32(count + 1),
+            col: to_u32(last.chars().count() + 1),
+        };
+        Lexer {
+            lines: src.lines().enumerate(),
+            eof,
+        }
+    }
+
+    pub fn eof(&self) -> SrcPos {
+        self.eof
+    }
+
+    /// Reads the next logical line into `words` (cleared first). Returns `false` at the end
+    /// of the source. A line without words (blank, comment, `%`) yields an empty `words`.
+    pub fn next_line(&mut self, words: &mut Vec<Word>) -> Result<bool, ParseError> {
+        words.clear();
+        let mut continued_at: Option<SrcPos> = None;
+        loop {
+            let Some((index, text)) = self.lines.next() else {
+                return match continued_at {
+                    Some(pos) => Err(ParseErrorKind::ContinuationAtEof.at(pos)),
+                    None => Ok(false),
+                };
+            };
+            let line = to_u32(index + 1);
+            if continued_at.is_none() && text.trim() == "%" {
+                return Ok(true);
+            }
+            continued_at = scan_line(line, text, words)?;
+            if continued_at.is_none() {
+                return Ok(true);
+            }
+        }
+    }
+}
+
+/// Scans one physical line, appending its words. Returns the position of a trailing `\`.
+fn scan_line(line: u32, text: &str, words: &mut Vec<Word>) -> Result<Option<SrcPos>, ParseError> {
+    let mut chars = text.char_indices().peekable();
+    let mut col = 0u32;
+    let err = |col: u32, kind: ParseErrorKind| kind.at(SrcPos { line, col });
+    while let Some((start, ch)) = chars.next() {
+        col = col.saturating_add(1);
+        match ch {
+            c if c.is_whitespace() => {}
+            ';' => return Ok(None),
+            '(' => {
+                let open = col;
+                loop {
+                    match chars.next() {
+                        Some((_, ')')) => break,
+                        Some(_) => col = col.saturating_add(1),
+                        None => return Err(err(open, ParseErrorKind::UnterminatedComment)),
+                    }
+                }
+                col = col.saturating_add(1);
+            }
+            '\\' => {
+                return if chars.all(|(_, c)| c.is_whitespace()) {
+                    Ok(Some(SrcPos { line, col }))
+                } else {
+                    Err(err(col, ParseErrorKind::MisplacedBackslash))
+                };
+            }
+            '%' => return Err(err(col, ParseErrorKind::MisplacedTapeMark)),
+            c if c.is_ascii_alphabetic() => {
+                let letter = c.to_ascii_uppercase();
+                let pos = SrcPos { line, col };
+                // The number: optional sign, digits, optional point, digits (one digit at least).
+                let num_start = start + c.len_utf8();
+                let mut end = num_start;
+                let mut digits = 0usize;
+                let mut seen_point = false;
+                while let Some(&(i, d)) = chars.peek() {
+                    let accept = match d {
+                        '+' | '-' => i == num_start,
+                        '.' => !seen_point,
+                        _ => d.is_ascii_digit(),
+                    };
+                    if !accept {
+                        break;
+                    }
+                    seen_point |= d == '.';
+                    digits += usize::from(d.is_ascii_digit());
+                    end = i + 1; // all accepted characters are ASCII
+                    col = col.saturating_add(1);
+                    chars.next();
+                }
+                let number = text.get(num_start..end).unwrap_or("");
+                if digits == 0 {
+                    return Err(ParseErrorKind::MissingNumber { letter }.at(pos));
+                }
+                let value = match number.parse::<f64>() {
+                    Ok(v) if v.is_finite() => v,
+                    _ => {
+                        let kind = ParseErrorKind::NumberOutOfRange {
+                            letter,
+                            len: number.len(),
+                        };
+                        return Err(kind.at(pos));
+                    }
+                };
+                let uint = number
+                    .bytes()
+                    .all(|b| b.is_ascii_digit())
+                    .then(|| number.parse().ok())
+                    .flatten();
+                words.push(Word {
+                    letter,
+                    value,
+                    uint,
+                    pos,
+                });
+            }
+            _ => return Err(err(col, ParseErrorKind::UnexpectedChar { ch })),
+        }
+    }
+    Ok(None)
+}
+
+/// Line and column numbers saturate instead of overflowing on absurdly large inputs.
+fn to_u32(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
