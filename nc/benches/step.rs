@@ -18,7 +18,11 @@ const PAPER: &str = include_str!("../../tests/data/paper-example.nc");
 
 fn bench(c: &mut Criterion) {
     let program = nc::parse::parse(PAPER).expect("paper example parses");
-    let lin = AxisLimit { velocity: 250.0, acceleration: 2500.0, jerk: 50000.0 };
+    let lin = AxisLimit {
+        velocity: 250.0,
+        acceleration: 2500.0,
+        jerk: 50000.0,
+    };
     let rot = AxisLimit {
         velocity: 90f64.to_radians(),
         acceleration: 900f64.to_radians(),
@@ -32,7 +36,11 @@ fn bench(c: &mut Criterion) {
         axes: [lin, lin, lin, rot, rot],
         rotary: RotaryLimits::UNLIMITED,
     };
-    let limits = BuildLimits { rapid_mm_s: 250.0, max_feed_mm_s: 166.0, rotary: cfg.rotary };
+    let limits = BuildLimits {
+        rapid_mm_s: 250.0,
+        max_feed_mm_s: 166.0,
+        rotary: cfg.rotary,
+    };
     let machines = [
         ("paper", MachineKinematics::Paper),
         (
@@ -51,7 +59,9 @@ fn bench(c: &mut Criterion) {
         for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
             group.bench_function(format!("{kname}/{}", method.name()), |b| {
                 b.iter_custom(|iters| {
-                    let new = || Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);
+                    let new = || {
+                        Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0)
+                    };
                     let mut ip = new();
                     let start = Instant::now();
                     for _ in 0..iters {

@@ -224,7 +224,7 @@ impl<'a> Interpolator<'a> {
                 }
                 (Geometry::Line { .. }, c) => {
                     self.line_s += c.unwrap_or(m.v * ts + m.a * ts * ts / 2.0).max(0.0);
-                    (self.line_s >= seg.length).then(|| self.line_s - seg.length)
+                    (self.line_s >= seg.length).then_some(self.line_s - seg.length)
                 }
             };
             match overshoot {
@@ -294,7 +294,9 @@ mod tests {
             b.weights.push(1.0).unwrap();
             b.ctrl_pos.push(SrcPos::default()).unwrap();
         }
-        b.knots.extend_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0]).unwrap();
+        b.knots
+            .extend_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0])
+            .unwrap();
         let dir = [t[0][0] - c[0][0], t[0][1] - c[0][1], t[0][2] - c[0][2]];
         let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
         Program {
@@ -314,7 +316,11 @@ mod tests {
     }
 
     pub(crate) fn machine() -> (MachineKinematics, PlanConfig, BuildLimits) {
-        let lin = AxisLimit { velocity: 250.0, acceleration: 2500.0, jerk: 50000.0 };
+        let lin = AxisLimit {
+            velocity: 250.0,
+            acceleration: 2500.0,
+            jerk: 50000.0,
+        };
         let rot = AxisLimit {
             velocity: 90f64.to_radians(),
             acceleration: 900f64.to_radians(),
@@ -328,7 +334,11 @@ mod tests {
             axes: [lin, lin, lin, rot, rot],
             rotary: RotaryLimits::UNLIMITED,
         };
-        let bl = BuildLimits { rapid_mm_s: 250.0, max_feed_mm_s: 10000.0 / 60.0, rotary: RotaryLimits::UNLIMITED };
+        let bl = BuildLimits {
+            rapid_mm_s: 250.0,
+            max_feed_mm_s: 10000.0 / 60.0,
+            rotary: RotaryLimits::UNLIMITED,
+        };
         (MachineKinematics::Paper, cfg, bl)
     }
 
@@ -338,7 +348,15 @@ mod tests {
         let profile = plan(&path, &kin, &cfg);
         let mut out = Vec::new();
         {
-            let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, cfg.path_acc * cfg.period);
+            let mut ip = Interpolator::new(
+                &path,
+                &profile,
+                kin,
+                cfg.rotary,
+                method,
+                cfg.period,
+                cfg.path_acc * cfg.period,
+            );
             for _ in 0..100_000 {
                 let sp = ip.step();
                 out.push(sp);
@@ -422,14 +440,21 @@ mod tests {
         let c = paper();
         let table = ArcTable::new(&c);
         let ts = 0.002;
-        for &(u0, v, a) in &[(0.2, 50.0, 1000.0), (0.6, 20.0, -800.0), (0.45, 100.0, 2000.0)] {
+        for &(u0, v, a) in &[
+            (0.2, 50.0, 1000.0),
+            (0.6, 20.0, -800.0),
+            (0.45, 100.0, 2000.0),
+        ] {
             let d = c.cutter(u0, 2);
             let exact = table.u_of_s(&c, table.s_of_u(&c, u0) + v * ts + a * ts * ts / 2.0) - u0;
             let with = taylor_du(Method::Taylor2, &d, v, a, ts);
             let without = taylor_du(Method::Taylor2, &d, v, 0.0, ts);
             let e_with = (with - exact).abs();
             let e_without = (without - exact).abs();
-            assert!(e_with * 20.0 < e_without, "u0={u0}: with {e_with:e}, without {e_without:e}");
+            assert!(
+                e_with * 20.0 < e_without,
+                "u0={u0}: with {e_with:e}, without {e_without:e}"
+            );
             // Taylor1 ignores curvature and acceleration alike.
             assert!((taylor_du(Method::Taylor1, &d, v, a, ts) - exact).abs() > e_with);
         }
@@ -442,7 +467,11 @@ mod tests {
         let p = plan(&path, &kin, &cfg);
         for w in p.phases.windows(2) {
             let e = w[0].end();
-            assert!((e.s - w[1].s0).abs() < 1e-9 && (e.v - w[1].v0).abs() < 1e-9 && (e.a - w[1].a0).abs() < 1e-6);
+            assert!(
+                (e.s - w[1].s0).abs() < 1e-9
+                    && (e.v - w[1].v0).abs() < 1e-9
+                    && (e.a - w[1].a0).abs() < 1e-6
+            );
             assert!((w[0].t0 + w[0].dur - w[1].t0).abs() < 1e-12);
         }
         for ph in &p.phases {

@@ -220,7 +220,10 @@ mod tests {
         assert!((c - (-t.x / t.y).atan()).abs() < 1e-12);
         assert!((k.tool_axis(a, c) - t).norm() < 1e-12);
         // Vertical tool: eq. 18.
-        assert_eq!(k.angles(&Vector3::z(), (0.0, 0.0), &RotaryLimits::UNLIMITED), (0.0, 0.0));
+        assert_eq!(
+            k.angles(&Vector3::z(), (0.0, 0.0), &RotaryLimits::UNLIMITED),
+            (0.0, 0.0)
+        );
     }
 
     #[test]

@@ -112,7 +112,9 @@ impl DoubleNurbs {
             tw: HVec::new(),
         };
         // Capacities were checked above, so these pushes cannot fail.
-        out.knots.extend_from_slice(knots).map_err(|_| CurveError::Knots)?;
+        out.knots
+            .extend_from_slice(knots)
+            .map_err(|_| CurveError::Knots)?;
         for (i, (&p, &w)) in ctrl.iter().zip(weights).enumerate() {
             if !(w.is_finite() && w > 0.0) {
                 return Err(CurveError::Weight(w));
@@ -200,8 +202,8 @@ impl DoubleNurbs {
             span,
             n: [[0.0; MAX_DEGREE + 1]; 3],
         };
-        for j in 0..=p {
-            out.n[0][j] = ndu[j][p];
+        for (j, row) in ndu.iter().enumerate().take(p + 1) {
+            out.n[0][j] = row[p];
         }
         let nd = nd.min(2).min(p);
         let mut a = [[0.0f64; MAX_DEGREE + 1]; 2];
@@ -307,7 +309,8 @@ pub(crate) mod tests {
         if p == 0 {
             let last = k[k.len() - 1];
             // Close the last non-empty span on the right so u = u_max evaluates.
-            let in_span = (k[i] <= u && u < k[i + 1]) || (u == last && k[i] < u && k[i + 1] == last);
+            let in_span =
+                (k[i] <= u && u < k[i + 1]) || (u == last && k[i] < u && k[i + 1] == last);
             return if in_span { 1.0 } else { 0.0 };
         }
         let mut v = 0.0;
@@ -380,7 +383,9 @@ pub(crate) mod tests {
         }
         // Known values: u=1/2 lies at 45 degrees.
         let m = c.cutter(0.5, 0).p;
-        assert!((m.x - m.y).abs() < 1e-15 && (m.x - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15);
+        assert!(
+            (m.x - m.y).abs() < 1e-15 && (m.x - core::f64::consts::FRAC_1_SQRT_2).abs() < 1e-15
+        );
     }
 
     #[test]
@@ -400,7 +405,12 @@ pub(crate) mod tests {
         // Cubic Bezier 0,0 / 1,2 / 3,2 / 4,0 at u=1/2: (0+3+9+4)/8 = 2, (0+6+6+0)/8 = 1.5.
         let b = DoubleNurbs::new(
             3,
-            &[[0.0, 0.0, 0.0], [1.0, 2.0, 0.0], [3.0, 2.0, 0.0], [4.0, 0.0, 0.0]],
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 2.0, 0.0],
+                [3.0, 2.0, 0.0],
+                [4.0, 0.0, 0.0],
+            ],
             &[],
             &[1.0; 4],
             &[0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
@@ -409,9 +419,17 @@ pub(crate) mod tests {
         let d = b.cutter(0.5, 2);
         assert!((d.p - Vector3::new(2.0, 1.5, 0.0)).norm() < 1e-15);
         // B'(1/2) = 3/4 (P1-P0) + 6/4 (P2-P1) + 3/4 (P3-P2): x = 0.75 + 3 + 0.75 = 4.5, y = 1.5 + 0 - 1.5 = 0.
-        assert!((d.d1 - Vector3::new(4.5, 0.0, 0.0)).norm() < 1e-14, "{:?}", d.d1);
+        assert!(
+            (d.d1 - Vector3::new(4.5, 0.0, 0.0)).norm() < 1e-14,
+            "{:?}",
+            d.d1
+        );
         // B''(1/2) = 6 (1/2 (P2 - 2P1 + P0) + 1/2 (P3 - 2P2 + P1)) = 3(P3 - P2 - P1 + P0)
-        assert!((d.d2 - Vector3::new(0.0, -12.0, 0.0)).norm() < 1e-13, "{:?}", d.d2);
+        assert!(
+            (d.d2 - Vector3::new(0.0, -12.0, 0.0)).norm() < 1e-13,
+            "{:?}",
+            d.d2
+        );
     }
 
     #[test]
@@ -457,7 +475,13 @@ pub(crate) mod tests {
 
     #[test]
     fn rational_weights_against_recursion() {
-        let cp = [[0.0, 0.0, 0.0], [1.0, 3.0, 1.0], [4.0, 3.0, -1.0], [6.0, 0.0, 2.0], [8.0, 1.0, 0.0]];
+        let cp = [
+            [0.0, 0.0, 0.0],
+            [1.0, 3.0, 1.0],
+            [4.0, 3.0, -1.0],
+            [6.0, 0.0, 2.0],
+            [8.0, 1.0, 0.0],
+        ];
         let w = [1.0, 2.5, 0.4, 1.7, 1.0];
         let k = [0.0, 0.0, 0.0, 0.3, 0.7, 1.0, 1.0, 1.0];
         let c = DoubleNurbs::new(2, &cp, &[], &w, &k).unwrap();
@@ -475,7 +499,10 @@ pub(crate) mod tests {
     fn constructor_rejects_bad_nets() {
         let cp = [[0.0; 3]; 4];
         let k = [0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
-        assert_eq!(DoubleNurbs::new(0, &cp, &[], &[1.0; 4], &k), Err(CurveError::Degree(0)));
+        assert_eq!(
+            DoubleNurbs::new(0, &cp, &[], &[1.0; 4], &k),
+            Err(CurveError::Degree(0))
+        );
         assert!(matches!(
             DoubleNurbs::new(3, &cp, &[], &[1.0; 4], &k[..7]),
             Err(CurveError::KnotCount { .. })
@@ -485,6 +512,9 @@ pub(crate) mod tests {
             Err(CurveError::Weight(-1.0))
         );
         let unclamped = [0.0, 0.0, 0.0, 0.1, 0.9, 1.0, 1.0, 1.0];
-        assert_eq!(DoubleNurbs::new(3, &cp, &[], &[1.0; 4], &unclamped), Err(CurveError::Knots));
+        assert_eq!(
+            DoubleNurbs::new(3, &cp, &[], &[1.0; 4], &unclamped),
+            Err(CurveError::Knots)
+        );
     }
 }

@@ -146,18 +146,15 @@ fn curvature(seg: &Segment, s: f64) -> f64 {
 
 /// Sample every segment; returns the stations and, per segment, the index of its first
 /// station (the joint with the previous segment) and the one-sided dq/ds at both ends.
-fn stations(
-    path: &Path,
-    kin: &MachineKinematics,
-    cfg: &PlanConfig,
-) -> (Vec<Station>, Vec<usize>) {
+fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Station>, Vec<usize>) {
     let mut out: Vec<Station> = Vec::new();
     let mut starts = Vec::with_capacity(path.segments.len() + 1);
     let mut prev = path.start_joints;
     let mut s0 = 0.0;
     let mut prev_end: Option<([f64; 5], bool)> = None;
     for seg in &path.segments {
-        let n = ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize).clamp(16, 4096);
+        let n =
+            ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize).clamp(16, 4096);
         let h = seg.length / n as f64;
         let mut q = Vec::with_capacity(n + 1);
         for i in 0..=n {
@@ -172,7 +169,7 @@ fn stations(
             if i == n {
                 last_d1 = d1;
             }
-            let mut v = seg.feed;
+            let mut v = seg.feed.min(1e9);
             let kappa = curvature(seg, s_loc);
             if kappa > 1e-12 {
                 let rho = 1.0 / kappa;
@@ -238,7 +235,15 @@ fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64,
 }
 
 /// Phases of one section from `va` to `vb` over `len`, cruising at most at `vmax`.
-fn section(out: &mut Vec<Phase>, t0: f64, s0: f64, (va, vb): (f64, f64), len: f64, vmax: f64, (acc, jerk): (f64, f64)) -> f64 {
+fn section(
+    out: &mut Vec<Phase>,
+    t0: f64,
+    s0: f64,
+    (va, vb): (f64, f64),
+    len: f64,
+    vmax: f64,
+    (acc, jerk): (f64, f64),
+) -> f64 {
     let lo = va.max(vb);
     let fits = |vc: f64| change_dist(va, vc, acc, jerk) + change_dist(vc, vb, acc, jerk) <= len;
     let vc = if vmax <= lo {
@@ -257,14 +262,25 @@ fn section(out: &mut Vec<Phase>, t0: f64, s0: f64, (va, vb): (f64, f64), len: f6
         }
         l
     };
-    let start = Motion { s: s0, v: va, a: 0.0 };
+    let start = Motion {
+        s: s0,
+        v: va,
+        a: 0.0,
+    };
     let (t1, m1) = push_change(out, t0, start, vc, acc, jerk);
     let d2 = change_dist(vc, vb, acc, jerk);
     let cruise = (len - (m1.s - s0) - d2).max(0.0);
     let mut t = t1;
     let mut m = m1;
     if cruise > 0.0 && vc > 0.0 {
-        let ph = Phase { t0: t, dur: cruise / vc, s0: m.s, v0: vc, a0: 0.0, j: 0.0 };
+        let ph = Phase {
+            t0: t,
+            dur: cruise / vc,
+            s0: m.s,
+            v0: vc,
+            a0: 0.0,
+            j: 0.0,
+        };
         out.push(ph);
         t += ph.dur;
         m = ph.end();
@@ -299,7 +315,12 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
     }
     seg_start.push(total);
     if path.segments.is_empty() {
-        return FeedProfile { phases: Vec::new(), seg_start, length: 0.0, duration: 0.0 };
+        return FeedProfile {
+            phases: Vec::new(),
+            seg_start,
+            length: 0.0,
+            duration: 0.0,
+        };
     }
     let (st, starts) = stations(path, kin, cfg);
     let last = st.len() - 1;
@@ -316,7 +337,10 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
 
     let mut phases = Vec::new();
     for round in 0..ROUNDS_MAX {
-        let limits: Vec<(f64, f64)> = crit.windows(2).map(|w| section_limits(&st, w[0].0, w[1].0, cfg)).collect();
+        let limits: Vec<(f64, f64)> = crit
+            .windows(2)
+            .map(|w| section_limits(&st, w[0].0, w[1].0, cfg))
+            .collect();
         // Backward then forward: every point's speed reachable within its sections.
         for k in (0..crit.len() - 1).rev() {
             let len = st[crit[k + 1].0].s - st[crit[k].0].s;
@@ -335,7 +359,15 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
             let ((ia, va), (ib, vb)) = (w[0], w[1]);
             let vmax = st[ia..=ib].iter().map(|x| x.vlim).fold(0.0, f64::max);
             let first = phases.len();
-            t = section(&mut phases, t, st[ia].s, (va, vb), st[ib].s - st[ia].s, vmax, limits[k]);
+            t = section(
+                &mut phases,
+                t,
+                st[ia].s,
+                (va, vb),
+                st[ib].s - st[ia].s,
+                vmax,
+                limits[k],
+            );
             let sec = &phases[first..];
             let vc = sec.iter().map(|p| p.v0).fold(va.max(vb), f64::max);
             let mut worst: Option<(usize, f64)> = None;
@@ -363,5 +395,10 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
         }
     }
     let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
-    FeedProfile { phases, seg_start, length: total, duration }
+    FeedProfile {
+        phases,
+        seg_start,
+        length: total,
+        duration,
+    }
 }

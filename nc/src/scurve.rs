@@ -76,7 +76,14 @@ pub fn reachable(v_end: f64, dist: f64, a: f64, j: f64) -> f64 {
 
 /// Append the phases of a change from `start` (with zero acceleration) to `v1`. Returns the
 /// state at its end (acceleration zero again).
-pub fn push_change(out: &mut Vec<Phase>, t0: f64, start: Motion, v1: f64, a: f64, j: f64) -> (f64, Motion) {
+pub fn push_change(
+    out: &mut Vec<Phase>,
+    t0: f64,
+    start: Motion,
+    v1: f64,
+    a: f64,
+    j: f64,
+) -> (f64, Motion) {
     let dv = v1 - start.v;
     if dv == 0.0 {
         return (t0, start);
@@ -123,7 +130,11 @@ mod tests {
             (80.0, 10.0, 500.0, 5000.0),
         ] {
             let mut ph = Vec::new();
-            let start = Motion { s: 3.0, v: v0, a: 0.0 };
+            let start = Motion {
+                s: 3.0,
+                v: v0,
+                a: 0.0,
+            };
             let (t, end) = push_change(&mut ph, 1.0, start, v1, a, j);
             let last = ph.last().unwrap().end();
             assert!((last.v - v1).abs() < 1e-9, "{last:?}");
@@ -144,7 +155,10 @@ mod tests {
         let (a, j) = (1000.0, 20000.0);
         for &d in &[0.001, 0.1, 5.0, 200.0] {
             let v = reachable(20.0, d, a, j);
-            assert!((change_dist(v, 20.0, a, j) - d).abs() < 1e-9 * d.max(1.0), "d={d}");
+            assert!(
+                (change_dist(v, 20.0, a, j) - d).abs() < 1e-9 * d.max(1.0),
+                "d={d}"
+            );
         }
         assert_eq!(reachable(7.0, 0.0, a, j), 7.0);
     }

@@ -109,7 +109,11 @@ impl Segment {
     /// Pose at path position `s` in [0, length] (clamped). Allocation-free.
     pub fn pose(&self, s: f64) -> Pose {
         let s = s.clamp(0.0, self.length);
-        let f = if self.length > 0.0 { s / self.length } else { 1.0 };
+        let f = if self.length > 0.0 {
+            s / self.length
+        } else {
+            1.0
+        };
         match &self.geometry {
             Geometry::Line { from, to } => Pose {
                 p: from + (to - from) * f,
@@ -237,11 +241,90 @@ pub fn build(
             segments.push(seg);
         }
     }
-    Ok(Path {
+    let mut path = Path {
         start,
         start_joints,
         segments,
-    })
+    };
+    orient_c_at_vertical(&mut path, kin, lim);
+    Ok(path)
+}
+
+/// True when the tool axis is (numerically) vertical, so that C is undefined.
+fn is_vertical(t: &Vector3<f64>) -> bool {
+    t.x.hypot(t.y) < VERTICAL_TOL
+}
+
+/// Below this |(Tx, Ty)| a segment's start counts as a vertical tool for the C look-ahead.
+const VERTICAL_TOL: f64 = 1e-9;
+
+/// The C a segment needs where it leaves the vertical, if it starts vertical and leaves it.
+fn c_leaving_vertical(
+    seg: &Segment,
+    kin: &MachineKinematics,
+    prev: &Joints,
+    lim: &RotaryLimits,
+) -> Option<f64> {
+    if !matches!(seg.tooling, Tooling::Curve | Tooling::Slerp { .. })
+        || !is_vertical(&seg.pose(0.0).axis(kin))
+    {
+        return None;
+    }
+    // Walk out from the start in decades until the tool has left the vertical.
+    let mut s = seg.length * 1e-9;
+    for _ in 0..10 {
+        let t = seg.pose(s).axis(kin);
+        if t.x.hypot(t.y) > 1e-7 {
+            return Some(kin.angles(&t, (prev[3], prev[4]), lim).1);
+        }
+        s *= 10.0;
+    }
+    None
+}
+
+/// With a vertical tool, C is free: choose it where the path leaves the vertical, instead
+/// of holding the last one and turning C through up to 180 degrees in one period.
+/// At the program start the start pose takes that C (the machine is positioned there
+/// before the program runs); later, a rotary-only move turns C at rest while the tool stays
+/// vertical, planned like any other move under the C axis limits.
+fn orient_c_at_vertical(path: &mut Path, kin: &MachineKinematics, lim: &RotaryLimits) {
+    let mut joints = path.start_joints;
+    let mut k = 0;
+    while k < path.segments.len() {
+        let seg = &path.segments[k];
+        if let Some(c) = c_leaving_vertical(seg, kin, &joints, lim) {
+            if k == 0 {
+                path.start_joints[4] = c;
+                joints[4] = c;
+            } else if (c - joints[4]).abs() > 1e-9 {
+                let p = seg.pose(0.0).p;
+                let turn = Segment {
+                    block: seg.block,
+                    src: seg.src,
+                    length: (c - joints[4]).abs().to_degrees(),
+                    feed: f64::INFINITY, // limited by the C axis alone
+                    rapid: false,
+                    rotary_only: true,
+                    geometry: Geometry::Line { from: p, to: p },
+                    tooling: Tooling::Angles {
+                        from: (joints[3], joints[4]),
+                        to: (joints[3], c),
+                    },
+                };
+                path.segments.insert(k, turn);
+            }
+        }
+        let seg = &path.segments[k];
+        let mut prev = joints;
+        // Follow the segment so the rotary branch at its end is the one the path takes.
+        for i in 1..=16 {
+            prev = seg
+                .pose(seg.length * i as f64 / 16.0)
+                .joints(kin, &prev, lim);
+        }
+        joints = prev;
+        k += 1;
+    }
 }
 
 fn linear_tool(m: &LinearMove) -> Tool {
@@ -323,8 +406,14 @@ fn nurbs(
     limits: &BuildLimits,
 ) -> Result<Segment, BuildError> {
     let err = |kind| BuildError { pos: b.pos, kind };
-    let curve = DoubleNurbs::new(b.degree as usize, &b.ctrl, &b.tool_ctrl, &b.weights, &b.knots)
-        .map_err(|e| err(e.into()))?;
+    let curve = DoubleNurbs::new(
+        b.degree as usize,
+        &b.ctrl,
+        &b.tool_ctrl,
+        &b.weights,
+        &b.knots,
+    )
+    .map_err(|e| err(e.into()))?;
     let table = ArcTable::new(&curve);
     let current = pose.axis(kin);
     let tooling = match b.kind {
@@ -338,13 +427,17 @@ fn nurbs(
                 let u = u0 + (u1 - u0) * i as f64 / n as f64;
                 let (c, t) = curve.both(u, 0);
                 let dist = (t.p - c.p).norm();
-                if !(dist >= MIN_TOOL_VECTOR_MM) {
+                if dist.is_nan() || dist < MIN_TOOL_VECTOR_MM {
                     return Err(err(BuildErrorKind::ToolVectorTooShort { u, dist }));
                 }
             }
             let (c, t) = curve.both(u0, 0);
             let start = (t.p - c.p).normalize();
-            let deg = current.cross(&start).norm().atan2(current.dot(&start)).to_degrees();
+            let deg = current
+                .cross(&start)
+                .norm()
+                .atan2(current.dot(&start))
+                .to_degrees();
             if deg > MAX_ORIENTATION_STEP_DEG {
                 return Err(err(BuildErrorKind::OrientationJump { deg }));
             }

@@ -1,6 +1,6 @@
 //! The per-period step must not touch the heap: a counting global allocator watches every
 //! `Interpolator::step` over whole programs (>= 100 000 periods in all, all three methods,
-//! paper and RTCP kinematics) and must see zero allocations, reallocations and frees.
+//! paper and RTCP kinematics, 2 ms and 1 ms periods) and must see zero allocations, reallocations and frees.
 //!
 //! This file is its own test binary, so no other test's allocations are counted.
 
@@ -41,21 +41,26 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOC: Counting = Counting;
 
-const PROGRAMS: [&str; 3] = [
+const PROGRAMS: [&str; 4] = [
     include_str!("../../tests/data/paper-example.nc"),
+    include_str!("../../tests/data/vertical-turns.nc"),
     include_str!("../../tests/data/tight-curvature.nc"),
     include_str!("../../tests/data/two-blocks-g2.nc"),
 ];
 
 #[test]
 fn step_never_allocates() {
-    let lin = AxisLimit { velocity: 250.0, acceleration: 2500.0, jerk: 50000.0 };
+    let lin = AxisLimit {
+        velocity: 250.0,
+        acceleration: 2500.0,
+        jerk: 50000.0,
+    };
     let rot = AxisLimit {
         velocity: 180f64.to_radians(),
         acceleration: 1800f64.to_radians(),
         jerk: 40000f64.to_radians(),
     };
-    let cfg = PlanConfig {
+    let base = PlanConfig {
         period: 0.002,
         chord_tol: 0.001,
         path_acc: 1000.0,
@@ -63,19 +68,29 @@ fn step_never_allocates() {
         axes: [lin, lin, lin, rot, rot],
         rotary: RotaryLimits::UNLIMITED,
     };
-    let limits = BuildLimits { rapid_mm_s: 250.0, max_feed_mm_s: 166.0, rotary: cfg.rotary };
+    let limits = BuildLimits {
+        rapid_mm_s: 250.0,
+        max_feed_mm_s: 166.0,
+        rotary: base.rotary,
+    };
     let kins = [
         MachineKinematics::Paper,
-        MachineKinematics::Trt { tilt: Tilt::A, tilt_point: Vector3::new(0.0, 0.0, -50.0), c_point: Vector3::zeros() },
+        MachineKinematics::Trt {
+            tilt: Tilt::A,
+            tilt_point: Vector3::new(0.0, 0.0, -50.0),
+            c_point: Vector3::zeros(),
+        },
     ];
     let mut periods = 0u64;
-    for src in PROGRAMS {
+    for (src, period) in PROGRAMS.iter().flat_map(|p| [(p, 0.002), (p, 0.001)]) {
+        let cfg = PlanConfig { period, ..base };
         let program = nc::parse::parse(src).expect("test program parses");
         for kin in kins {
             let path = build(&program, &kin, &limits).expect("test program builds");
             let profile = plan(&path, &kin, &cfg);
             for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
-                let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);
+                let mut ip =
+                    Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);
                 let mut sum = 0.0;
                 EVENTS.store(0, Ordering::SeqCst);
                 ARMED.store(true, Ordering::SeqCst);
@@ -89,7 +104,12 @@ fn step_never_allocates() {
                 }
                 ARMED.store(false, Ordering::SeqCst);
                 assert!(sum.is_finite());
-                assert_eq!(EVENTS.load(Ordering::SeqCst), 0, "heap touched during {} steps", method.name());
+                assert_eq!(
+                    EVENTS.load(Ordering::SeqCst),
+                    0,
+                    "heap touched during {} steps",
+                    method.name()
+                );
             }
         }
     }

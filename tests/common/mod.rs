@@ -58,7 +58,10 @@ pub fn read_trace(path: &std::path::Path) -> Vec<Row> {
         .map(|l| {
             let f: Vec<&str> = l.split(',').collect();
             assert_eq!(f.len(), 16, "row {l}");
-            let x = |i: usize| f[i].parse::<f64>().unwrap_or_else(|_| panic!("field {i} of {l}"));
+            let x = |i: usize| {
+                f[i].parse::<f64>()
+                    .unwrap_or_else(|_| panic!("field {i} of {l}"))
+            };
             Row {
                 cycle: f[0].parse().unwrap(),
                 t: x(1),
@@ -74,7 +77,11 @@ pub fn read_trace(path: &std::path::Path) -> Vec<Row> {
 }
 
 /// Run `simulate` with `--json` and a trace; returns the summary and the rows.
-pub fn simulate(program: &str, machine_file: &str, extra: &[&str]) -> (serde_json::Value, Vec<Row>) {
+pub fn simulate(
+    program: &str,
+    machine_file: &str,
+    extra: &[&str],
+) -> (serde_json::Value, Vec<Row>) {
     let trace = temp("trace.csv");
     let prog = data(program);
     let mach = machine(machine_file);

@@ -96,8 +96,8 @@ fn simulate(
         Some(MethodArg::Taylor2) => Method::Taylor2,
         None => setup.method,
     };
-    let result = run(&prog, &setup, method)
-        .map_err(|e| InputError(format!("{}:{e}", program.display())))?;
+    let result =
+        run(&prog, &setup, method).map_err(|e| InputError(format!("{}:{e}", program.display())))?;
     if let Some(path) = &trace {
         let file = std::fs::File::create(path)
             .map_err(|e| anyhow::anyhow!("{}: cannot create the trace: {e}", path.display()))?;

@@ -8,6 +8,7 @@
 
 use crate::setup::MachineSetup;
 use nalgebra::Vector3;
+use nc::arclen::GL8;
 use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::Kinematics;
 use nc::nurbs::DoubleNurbs;
@@ -15,7 +16,6 @@ use nc::plan::{plan, FeedProfile};
 use nc::program::Program;
 use nc::segment::{build, BuildError, Path, Tooling};
 use serde::Serialize;
-use std::collections::BTreeMap;
 
 /// A finished offline run.
 pub struct Run {
@@ -60,6 +60,17 @@ pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Ru
     })
 }
 
+/// Per-axis values in machine order (X Y Z, tilt, C).
+pub type AxisMap = serde_json::Map<String, serde_json::Value>;
+
+fn axis_map(names: &[&str; 5], values: [f64; 5]) -> AxisMap {
+    names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| (n.to_string(), v.into()))
+        .collect()
+}
+
 /// The summary `dnurbs simulate` prints (JSON keys documented in the README).
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -75,23 +86,12 @@ pub struct Summary {
     pub feed_fluctuation_periods: u64,
     pub chord_error_max_mm: f64,
     pub chord_tolerance_mm: f64,
-    pub axis_velocity_fraction: BTreeMap<&'static str, f64>,
-    pub axis_acceleration_fraction: BTreeMap<&'static str, f64>,
+    pub axis_velocity_fraction: AxisMap,
+    pub axis_acceleration_fraction: AxisMap,
     pub axis_travel_ok: bool,
     pub tool_axis_deviation_max_deg: f64,
     pub end_position_error_mm: f64,
 }
-
-const GL8: [(f64, f64); 8] = [
-    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (-0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
-    (-0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362_0),
-    (0.525_532_409_916_329_0, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-];
 
 /// Arc length of the cutter curve between two parameters, integrated directly.
 pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
@@ -104,7 +104,10 @@ pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
     cuts.windows(2)
         .map(|w| {
             let (m, h) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
-            GL8.iter().map(|&(x, wt)| wt * curve.speed(m + h * x)).sum::<f64>() * h
+            GL8.iter()
+                .map(|&(x, wt)| wt * curve.speed(m + h * x))
+                .sum::<f64>()
+                * h
         })
         .sum()
 }
@@ -112,7 +115,11 @@ pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
 fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     let ab = b - a;
     let l2 = ab.norm_squared();
-    let f = if l2 > 0.0 { ((p - a).dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    let f = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (p - (a + ab * f)).norm()
 }
 
@@ -162,7 +169,10 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
                 vfrac[j] = vfrac[j].max(v.abs() / l.velocity);
             }
             if k >= 2 {
-                let a = unit(j, sp.joints[j] - 2.0 * sps[k - 1].joints[j] + sps[k - 2].joints[j]) / (ts * ts);
+                let a = unit(
+                    j,
+                    sp.joints[j] - 2.0 * sps[k - 1].joints[j] + sps[k - 2].joints[j],
+                ) / (ts * ts);
                 afrac[j] = afrac[j].max(a.abs() / l.acceleration);
             }
         }
@@ -171,17 +181,26 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     // through forward kinematics, against the program's own CT(u) - C(u).
     let mut tool_dev = 0.0f64;
     for seg in &run.path.segments {
-        let (Some((curve, _)), Tooling::Curve) = (seg.nurbs(), &seg.tooling) else { continue };
-        let mine: Vec<&Setpoint> = sps.iter().filter(|s| s.block == seg.block && s.u.is_some()).collect();
+        let (Some((curve, _)), Tooling::Curve) = (seg.nurbs(), &seg.tooling) else {
+            continue;
+        };
+        let mine: Vec<&Setpoint> = sps
+            .iter()
+            .filter(|s| s.block == seg.block && s.u.is_some())
+            .collect();
         let mut knots: Vec<f64> = curve.knots().to_vec();
         knots.dedup();
         for &k in &knots {
-            let Some(w) = mine.windows(2).find(|w| w[0].u.unwrap_or(0.0) <= k && k <= w[1].u.unwrap_or(0.0)) else {
+            let Some(w) = mine
+                .windows(2)
+                .find(|w| w[0].u.unwrap_or(0.0) <= k && k <= w[1].u.unwrap_or(0.0))
+            else {
                 continue;
             };
             let (ua, ub) = (w[0].u.unwrap_or(0.0), w[1].u.unwrap_or(0.0));
             let f = if ub > ua { (k - ua) / (ub - ua) } else { 0.0 };
-            let j: [f64; 5] = core::array::from_fn(|i| w[0].joints[i] + (w[1].joints[i] - w[0].joints[i]) * f);
+            let j: [f64; 5] =
+                core::array::from_fn(|i| w[0].joints[i] + (w[1].joints[i] - w[0].joints[i]) * f);
             let got = setup.kin.tool_axis(j[3], j[4]);
             let (c, t) = curve.both(k, 0);
             let want = (t.p - c.p).normalize();
@@ -202,12 +221,16 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         machining_time_s: sps.last().map_or(0.0, |s| s.t),
         path_length: run.profile.length,
         feed_fluctuation_max: fmax,
-        feed_fluctuation_rms: if fn_ > 0 { (fsq / fn_ as f64).sqrt() } else { 0.0 },
+        feed_fluctuation_rms: if fn_ > 0 {
+            (fsq / fn_ as f64).sqrt()
+        } else {
+            0.0
+        },
         feed_fluctuation_periods: fn_,
         chord_error_max_mm: chord,
         chord_tolerance_mm: setup.plan.chord_tol,
-        axis_velocity_fraction: names.iter().copied().zip(vfrac).collect(),
-        axis_acceleration_fraction: names.iter().copied().zip(afrac).collect(),
+        axis_velocity_fraction: axis_map(&names, vfrac),
+        axis_acceleration_fraction: axis_map(&names, afrac),
         axis_travel_ok: travel_ok,
         tool_axis_deviation_max_deg: tool_dev,
         end_position_error_mm: end_err,
@@ -217,8 +240,11 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
 impl Summary {
     /// The human-readable form printed without `--json`.
     pub fn text(&self) -> String {
-        let fr = |m: &BTreeMap<&str, f64>| {
-            m.iter().map(|(k, v)| format!("{k} {:.1}%", v * 100.0)).collect::<Vec<_>>().join("  ")
+        let fr = |m: &AxisMap| {
+            m.iter()
+                .map(|(k, v)| format!("{k} {:.1}%", v.as_f64().unwrap_or(f64::NAN) * 100.0))
+                .collect::<Vec<_>>()
+                .join("  ")
         };
         format!(
             "machine            {}\n\
@@ -248,7 +274,11 @@ impl Summary {
             self.chord_tolerance_mm,
             fr(&self.axis_velocity_fraction),
             fr(&self.axis_acceleration_fraction),
-            if self.axis_travel_ok { "within limits" } else { "OUTSIDE LIMITS" },
+            if self.axis_travel_ok {
+                "within limits"
+            } else {
+                "OUTSIDE LIMITS"
+            },
             self.tool_axis_deviation_max_deg,
             self.end_position_error_mm,
         )
