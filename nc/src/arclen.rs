@@ -19,7 +19,7 @@ use heapless::Vec as HVec;
 /// Table capacity per block.
 pub const MAX_NODES: usize = 1025;
 /// Newton steps per evaluation (bounded, no convergence loop in the real-time path).
-pub const NEWTON_STEPS: usize = 2;
+pub const NEWTON_STEPS: usize = 1;
 
 /// Gauss-Legendre 8-point nodes and weights on [-1, 1] (published to more digits than an
 /// f64 holds; the compiler rounds them correctly).
@@ -76,7 +76,7 @@ impl ArcTable {
     pub fn new(curve: &DoubleNurbs) -> Self {
         let knots = curve.knots();
         let spans = knots.windows(2).filter(|w| w[1] > w[0]).count().max(1);
-        let per_span = ((MAX_NODES - 1) / spans).clamp(1, 64);
+        let per_span = ((MAX_NODES - 1) / spans).clamp(1, 512);
         let mut nodes: HVec<Node, MAX_NODES> = HVec::new();
         let (u0, _) = curve.range();
         let node = |u: f64, s: f64| Node {
@@ -204,6 +204,28 @@ mod tests {
         );
         for i in 0..=1000 {
             let s = t.length() * i as f64 / 1000.0;
+            let u = t.u_of_s(&c, s);
+            assert!((t.s_of_u(&c, u) - s).abs() < 1e-9, "s={s}");
+        }
+    }
+
+    #[test]
+    fn one_newton_step_suffices_with_the_most_spans_a_block_can_have() {
+        // 64 control points on a helix, cubic, uniform knots: 61 spans, 16 nodes each.
+        let n = crate::program::MAX_CTRL;
+        let ctrl: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let a = i as f64 * 0.4;
+                [20.0 * a.cos(), 20.0 * a.sin(), i as f64 * 0.7]
+            })
+            .collect();
+        let mut knots = vec![0.0; 4];
+        knots.extend((1..n - 3).map(|i| i as f64 / (n - 3) as f64));
+        knots.extend([1.0; 4]);
+        let c = DoubleNurbs::new(3, &ctrl, &[], &vec![1.0; n], &knots).unwrap();
+        let t = ArcTable::new(&c);
+        for i in 0..=4000 {
+            let s = t.length() * i as f64 / 4000.0;
             let u = t.u_of_s(&c, s);
             assert!((t.s_of_u(&c, u) - s).abs() < 1e-9, "s={s}");
         }

@@ -54,6 +54,16 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Simulate programs with each parameter update method (taylor1, taylor2, arclength)
+    /// and print a Markdown table of feed fluctuation and chord error.
+    Compare {
+        /// NC programs to compare on.
+        #[arg(required = true)]
+        programs: Vec<PathBuf>,
+        /// Machine file (TOML).
+        #[arg(long, short)]
+        machine: PathBuf,
+    },
 }
 
 fn main() -> ExitCode {
@@ -66,6 +76,7 @@ fn main() -> ExitCode {
             trace,
             json,
         } => simulate(program, machine, method, trace, json),
+        Command::Compare { programs, machine } => compare(programs, machine),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -111,6 +122,35 @@ fn simulate(
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print!("{}", summary.text());
+    }
+    Ok(())
+}
+
+fn compare(programs: Vec<PathBuf>, machine: PathBuf) -> anyhow::Result<()> {
+    let setup = MachineSetup::new(&load_machine(&machine)?);
+    println!(
+        "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for program in &programs {
+        let prog = load_program(program)?;
+        let name = program.file_name().map_or_else(
+            || program.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        for method in [Method::Taylor1, Method::Taylor2, Method::ArcLength] {
+            let result = run(&prog, &setup, method)
+                .map_err(|e| InputError(format!("{}:{e}", program.display())))?;
+            let s = summarize(&result, &setup, prog.blocks.len());
+            println!(
+                "| {name} | {} | {:.2e} | {:.2e} | {:.2e} | {} |",
+                s.method,
+                s.feed_fluctuation_max,
+                s.feed_fluctuation_rms,
+                s.chord_error_max_mm,
+                s.cycles
+            );
+        }
     }
     Ok(())
 }
