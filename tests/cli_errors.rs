@@ -216,3 +216,29 @@ fn bad_machine_files_and_missing_files_exit_2() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no/such/program.nc"));
 }
+
+#[test]
+fn degenerate_programs_are_errors_or_stand_still_never_panics() {
+    // A NURBS block whose control points all coincide has no length.
+    let dot = "G01 X1 Y2 Z3 F100\nG06.2 P2 K0 X1 Y2 Z3\nK0 X1 Y2 Z3\nK1 X1 Y2 Z3\nK1 K1\n";
+    check("zero-length-nurbs", dot, "2:1", "has length");
+    // A program that is only its start pose: one setpoint, at rest, exit 0.
+    let path = temp("start-only.nc");
+    std::fs::write(&path, "G01 X1 Y2 Z3 F100\nM30\n").unwrap();
+    let mach = machine("paper-ac-table.toml");
+    let out = dnurbs(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--machine",
+        mach.to_str().unwrap(),
+        "--json",
+    ]);
+    let _ = std::fs::remove_file(&path);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(s["cycles"], 1);
+}

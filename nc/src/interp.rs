@@ -150,7 +150,9 @@ impl<'a> Interpolator<'a> {
     pub fn step(&mut self) -> Setpoint {
         let t = self.cycle as f64 * self.period;
         let motion = self.profile.at(t, &mut self.phase);
-        let pose = if self.cycle == 0 {
+        let pose = if self.cycle == 0 || self.path.segments.is_empty() {
+            // Nothing to move along (a program that is only its start pose) stays put.
+            self.done |= self.path.segments.is_empty();
             self.path.start
         } else {
             match self.method {

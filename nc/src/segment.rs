@@ -23,6 +23,8 @@ pub const MIN_TOOL_VECTOR_MM: f64 = 1e-3;
 pub const MAX_ORIENTATION_STEP_DEG: f64 = 0.01;
 /// Moves shorter than this (mm, and degrees for the tool) are no motion at all.
 const NULL_MOVE: f64 = 1e-9;
+/// Shortest NURBS block, mm: below it the arc-length parametrisation is meaningless.
+pub const NULL_MOVE_MM: f64 = 1e-6;
 
 /// How a segment's tool orientation varies.
 #[derive(Clone, Debug, PartialEq)]
@@ -178,6 +180,8 @@ pub enum BuildErrorKind {
     OrientationJump { deg: f64 },
     #[error("the tool axis turns by 180 degrees in one linear move: the great circle between opposite axes is undefined")]
     OppositeAxes,
+    #[error("the cutter curve has length {0:.3e} mm: a NURBS block must move the cutter at least {NULL_MOVE_MM} mm")]
+    ZeroLength(f64),
     #[error("{0}")]
     Curve(#[from] crate::nurbs::CurveError),
 }
@@ -415,6 +419,9 @@ fn nurbs(
     )
     .map_err(|e| err(e.into()))?;
     let table = ArcTable::new(&curve);
+    if table.length().is_nan() || table.length() < NULL_MOVE_MM {
+        return Err(err(BuildErrorKind::ZeroLength(table.length())));
+    }
     let current = pose.axis(kin);
     let tooling = match b.kind {
         NurbsKind::G062 => Tooling::Fixed(current),

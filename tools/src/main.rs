@@ -12,8 +12,8 @@ use std::process::ExitCode;
 #[command(
     name = "dnurbs",
     version,
-    about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007) for CiA-402 drives",
-    long_about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007) for CiA-402 drives.\n\n\
+    about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007)",
+    long_about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007).\n\n\
         An NC program (G01 5-axis lines, G06.2 NURBS, G06.5 double NURBS) is parsed, planned \
         with jerk-limited look-ahead and interpolated period by period into X Y Z A C setpoints.\n\n\
         Exit codes: 0 success, 1 failure writing output, 2 bad program or machine file."
