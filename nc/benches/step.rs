@@ -8,9 +8,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use nalgebra::Vector3;
 use nc::interp::{Interpolator, Method};
-use nc::kinematics::{MachineKinematics, RotaryLimits, Tilt};
-use nc::plan::{plan, AxisLimit, PlanConfig};
-use nc::segment::{build, BuildLimits};
+use nc::kinematics::{MachineKinematics, Tilt};
+use nc::plan::plan;
+use nc::segment::build;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -18,29 +18,7 @@ const PAPER: &str = include_str!("../../tests/data/paper-example.nc");
 
 fn bench(c: &mut Criterion) {
     let program = nc::parse::parse(PAPER).expect("paper example parses");
-    let lin = AxisLimit {
-        velocity: 250.0,
-        acceleration: 2500.0,
-        jerk: 50000.0,
-    };
-    let rot = AxisLimit {
-        velocity: 90f64.to_radians(),
-        acceleration: 900f64.to_radians(),
-        jerk: 20000f64.to_radians(),
-    };
-    let cfg = PlanConfig {
-        period: 0.002,
-        chord_tol: 0.001,
-        path_acc: 1000.0,
-        path_jerk: 20000.0,
-        axes: [lin, lin, lin, rot, rot],
-        rotary: RotaryLimits::UNLIMITED,
-    };
-    let limits = BuildLimits {
-        rapid_mm_s: 250.0,
-        max_feed_mm_s: 166.0,
-        rotary: cfg.rotary,
-    };
+    let (cfg, limits) = nc::fixtures::small_mill(0.002);
     let machines = [
         ("paper", MachineKinematics::Paper),
         (

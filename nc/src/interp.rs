@@ -257,27 +257,14 @@ mod tests {
     use crate::arclen::ArcTable;
     use crate::kinematics::Kinematics;
     use crate::nurbs::tests::paper;
-    use crate::plan::{plan, AxisLimit, PlanConfig};
+    use crate::plan::{plan, PlanConfig};
     use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
     use crate::segment::{build, BuildLimits};
 
     /// The paper's example as the parser produces it (built by hand here so these tests do
     /// not depend on the parser).
     pub(crate) fn paper_program() -> Program {
-        let c = [
-            [47.7773, 71.0202, 58.8006],
-            [44.3229, 75.6066, 54.4778],
-            [37.2164, 84.6443, 44.5755],
-            [28.7567, 101.5653, 29.7151],
-            [-1.6963, 163.6796, 5.8369],
-        ];
-        let t = [
-            [47.8066, 71.9791, 59.0828],
-            [44.3651, 76.5494, 54.8138],
-            [37.2554, 85.5421, 45.0342],
-            [28.7081, 102.3535, 30.3361],
-            [-1.8572, 163.9906, 6.7762],
-        ];
+        let (c, t) = (crate::fixtures::PAPER_C, crate::fixtures::PAPER_T);
         let mut b = NurbsBlock {
             pos: SrcPos { line: 2, col: 1 },
             n: Some(30),
@@ -297,7 +284,7 @@ mod tests {
             b.ctrl_pos.push(SrcPos::default()).unwrap();
         }
         b.knots
-            .extend_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0])
+            .extend_from_slice(&crate::fixtures::PAPER_K)
             .unwrap();
         let dir = [t[0][0] - c[0][0], t[0][1] - c[0][1], t[0][2] - c[0][2]];
         let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
@@ -318,29 +305,7 @@ mod tests {
     }
 
     pub(crate) fn machine() -> (MachineKinematics, PlanConfig, BuildLimits) {
-        let lin = AxisLimit {
-            velocity: 250.0,
-            acceleration: 2500.0,
-            jerk: 50000.0,
-        };
-        let rot = AxisLimit {
-            velocity: 90f64.to_radians(),
-            acceleration: 900f64.to_radians(),
-            jerk: 20000f64.to_radians(),
-        };
-        let cfg = PlanConfig {
-            period: 0.002,
-            chord_tol: 0.001,
-            path_acc: 1000.0,
-            path_jerk: 20000.0,
-            axes: [lin, lin, lin, rot, rot],
-            rotary: RotaryLimits::UNLIMITED,
-        };
-        let bl = BuildLimits {
-            rapid_mm_s: 250.0,
-            max_feed_mm_s: 10000.0 / 60.0,
-            rotary: RotaryLimits::UNLIMITED,
-        };
+        let (cfg, bl) = crate::fixtures::small_mill(0.002);
         (MachineKinematics::Paper, cfg, bl)
     }
 

@@ -338,22 +338,8 @@ pub(crate) mod tests {
 
     /// The paper's block (design.md section 1).
     pub(crate) fn paper() -> DoubleNurbs {
-        let c = [
-            [47.7773, 71.0202, 58.8006],
-            [44.3229, 75.6066, 54.4778],
-            [37.2164, 84.6443, 44.5755],
-            [28.7567, 101.5653, 29.7151],
-            [-1.6963, 163.6796, 5.8369],
-        ];
-        let t = [
-            [47.8066, 71.9791, 59.0828],
-            [44.3651, 76.5494, 54.8138],
-            [37.2554, 85.5421, 45.0342],
-            [28.7081, 102.3535, 30.3361],
-            [-1.8572, 163.9906, 6.7762],
-        ];
-        let k = [0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0];
-        DoubleNurbs::new(3, &c, &t, &[1.0; 5], &k).unwrap()
+        use crate::fixtures::*;
+        DoubleNurbs::new(PAPER_DEGREE, &PAPER_C, &PAPER_T, &[1.0; 5], &PAPER_K).unwrap()
     }
 
     /// Quarter circle as a rational quadratic: exact radius 1 for every u.
@@ -435,13 +421,7 @@ pub(crate) mod tests {
     #[test]
     fn paper_block_matches_cox_de_boor_and_interpolates_ends() {
         let c = paper();
-        let cp = [
-            [47.7773, 71.0202, 58.8006],
-            [44.3229, 75.6066, 54.4778],
-            [37.2164, 84.6443, 44.5755],
-            [28.7567, 101.5653, 29.7151],
-            [-1.6963, 163.6796, 5.8369],
-        ];
+        let cp = crate::fixtures::PAPER_C;
         let k = c.knots().to_vec();
         for i in 0..=200 {
             let u = i as f64 / 200.0;

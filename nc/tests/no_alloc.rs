@@ -6,9 +6,9 @@
 
 use nalgebra::Vector3;
 use nc::interp::{Interpolator, Method};
-use nc::kinematics::{MachineKinematics, RotaryLimits, Tilt};
-use nc::plan::{plan, AxisLimit, PlanConfig};
-use nc::segment::{build, BuildLimits};
+use nc::kinematics::{MachineKinematics, Tilt};
+use nc::plan::{plan, PlanConfig};
+use nc::segment::build;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
@@ -50,29 +50,7 @@ const PROGRAMS: [&str; 4] = [
 
 #[test]
 fn step_never_allocates() {
-    let lin = AxisLimit {
-        velocity: 250.0,
-        acceleration: 2500.0,
-        jerk: 50000.0,
-    };
-    let rot = AxisLimit {
-        velocity: 180f64.to_radians(),
-        acceleration: 1800f64.to_radians(),
-        jerk: 40000f64.to_radians(),
-    };
-    let base = PlanConfig {
-        period: 0.002,
-        chord_tol: 0.001,
-        path_acc: 1000.0,
-        path_jerk: 20000.0,
-        axes: [lin, lin, lin, rot, rot],
-        rotary: RotaryLimits::UNLIMITED,
-    };
-    let limits = BuildLimits {
-        rapid_mm_s: 250.0,
-        max_feed_mm_s: 166.0,
-        rotary: base.rotary,
-    };
+    let (base, limits) = nc::fixtures::small_mill(0.002);
     let kins = [
         MachineKinematics::Paper,
         MachineKinematics::Trt {
