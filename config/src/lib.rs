@@ -62,6 +62,7 @@
 //!
 //! Example files: `config/machines/*.toml`.
 
+pub mod bus;
 mod error;
 mod machine;
 mod raw;

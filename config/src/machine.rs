@@ -18,6 +18,10 @@ pub struct Machine {
     pub kinematics: Kinematics,
     pub axes: Axes,
     pub interpolation: Interpolation,
+    /// CAN buses (`[[bus]]`); empty for a machine that is only simulated.
+    pub buses: Vec<crate::bus::Bus>,
+    /// One drive per axis in joint order (X Y Z tilt C) when `buses` is not empty, else none.
+    pub drives: Vec<crate::bus::Drive>,
 }
 
 impl Machine {

@@ -20,6 +20,37 @@ pub(crate) struct RawFile {
     pub kinematics: RawKinematics,
     pub axes: RawAxes,
     pub interpolation: Option<RawInterpolation>,
+    /// `[[bus]]`: CAN buses; absent for a machine that is only simulated.
+    #[serde(default)]
+    pub bus: Vec<RawBus>,
+}
+
+/// `[[bus]]`: one CAN bus.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawBus {
+    /// Name the axes' `drive.bus` refers to.
+    pub name: String,
+    /// SocketCAN interface, e.g. "can0" or "vcan0".
+    pub interface: String,
+    /// bit/s; default 1 000 000.
+    pub bitrate: Option<i64>,
+    /// Highest allowed worst-case bus load, fraction of the bitrate; default 0.70.
+    pub max_load: Option<f64>,
+}
+
+/// `[axes.*.drive]`: the CiA-402 drive behind one axis.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawDrive {
+    pub bus: String,
+    pub node: i64,
+    /// Drive counts per mm (linear) or per degree (rotary).
+    pub counts_per_unit: f64,
+    /// +1 or -1; default +1.
+    pub sign: Option<i64>,
+    /// Counts at axis position 0; default 0.
+    pub offset: Option<i64>,
 }
 
 /// `[machine]`
@@ -65,6 +96,7 @@ pub(crate) struct RawAxis {
     pub velocity: f64,
     pub acceleration: f64,
     pub jerk: f64,
+    pub drive: Option<RawDrive>,
 }
 
 /// `[interpolation]`: every key optional.

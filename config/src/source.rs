@@ -74,15 +74,34 @@ impl<'a> Source<'a> {
     pub fn locate(&self, path: &[&str]) -> Location {
         let mut table = self.doc.get_ref();
         let mut best: Option<Range<usize>> = None;
-        for seg in path {
+        let mut i = 0;
+        while let Some(seg) = path.get(i) {
             let Some((key, value)) = table.get_key_value(*seg) else {
                 break;
             };
-            match value.get_ref() {
-                DeValue::Table(inner) => {
-                    best = Some(key.span());
-                    table = inner;
+            best = Some(key.span());
+            i += 1;
+            let mut value = value;
+            // An array of tables (`[[bus]]`) is entered by the index that follows its key.
+            if let DeValue::Array(items) = value.get_ref() {
+                match path
+                    .get(i)
+                    .and_then(|ix| ix.parse::<usize>().ok())
+                    .and_then(|ix| items.get(ix))
+                {
+                    Some(item) => {
+                        value = item;
+                        best = Some(item.span());
+                        i += 1;
+                    }
+                    None => {
+                        best = Some(value.span());
+                        break;
+                    }
                 }
+            }
+            match value.get_ref() {
+                DeValue::Table(inner) => table = inner,
                 _ => {
                     best = Some(value.span());
                     break;
@@ -95,15 +114,27 @@ impl<'a> Source<'a> {
         }
     }
 
-    /// The value at `path` exactly as written, if it is on a single line.
+    /// The value at `path` exactly as written, if it is on one line.
     pub fn written(&self, path: &[&str]) -> Option<String> {
-        let (last, parents) = path.split_last()?;
         let mut table = self.doc.get_ref();
-        for seg in parents {
-            table = table.get(*seg)?.get_ref().as_table()?;
+        let mut i = 0;
+        loop {
+            let value = table.get(*path.get(i)?)?;
+            i += 1;
+            let value = match value.get_ref() {
+                DeValue::Array(items) if i < path.len() => {
+                    let item = items.get(path[i].parse::<usize>().ok()?)?;
+                    i += 1;
+                    item
+                }
+                _ => value,
+            };
+            if i == path.len() {
+                let text = self.text.get(value.span())?;
+                return (!text.contains('\n')).then(|| text.to_owned());
+            }
+            table = value.get_ref().as_table()?;
         }
-        let text = self.text.get(table.get(*last)?.span())?;
-        (!text.contains('\n')).then(|| text.to_owned())
     }
 
     /// Dotted key path of the deepest key or value containing byte `offset`, with `[i]` for

@@ -4,9 +4,10 @@
 //! the unit. The first violation is returned as [`ConfigError::Invalid`] with the key path,
 //! the value as written and its line:col (looked up in [`Source`]).
 
+use crate::bus::{self, Bus, Drive};
 use crate::error::ConfigError;
 use crate::machine::{Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, RotaryName};
-use crate::raw::{RawAxes, RawAxis, RawFile, RawInterpolation, RawKinematics, RawMachine};
+use crate::raw::{RawAxes, RawAxis, RawBus, RawFile, RawInterpolation, RawKinematics, RawMachine};
 use crate::source::Source;
 
 /// Converts the raw file into a validated [`Machine`].
@@ -16,12 +17,16 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     let kinematics = check.kinematics(&raw.kinematics)?;
     let axes = check.axes(&raw.axes, &kinematics)?;
     let interpolation = check.interpolation(&raw.interpolation.unwrap_or_default())?;
+    let buses = check.buses(&raw.bus)?;
+    let drives = check.drives(&raw.axes, &axes, &buses, period_s)?;
     Ok(Machine {
         name,
         period_s,
         kinematics,
         axes,
         interpolation,
+        buses,
+        drives,
     })
 }
 
@@ -258,6 +263,166 @@ impl Check<'_, '_> {
             max_feed_mm_min: max_feed,
             rapid_feed_mm_min: opt("rapid_feed_mm_min", i.rapid_feed_mm_min, max_feed, "mm/min")?,
         })
+    }
+}
+
+impl Check<'_, '_> {
+    fn buses(&self, raw: &[RawBus]) -> Result<Vec<Bus>, ConfigError> {
+        let mut out: Vec<Bus> = Vec::with_capacity(raw.len());
+        for (i, b) in raw.iter().enumerate() {
+            let idx = i.to_string();
+            let path = |field: &'static str| ["bus", idx.as_str(), field];
+            if b.name.trim().is_empty() || out.iter().any(|o| o.name == b.name) {
+                let rule = "must be a non-empty name, unique among the [[bus]] tables".to_owned();
+                return Err(self.invalid(&path("name"), Some(format!("{:?}", b.name)), rule));
+            }
+            if b.interface.is_empty() || b.interface.len() > 15 || b.interface.contains(['/', ' '])
+            {
+                let rule =
+                    "must be a network interface name of 1 to 15 bytes (e.g. \"can0\")".to_owned();
+                return Err(self.invalid(
+                    &path("interface"),
+                    Some(format!("{:?}", b.interface)),
+                    rule,
+                ));
+            }
+            let bitrate = b.bitrate.unwrap_or(i64::from(bus::DEFAULT_BITRATE));
+            if !(10_000..=1_000_000).contains(&bitrate) {
+                let rule = "must be in 10000..=1000000 (bit/s)".to_owned();
+                return Err(self.invalid(&path("bitrate"), Some(bitrate.to_string()), rule));
+            }
+            let max_load = b.max_load.unwrap_or(bus::DEFAULT_MAX_LOAD);
+            if !(max_load.is_finite() && max_load > 0.0 && max_load <= 1.0) {
+                let rule = "must be in (0, 1] (fraction of the bitrate)".to_owned();
+                return Err(self.invalid(&path("max_load"), Some(max_load.to_string()), rule));
+            }
+            out.push(Bus {
+                name: b.name.clone(),
+                interface: b.interface.clone(),
+                bitrate: bitrate as u32,
+                max_load,
+            });
+        }
+        Ok(out)
+    }
+
+    fn drives(
+        &self,
+        raw: &RawAxes,
+        axes: &Axes,
+        buses: &[Bus],
+        period_s: f64,
+    ) -> Result<Vec<Drive>, ConfigError> {
+        let tilt_key = axes.tilt_name.key();
+        let tilt = match axes.tilt_name {
+            RotaryName::A => raw.a.as_ref(),
+            RotaryName::B => raw.b.as_ref(),
+        };
+        let keyed: [(&str, Option<&RawAxis>, &AxisLimits); 5] = [
+            ("x", Some(&raw.x), &axes.x),
+            ("y", Some(&raw.y), &axes.y),
+            ("z", Some(&raw.z), &axes.z),
+            (tilt_key, tilt, &axes.tilt),
+            ("c", Some(&raw.c), &axes.c),
+        ];
+        let mut out: Vec<Drive> = Vec::new();
+        for (axis, (key, raw_axis, limits)) in keyed.iter().enumerate() {
+            let path = |field: &'static str| ["axes", key, "drive", field];
+            let Some(d) = raw_axis.and_then(|a| a.drive.as_ref()) else {
+                if !buses.is_empty() {
+                    let rule =
+                        "missing: a machine with [[bus]] tables needs a drive on every axis \
+                                (bus, node, counts_per_unit)"
+                            .to_owned();
+                    return Err(self.missing(&["axes", key], rule));
+                }
+                continue;
+            };
+            let Some(bus) = buses.iter().position(|b| b.name == d.bus) else {
+                let names: Vec<String> = buses.iter().map(|b| format!("{:?}", b.name)).collect();
+                let rule = if names.is_empty() {
+                    "names no bus: add a [[bus]] table with this name".to_owned()
+                } else {
+                    format!("must name a [[bus]]: one of {}", names.join(", "))
+                };
+                return Err(self.invalid(&path("bus"), Some(format!("{:?}", d.bus)), rule));
+            };
+            if !(1..=127).contains(&d.node)
+                || out
+                    .iter()
+                    .any(|o| o.bus == bus && i64::from(o.node) == d.node)
+            {
+                let rule = format!(
+                    "must be a CANopen node id in 1..=127, unique on bus {:?}",
+                    d.bus
+                );
+                return Err(self.invalid(&path("node"), Some(d.node.to_string()), rule));
+            }
+            let unit = if axis >= 3 { "counts/deg" } else { "counts/mm" };
+            let counts_per_unit =
+                self.positive(&path("counts_per_unit"), d.counts_per_unit, unit)?;
+            let sign = d.sign.unwrap_or(1);
+            if sign != 1 && sign != -1 {
+                let rule = "must be 1 or -1".to_owned();
+                return Err(self.invalid(&path("sign"), Some(sign.to_string()), rule));
+            }
+            let offset = d.offset.unwrap_or(0);
+            let Ok(offset) = i32::try_from(offset) else {
+                let rule = "must fit a 32-bit signed count".to_owned();
+                return Err(self.invalid(&path("offset"), Some(offset.to_string()), rule));
+            };
+            let drive = Drive {
+                axis,
+                bus,
+                node: d.node as u8,
+                counts_per_unit,
+                sign: sign as i8,
+                offset,
+            };
+            if !limits.is_unlimited()
+                && (drive.counts(limits.min).is_none() || drive.counts(limits.max).is_none())
+            {
+                let rule = format!(
+                    "at this scale the travel {}..{} does not fit the drive's 32-bit position \
+                     (counts from {:.0} to {:.0}, limit +-2147483647)",
+                    limits.min,
+                    limits.max,
+                    limits.min * counts_per_unit * f64::from(drive.sign) + f64::from(offset),
+                    limits.max * counts_per_unit * f64::from(drive.sign) + f64::from(offset),
+                );
+                return Err(self.invalid(
+                    &path("counts_per_unit"),
+                    Some(counts_per_unit.to_string()),
+                    rule,
+                ));
+            }
+            out.push(drive);
+        }
+        for (i, b) in buses.iter().enumerate() {
+            let n = out.iter().filter(|d| d.bus == i).count() as u32;
+            let load = bus::load(n, b.bitrate, period_s);
+            if load > b.max_load {
+                let idx = i.to_string();
+                let rule = format!(
+                    "bus {:?} would carry {n} drives: {} bits per {} ms cycle = {:.1} % of {} bit/s, \
+                     over max_load {:.1} % by {:.1} points: lengthen the period, raise the bitrate \
+                     or move axes to another bus",
+                    b.name,
+                    bus::cycle_bits(n),
+                    period_s * 1e3,
+                    load * 100.0,
+                    b.bitrate,
+                    b.max_load * 100.0,
+                    (load - b.max_load) * 100.0,
+                );
+                return Err(self.invalid(
+                    &["bus", idx.as_str(), "max_load"],
+                    Some(b.max_load.to_string()),
+                    rule,
+                ));
+            }
+        }
+        Ok(out)
     }
 }
 

@@ -275,3 +275,119 @@ fn path_limits_and_feeds_must_be_positive() {
         );
     }
 }
+
+/// The minimal file with one bus and a drive on every axis (nodes 1..=5).
+fn with_drives(period_ms: &str, bitrate: &str) -> String {
+    let mut text = MINIMAL.replace(
+        "name = \"minimal\"",
+        &format!("name = \"minimal\"\nperiod_ms = {period_ms}"),
+    );
+    text.push_str(&format!(
+        "\n[[bus]]\nname = \"can0\"\ninterface = \"vcan0\"\nbitrate = {bitrate}\n"
+    ));
+    for (i, ax) in ["x", "y", "z", "a", "c"].iter().enumerate() {
+        text.push_str(&format!(
+            "\n[axes.{ax}.drive]\nbus = \"can0\"\nnode = {}\ncounts_per_unit = 1000.0\n",
+            i + 1
+        ));
+    }
+    text
+}
+
+#[test]
+fn drives_load_and_convert_counts() {
+    let m = common::parse(&with_drives("2.0", "1000000")).unwrap();
+    assert_eq!(m.buses.len(), 1);
+    assert_eq!(m.buses[0].interface, "vcan0");
+    assert_eq!(m.drives.len(), 5);
+    assert_eq!(
+        m.drives.iter().map(|d| d.node).collect::<Vec<_>>(),
+        [1, 2, 3, 4, 5]
+    );
+    assert_eq!(m.drives[3].axis, 3);
+    assert_eq!(m.drives[0].counts(1.5), Some(1500));
+    // The example machine carries drives too, within its bus load.
+    let p = common::parse(common::PAPER).unwrap();
+    assert_eq!(p.drives.len(), 5);
+    assert!(config::bus::load(5, p.buses[0].bitrate, p.period_s) <= p.buses[0].max_load);
+}
+
+#[test]
+fn bus_load_over_the_maximum_says_by_how_much() {
+    // 5 drives at 1 ms on 1 Mbit/s: 1205 bits = 120.5 % against the default 70 %.
+    let (_, shown) = fail(&with_drives("1.0", "1000000"));
+    assert_mentions(
+        &shown,
+        &[
+            ORIGIN,
+            "bus.0.max_load",
+            "1205 bits",
+            "120.5 %",
+            "70.0 %",
+            "by 50.5 points",
+        ],
+    );
+}
+
+#[test]
+fn drive_rules() {
+    let base = with_drives("2.0", "1000000");
+    let cases = [
+        (
+            base.replacen("node = 2", "node = 1", 1),
+            "axes.y.drive.node",
+            "unique",
+        ),
+        (
+            base.replacen("node = 3", "node = 128", 1),
+            "axes.z.drive.node",
+            "1..=127",
+        ),
+        (
+            base.replacen("bus = \"can0\"\nnode = 1", "bus = \"can9\"\nnode = 1", 1),
+            "axes.x.drive.bus",
+            "\"can0\"",
+        ),
+        (
+            base.replacen("counts_per_unit = 1000.0", "counts_per_unit = -5.0", 1),
+            "axes.x.drive.counts_per_unit",
+            "> 0",
+        ),
+        (
+            base.replacen("counts_per_unit = 1000.0", "counts_per_unit = 1e8", 1),
+            "axes.x.drive.counts_per_unit",
+            "32-bit",
+        ),
+        (
+            base.replacen("node = 1\n", "node = 1\nsign = 2\n", 1),
+            "axes.x.drive.sign",
+            "1 or -1",
+        ),
+        (
+            base.replace("bitrate = 1000000", "bitrate = 5000000"),
+            "bus.0.bitrate",
+            "10000..=1000000",
+        ),
+        (
+            base.replace(
+                "interface = \"vcan0\"",
+                "interface = \"a-name-much-too-long\"",
+            ),
+            "bus.0.interface",
+            "15 bytes",
+        ),
+        (
+            base.replacen(
+                "\n[axes.c.drive]\nbus = \"can0\"\nnode = 5\ncounts_per_unit = 1000.0\n",
+                "",
+                1,
+            ),
+            "axes.c",
+            "drive on every axis",
+        ),
+    ];
+    for (text, key, words) in cases {
+        let (_, shown) = fail(&text);
+        assert_mentions(&shown, &[ORIGIN, key, words]);
+    }
+}

@@ -1,0 +1,105 @@
+//! CAN buses and the CiA-402 drive behind each axis (`[[bus]]`, `[axes.*.drive]`), and the
+//! worst-case bus load that decides whether a machine file is accepted.
+//!
+//! Bus load (design.md section 2): a standard CAN frame with n data bytes takes at most
+//! `55 + 10 n` bits on the wire with worst-case bit stuffing and the interframe space
+//! (`47 + 8 n` without stuffing). Each cycle a bus carries one SYNC (0 bytes), and per drive
+//! one RPDO (controlword + target, 6 bytes) and one TPDO (statusword + actual, 6 bytes).
+//! vcan has no bit timing, so the project computes the load itself.
+
+/// Default `bitrate`, bit/s.
+pub const DEFAULT_BITRATE: u32 = 1_000_000;
+/// Default `max_load`, fraction of the bitrate.
+pub const DEFAULT_MAX_LOAD: f64 = 0.70;
+/// Bytes of the cyclic RPDO (0x6040 + 0x607A) and TPDO (0x6041 + 0x6064).
+pub const PDO_BYTES: u32 = 6;
+
+/// Worst-case bits of one standard frame with `n` data bytes, stuffing and IFS included.
+pub const fn frame_bits(n: u32) -> u32 {
+    55 + 10 * n
+}
+
+/// Worst-case bits per cycle on a bus carrying `drives` drives: SYNC + RPDO + TPDO each.
+pub const fn cycle_bits(drives: u32) -> u32 {
+    frame_bits(0) + drives * 2 * frame_bits(PDO_BYTES)
+}
+
+/// Fraction of the bus's capacity used per cycle.
+pub fn load(drives: u32, bitrate: u32, period_s: f64) -> f64 {
+    f64::from(cycle_bits(drives)) / (f64::from(bitrate) * period_s)
+}
+
+/// One CAN bus.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bus {
+    /// The name axes refer to.
+    pub name: String,
+    /// SocketCAN interface name (at most 15 bytes).
+    pub interface: String,
+    /// bit/s, 10 000..=1 000 000.
+    pub bitrate: u32,
+    /// Highest accepted worst-case load, in (0, 1].
+    pub max_load: f64,
+}
+
+/// The drive behind one axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drive {
+    /// Joint index: 0 X, 1 Y, 2 Z, 3 tilt (A/B), 4 C.
+    pub axis: usize,
+    /// Index into [`crate::Machine::buses`].
+    pub bus: usize,
+    /// CANopen node id, 1..=127, unique on its bus.
+    pub node: u8,
+    /// Drive counts per mm or per degree, finite and > 0.
+    pub counts_per_unit: f64,
+    /// +1 or -1: the drive's positive direction against the axis's.
+    pub sign: i8,
+    /// Counts at axis position 0.
+    pub offset: i32,
+}
+
+impl Drive {
+    /// Counts for an axis position (mm or degrees), `None` if they do not fit an i32.
+    pub fn counts(&self, position: f64) -> Option<i32> {
+        let c = (position * self.counts_per_unit * f64::from(self.sign)).round()
+            + f64::from(self.offset);
+        (c.is_finite() && c >= f64::from(i32::MIN) && c <= f64::from(i32::MAX)).then_some(c as i32)
+    }
+
+    /// Axis position (mm or degrees) for drive counts.
+    pub fn position(&self, counts: i32) -> f64 {
+        (f64::from(counts) - f64::from(self.offset)) / (self.counts_per_unit * f64::from(self.sign))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn design_md_bus_load_example() {
+        // 5 axes: one SYNC + 5 RPDO(6 B) + 5 TPDO(6 B) = 55 + 10 * 115 = 1205 bits.
+        assert_eq!(frame_bits(0), 55);
+        assert_eq!(frame_bits(6), 115);
+        assert_eq!(cycle_bits(5), 1205);
+        assert!((load(5, 1_000_000, 0.002) - 0.6025).abs() < 1e-12);
+        assert!((load(5, 1_000_000, 0.001) - 1.205).abs() < 1e-12);
+    }
+
+    #[test]
+    fn counts_round_trip_and_refuse_overflow() {
+        let d = Drive {
+            axis: 0,
+            bus: 0,
+            node: 1,
+            counts_per_unit: 10_000.0,
+            sign: -1,
+            offset: 500,
+        };
+        assert_eq!(d.counts(1.5), Some(-14_500));
+        assert!((d.position(-14_500) - 1.5).abs() < 1e-12);
+        assert_eq!(d.counts(1e6), None);
+        assert_eq!(d.counts(f64::NAN), None);
+    }
+}
