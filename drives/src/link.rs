@@ -41,7 +41,9 @@ pub enum LinkError {
 impl LinkError {
     fn from_io(e: &io::Error) -> LinkError {
         match e.kind() {
-            ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => LinkError::Closed,
+            ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
+                LinkError::Closed
+            }
             _ => LinkError::Os(e.raw_os_error().unwrap_or(0)),
         }
     }
@@ -72,8 +74,13 @@ impl SocketLink {
     /// Two connected ends of an in-process link (AF_UNIX SOCK_SEQPACKET socketpair).
     pub fn pair() -> io::Result<(SocketLink, SocketLink)> {
         use nix::sys::socket::{socketpair, AddressFamily, SockFlag, SockType};
-        let (a, b) = socketpair(AddressFamily::Unix, SockType::SeqPacket, None, SockFlag::SOCK_CLOEXEC)
-            .map_err(io::Error::from)?;
+        let (a, b) = socketpair(
+            AddressFamily::Unix,
+            SockType::SeqPacket,
+            None,
+            SockFlag::SOCK_CLOEXEC,
+        )
+        .map_err(io::Error::from)?;
         Ok((SocketLink::from_fd(a)?, SocketLink::from_fd(b)?))
     }
 
@@ -106,13 +113,18 @@ impl CanLink for SocketLink {
     fn send(&mut self, frame: &CanFrame) -> Result<Sent, LinkError> {
         // Every CanFrame holds an 11-bit id and <= 8 bytes, so both conversions succeed;
         // were they ever to fail, the frame is counted as dropped rather than panicking.
-        let Some(out) = StandardId::new(frame.id()).and_then(|id| socketcan::CanFrame::new(id, frame.data())) else {
+        let Some(out) =
+            StandardId::new(frame.id()).and_then(|id| socketcan::CanFrame::new(id, frame.data()))
+        else {
             self.dropped += 1;
             return Ok(Sent::Dropped);
         };
         match self.sock.write_frame(&out) {
             Ok(()) => Ok(Sent::Queued),
-            Err(e) if e.kind() == ErrorKind::WouldBlock || e.raw_os_error() == Some(nix::libc::ENOBUFS) => {
+            Err(e)
+                if e.kind() == ErrorKind::WouldBlock
+                    || e.raw_os_error() == Some(nix::libc::ENOBUFS) =>
+            {
                 self.dropped += 1;
                 Ok(Sent::Dropped)
             }
@@ -152,10 +164,22 @@ mod tests {
     fn frames_cross_the_in_process_link_unchanged() {
         let (mut master, mut drives) = SocketLink::pair().unwrap();
         assert_eq!(drives.recv(), Ok(None));
-        for v in ["000#0100", "080#", "605#2B40600006000000", "201#0F00A0860100", "7FF#0102030405060708"] {
+        for v in [
+            "000#0100",
+            "080#",
+            "605#2B40600006000000",
+            "201#0F00A0860100",
+            "7FF#0102030405060708",
+        ] {
             assert_eq!(master.send(&f(v)), Ok(Sent::Queued));
         }
-        for v in ["000#0100", "080#", "605#2B40600006000000", "201#0F00A0860100", "7FF#0102030405060708"] {
+        for v in [
+            "000#0100",
+            "080#",
+            "605#2B40600006000000",
+            "201#0F00A0860100",
+            "7FF#0102030405060708",
+        ] {
             assert_eq!(drives.recv(), Ok(Some(f(v))));
         }
         assert_eq!(drives.recv(), Ok(None));
@@ -174,7 +198,11 @@ mod tests {
                 sent += 1;
             }
         }
-        assert!(sent > 0 && master.dropped() > 0, "sent {sent}, dropped {}", master.dropped());
+        assert!(
+            sent > 0 && master.dropped() > 0,
+            "sent {sent}, dropped {}",
+            master.dropped()
+        );
         assert_eq!(sent + master.dropped(), 100_000);
     }
 
@@ -194,7 +222,15 @@ mod tests {
         let iface = std::env::var("DNURBS_VCAN").unwrap_or_else(|_| "vcan0".into());
         let mut a = SocketLink::open(&iface).expect("open the vcan interface");
         let mut b = SocketLink::open(&iface).expect("open the vcan interface twice");
-        let seq = ["000#8200", "701#00", "601#2F60600008000000", "581#6060600000000000", "080#", "201#0F00A0860100", "181#3712A0860100"];
+        let seq = [
+            "000#8200",
+            "701#00",
+            "601#2F60600008000000",
+            "581#6060600000000000",
+            "080#",
+            "201#0F00A0860100",
+            "181#3712A0860100",
+        ];
         for v in seq {
             assert_eq!(a.send(&f(v)), Ok(Sent::Queued));
         }

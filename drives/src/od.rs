@@ -1,0 +1,40 @@
+//! Object dictionary entries this master reads or writes (CiA-301 and CiA-402), as named in
+//! design.md section 2. Indices only; the SDO codec takes them with a sub-index and a value.
+#![forbid(unsafe_code)]
+
+/// Heartbeat consumer time (u32 per sub-index: `node << 16 | ms`).
+pub const HEARTBEAT_CONSUMER: u16 = 0x1016;
+/// Heartbeat producer time (u16, ms).
+pub const HEARTBEAT_PRODUCER: u16 = 0x1017;
+/// RPDO1 communication parameter (sub 1 COB-ID, bit 31 = invalid; sub 2 transmission type).
+pub const RPDO1_COMMUNICATION: u16 = 0x1400;
+/// RPDO1 mapping parameter (sub 0 count, sub 1.. entries).
+pub const RPDO1_MAPPING: u16 = 0x1600;
+/// TPDO1 communication parameter.
+pub const TPDO1_COMMUNICATION: u16 = 0x1800;
+/// TPDO1 mapping parameter.
+pub const TPDO1_MAPPING: u16 = 0x1A00;
+/// Bit 31 of a PDO COB-ID entry: the PDO is disabled.
+pub const PDO_COB_ID_INVALID: u32 = 1 << 31;
+/// Transmission type: synchronous, every SYNC.
+pub const TRANSMISSION_EVERY_SYNC: u8 = 1;
+
+/// Controlword (u16).
+pub const CONTROLWORD: u16 = 0x6040;
+/// Statusword (u16).
+pub const STATUSWORD: u16 = 0x6041;
+/// Modes of operation (i8).
+pub const MODES_OF_OPERATION: u16 = 0x6060;
+/// Modes of operation display (i8).
+pub const MODES_OF_OPERATION_DISPLAY: u16 = 0x6061;
+/// Position actual value (i32).
+pub const POSITION_ACTUAL: u16 = 0x6064;
+/// Following error window (u32).
+pub const FOLLOWING_ERROR_WINDOW: u16 = 0x6065;
+/// Target position (i32).
+pub const TARGET_POSITION: u16 = 0x607A;
+/// Interpolation time period: sub 1 value (u8), sub 2 exponent (i8); period = value * 10^exp s.
+pub const INTERPOLATION_TIME_PERIOD: u16 = 0x60C2;
+
+/// Modes of operation value of cyclic synchronous position mode.
+pub const MODE_CSP: i8 = 8;
