@@ -37,6 +37,7 @@
 pub mod cia402;
 pub mod frame;
 pub mod link;
+pub mod master;
 pub mod od;
 pub mod wire;
 

@@ -1,0 +1,11 @@
+//! The CANopen master for one bus: configuration before motion ([`setup`]) and the
+//! allocation-free exchange of every cycle ([`cyclic`]).
+//!
+//! Errors and faults always name the node and the cause (and for SDO the object as
+//! `index:sub` and the abort code in words), so that an integrator can act on them.
+
+pub mod cyclic;
+pub mod setup;
+
+pub use cyclic::{DriveFault, FaultCause, Master, NodeStatus, Supervision, MAX_NODES};
+pub use setup::{configure, SetupError, SetupErrorKind, SetupOptions};
