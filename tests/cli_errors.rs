@@ -242,3 +242,35 @@ fn degenerate_programs_are_errors_or_stand_still_never_panics() {
     let s: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(s["cycles"], 1);
 }
+
+#[test]
+fn busload_prints_the_design_md_numbers_and_refuses_an_overloaded_bus() {
+    let mach = machine("paper-ac-table.toml");
+    let out = dnurbs(&["busload", "--machine", mach.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("5 drives")
+            && text.contains("1205 bits per cycle")
+            && text.contains("60.25 %"),
+        "{text}"
+    );
+    // The same machine at 1 ms: 120.5 %, refused with the numbers.
+    let fast = temp("fast.toml");
+    let body = std::fs::read_to_string(&mach)
+        .unwrap()
+        .replace("period_ms = 2.0", "period_ms = 1.0");
+    std::fs::write(&fast, body).unwrap();
+    let out = dnurbs(&["busload", "--machine", fast.to_str().unwrap()]);
+    let _ = std::fs::remove_file(&fast);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("120.5 %") && err.contains("by 50.5 points"),
+        "{err}"
+    );
+}

@@ -54,6 +54,14 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Print the worst-case CAN bus load of a machine file, per bus: SYNC plus one 6-byte
+    /// RPDO and TPDO per drive each cycle, at 55 + 10 n bits per frame (stuffing and
+    /// interframe space included). vcan has no bit timing, so this is computed, not measured.
+    Busload {
+        /// Machine file (TOML) with [[bus]] tables and [axes.*.drive] mappings.
+        #[arg(long, short)]
+        machine: PathBuf,
+    },
     /// Simulate programs with each parameter update method (taylor1, taylor2, arclength)
     /// and print a Markdown table of feed fluctuation and chord error.
     Compare {
@@ -77,6 +85,7 @@ fn main() -> ExitCode {
             json,
         } => simulate(program, machine, method, trace, json),
         Command::Compare { programs, machine } => compare(programs, machine),
+        Command::Busload { machine } => busload(machine),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -151,6 +160,40 @@ fn compare(programs: Vec<PathBuf>, machine: PathBuf) -> anyhow::Result<()> {
                 s.cycles
             );
         }
+    }
+    Ok(())
+}
+
+fn busload(machine: PathBuf) -> anyhow::Result<()> {
+    // Loading already refuses a bus over its max_load; this prints the numbers.
+    let m = load_machine(&machine)?;
+    if m.buses.is_empty() {
+        println!(
+            "{}: no [[bus]] tables: the machine has no drives",
+            machine.display()
+        );
+        return Ok(());
+    }
+    println!("period {} ms", m.period_s * 1e3);
+    for (i, b) in m.buses.iter().enumerate() {
+        let drives: Vec<String> = m
+            .drives
+            .iter()
+            .filter(|d| d.bus == i)
+            .map(|d| format!("{}=node {}", m.axes.all()[d.axis].0, d.node))
+            .collect();
+        let n = drives.len() as u32;
+        println!(
+            "bus {} ({}, {} bit/s): {} drives [{}]: {} bits per cycle, load {:.2} % (max {:.0} %)",
+            b.name,
+            b.interface,
+            b.bitrate,
+            n,
+            drives.join(", "),
+            config::bus::cycle_bits(n),
+            config::bus::load(n, b.bitrate, m.period_s) * 100.0,
+            b.max_load * 100.0
+        );
     }
     Ok(())
 }
