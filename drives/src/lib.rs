@@ -24,12 +24,14 @@
 //!   drive-side [`DriveModel`] for the simulated drive.
 //! - [`od`]: object dictionary indices used by the master.
 //! - [`link`]: the non-blocking CAN link: SocketCAN, or an in-process socketpair for tests.
+//! - [`sim`]: simulated CiA-402 drives (the slave side of the bus, sans-I/O), for
+//!   `dnurbs sim-drives` and for testing the master. Not real-time: it allocates.
 //!
 //! The worst-case bus load of the cyclic traffic (vcan cannot measure it) is computed where
 //! machine files are validated, in `config::bus`.
 //!
-//! Nothing in these modules allocates, blocks, reads a clock or panics on any input; time,
-//! when it matters (SDO timeouts, heartbeat supervision), will be passed in by the transport
+//! Nothing in these modules allocates (`sim` excepted), blocks, reads a clock or panics on
+//! any input; time, when it matters (SDO timeouts, heartbeat supervision), will be passed in by the transport
 //! layer. The modules are `#![forbid(unsafe_code)]` each, so that a transport module that
 //! needs `unsafe` for socket set-up can relax only the crate-level attribute below.
 #![forbid(unsafe_code)]
@@ -39,6 +41,7 @@ pub mod frame;
 pub mod link;
 pub mod master;
 pub mod od;
+pub mod sim;
 pub mod wire;
 
 pub use cia402::{Controlword, DriveModel, Goal, Sequencer, State, Statusword};

@@ -1,0 +1,275 @@
+//! Simulated CiA-402 drives: the slave side of the bus, sans-I/O, for `dnurbs sim-drives`
+//! and for testing the master without hardware.
+//!
+//! A [`SimBus`] plays every configured node. It is pure: frames from the master go in through
+//! [`SimBus::on_frame`], time through `now_s` arguments and [`SimBus::poll`], and frames to
+//! the master come out through a closure; the process that runs it owns the socket. It is not
+//! real-time code (it allocates), but no input makes it panic: malformed frames are ignored
+//! or answered with the SDO abort the standard names.
+//!
+//! # Each node
+//!
+//! * **NMT.** At power-on a node is initialising; its boot-up message `0x700+node [00]` goes
+//!   out at the next [`SimBus::poll`], and it enters pre-operational. Reset node and reset
+//!   communication (0x81/0x82, to the node or to all) restore the defaults of the
+//!   communication objects (0x1000..=0x1FFF), reset node those of the application objects
+//!   too and restarts the drive state machine; the node is initialising again until the
+//!   next poll sends a new boot-up. Start, stop and enter pre-operational switch the state.
+//!   An initialising node ignores every frame. Heartbeats `0x700+node [state]` are sent
+//!   every 0x1017 ms (0, the default, is off) from [`SimBus::poll`], the first one period
+//!   after 0x1017 is written.
+//! * **SDO server**, expedited transfers only, on 0x600+node -> 0x580+node, in
+//!   pre-operational and operational (a stopped node does not answer). Requests that are not
+//!   8 bytes long are ignored; segmented, block and unknown command specifiers are answered
+//!   with 0x05040001.
+//! * **PDOs**, in operational only. An RPDO on the COB-ID of 0x1400 sub 1 (while valid) is
+//!   split per the *current* mapping of 0x1600 into the mapped objects; a frame whose length
+//!   is not the mapping's is ignored and counted ([`NodeCounters::rpdo_length_errors`]).
+//!   With a synchronous transmission type (0..=240) the values take effect at the next SYNC,
+//!   with 0xFE/0xFF at once. At each SYNC (0x080, with or without counter): the motor
+//!   advances one period, the drive's automatic transitions run, an injected fault fires,
+//!   the pending RPDO values take effect (a controlword goes to [`DriveModel::apply`](crate::DriveModel::apply)), and
+//!   then, in Operation enabled with mode 8, the motor moves toward 0x607A during the next
+//!   period. TPDO1 (while valid) carries the mapped objects' values: every n-th SYNC for
+//!   transmission type n in 1..=240, at a SYNC where they changed for 0, 0xFE and 0xFF. A
+//!   [`Record`] of every SYNC in operational is kept, whether the TPDO is sent or not.
+//! * **Motor**: a first-order lag with time constant `lag_s`, advanced by `period_s` per
+//!   SYNC: `actual += (demand - actual) * (1 - exp(-period_s / lag_s))`, the demand being
+//!   the target that took effect at the previous SYNC (so with `lag_s = 0` the actual
+//!   position equals the previous SYNC's target). Outside Operation enabled in CSP the
+//!   demand is where the motor stands. 0x60C2 is stored, not used: the motor runs on the
+//!   `period_s` given to [`SimBus::new`].
+//! * **Statusword** (0x6041): [`DriveModel::statusword`](crate::DriveModel::statusword), bit 12 (target followed) only in
+//!   Operation enabled with 0x6060 = 8, bit 13 (following error) when
+//!   `|0x607A - 0x6064| > 0x6065` at the SYNC (0x6065 = 0, the default, switches it off).
+//!
+//! # Object dictionary
+//!
+//! | index  | sub  | type | access | default                 | notes                                  |
+//! |--------|------|------|--------|-------------------------|----------------------------------------|
+//! | 0x1000 | 0    | U32  | ro     | 0x00020192              | device type: CiA-402 servo drive       |
+//! | 0x1001 | 0    | U8   | ro     | 0                       | error register: 0x81 while faulted     |
+//! | 0x1017 | 0    | U16  | rw     | 0                       | heartbeat producer time, ms            |
+//! | 0x1400 | 0    | U8   | ro     | 2                       | RPDO1 communication                    |
+//! |        | 1    | U32  | rw     | 0x200+node              | COB-ID, bit 31 = invalid               |
+//! |        | 2    | U8   | rw     | 0xFF                    | transmission type                      |
+//! | 0x1600 | 0    | U8   | rw     | 1                       | RPDO1 mapping: number of entries       |
+//! |        | 1..8 | U32  | rw     | 0x60400010, 0...        | `index << 16 \| sub << 8 \| bits`        |
+//! | 0x1800 | 0..2 |      |        | 2, 0x180+node, 0xFF     | TPDO1 communication, as 0x1400         |
+//! | 0x1A00 | 0..8 |      |        | 1, 0x60410010, 0...     | TPDO1 mapping, as 0x1600               |
+//! | 0x6040 | 0    | U16  | rw     | 0                       | controlword; an SDO write applies it   |
+//! | 0x6041 | 0    | U16  | ro     |                         | statusword                             |
+//! | 0x6060 | 0    | I8   | rw     | 0                       | modes of operation: only 8 (CSP)       |
+//! | 0x6061 | 0    | I8   | ro     | 0                       | modes of operation display = 0x6060    |
+//! | 0x6064 | 0    | I32  | ro     | `initial_position`      | position actual value, counts          |
+//! | 0x6065 | 0    | U32  | rw     | 0                       | following error window, 0 = off        |
+//! | 0x607A | 0    | I32  | rw     | position at (re)set     | target position, counts                |
+//! | 0x60C2 | 0..2 | U8, U8, I8 | ro, rw, rw | 2, 1, -3   | interpolation time period (1 ms)       |
+//!
+//! SDO aborts, checked in this order: unknown index 0x06020000; unknown sub-index 0x06090011;
+//! write to a read-only entry 0x06010002; data length not the type's (a download without size
+//! indication counts as 4 bytes) 0x06070010; then per entry: 0x6060 other than 8 0x06090030;
+//! a mapping entry or count written while the PDO is valid, or an entry while the count is
+//! not 0 (CiA-301's procedure: disable, count 0, entries, count), 0x06010000; an entry that
+//! is not one of the direction's mappable objects (RPDO 0x6040, 0x607A; TPDO 0x6041,
+//! 0x6064) with its exact bit length, or a count enabling such an entry, 0x06040041; a
+//! count above 8 0x06090030; more than 64 mapped bits 0x06040042; a valid COB-ID that is
+//! not 11 bits, is restricted by CiA-301 (or 0x080, the SYNC) or differs from the current
+//! valid one 0x06090030; a transmission type of 241..=253 0x06090030.
+//!
+//! # Faults ([`Faults`])
+//!
+//! * `fault_at_sync: Some(n)`: at SYNC `n` (counted by the bus from 1) the drive faults
+//!   once: [`DriveModel::inject_fault`](crate::DriveModel::inject_fault) (Fault reaction active in that SYNC's statusword,
+//!   Fault from the next), EMCY `0x080+node` with error code 0x8611 (following error) and
+//!   error register 0x81 (generic + manufacturer). The motor then stands still whatever the
+//!   target. A fault reset (controlword bit 7 edge) clears it with EMCY 0x0000. EMCY is
+//!   sent in pre-operational and operational only; a stopped node faults silently.
+//! * `heartbeat_stops_at: Some(n)`: no heartbeat once the bus has seen `n` SYNCs.
+//! * `never_boots`: the node stays initialising: no boot-up, no answers, no PDOs, no EMCY.
+//! * `drop_every: Some(n)`: every n-th frame the node would send is lost (counted in
+//!   [`NodeCounters::dropped`]); `Some(0)` drops nothing.
+#![forbid(unsafe_code)]
+
+mod dictionary;
+mod node;
+#[cfg(test)]
+mod tests;
+
+use std::io::{self, Write};
+
+use crate::cia402;
+use crate::frame::CanFrame;
+use crate::wire::heartbeat::NmtState;
+use crate::wire::nmt::{self, Target};
+use crate::wire::{cob, sync, NodeId};
+
+pub use dictionary::DEVICE_TYPE_SERVO;
+pub use node::FAULT_ERROR_REGISTER;
+
+use node::SimNode;
+
+/// One simulated drive.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimNodeConfig {
+    pub node: NodeId,
+    /// First-order lag of the motor model: actual position moves toward the target with this
+    /// time constant (s); 0 = actual equals the target of the previous SYNC.
+    pub lag_s: f64,
+    /// Position at power-on, counts.
+    pub initial_position: i32,
+    pub faults: Faults,
+}
+
+impl SimNodeConfig {
+    /// A healthy node without lag at position 0.
+    pub fn new(node: NodeId) -> Self {
+        Self {
+            node,
+            lag_s: 0.0,
+            initial_position: 0,
+            faults: Faults::default(),
+        }
+    }
+}
+
+/// Faults to inject, as a master sees them (see the module docs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Faults {
+    /// Drive fault (EMCY 0x8611 following error + statusword Fault) at this SYNC count.
+    pub fault_at_sync: Option<u64>,
+    /// Stop producing heartbeats after this SYNC count.
+    pub heartbeat_stops_at: Option<u64>,
+    /// The node stays silent: no boot-up, no SDO answers, no PDOs.
+    pub never_boots: bool,
+    /// Drop every n-th frame this node would send.
+    pub drop_every: Option<u32>,
+}
+
+/// One node at one SYNC in operational: the target that took effect and what the drive
+/// reported (whether or not its TPDO was sent).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Record {
+    pub sync: u64,
+    pub node: u8,
+    pub target_counts: i32,
+    pub actual_counts: i32,
+    pub statusword: u16,
+}
+
+/// What a node ignored or lost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NodeCounters {
+    /// RPDOs whose length did not match the current mapping.
+    pub rpdo_length_errors: u64,
+    /// Frames lost to [`Faults::drop_every`].
+    pub dropped: u64,
+}
+
+/// Every simulated node on one bus.
+#[derive(Debug)]
+pub struct SimBus {
+    nodes: Vec<SimNode>,
+    period_s: f64,
+    syncs: u64,
+    records: Vec<Record>,
+}
+
+impl SimBus {
+    /// The nodes at power-on. A node id configured twice is kept once (the first).
+    pub fn new(nodes: Vec<SimNodeConfig>, period_s: f64) -> SimBus {
+        let mut sims: Vec<SimNode> = Vec::with_capacity(nodes.len());
+        for config in nodes {
+            if sims.iter().all(|n| n.id() != config.node) {
+                sims.push(SimNode::new(config));
+            }
+        }
+        SimBus {
+            nodes: sims,
+            period_s,
+            syncs: 0,
+            records: Vec::new(),
+        }
+    }
+
+    /// A frame arrived from the bus (from the master).
+    pub fn on_frame(&mut self, frame: &CanFrame, now_s: f64, out: &mut dyn FnMut(CanFrame)) {
+        match frame.id() {
+            cob::NMT => {
+                let Ok((cmd, target)) = nmt::decode(frame) else {
+                    return;
+                };
+                for node in &mut self.nodes {
+                    if target == Target::All || target == Target::Node(node.id()) {
+                        node.on_nmt(cmd);
+                    }
+                }
+            }
+            cob::SYNC => {
+                if sync::decode(frame).is_err() {
+                    return;
+                }
+                self.syncs += 1;
+                for node in &mut self.nodes {
+                    node.on_sync(self.syncs, self.period_s, &mut self.records, out);
+                }
+            }
+            _ => {
+                for node in &mut self.nodes {
+                    node.on_frame(frame, now_s, out);
+                }
+            }
+        }
+    }
+
+    /// Time passed: heartbeats, delayed boot-up messages.
+    pub fn poll(&mut self, now_s: f64, out: &mut dyn FnMut(CanFrame)) {
+        for node in &mut self.nodes {
+            node.poll(now_s, self.syncs, out);
+        }
+    }
+
+    /// SYNCs seen so far.
+    pub fn syncs(&self) -> u64 {
+        self.syncs
+    }
+
+    pub fn records(&self) -> &[Record] {
+        &self.records
+    }
+
+    /// Hands the records over and starts a new list (for a long-running simulation that
+    /// writes them out as it goes).
+    pub fn take_records(&mut self) -> Vec<Record> {
+        std::mem::take(&mut self.records)
+    }
+
+    /// The records as CSV with the header `sync,node,target_counts,actual_counts,statusword`,
+    /// all columns decimal.
+    pub fn write_records(&self, w: &mut impl Write) -> io::Result<()> {
+        writeln!(w, "sync,node,target_counts,actual_counts,statusword")?;
+        for r in &self.records {
+            writeln!(
+                w,
+                "{},{},{},{},{}",
+                r.sync, r.node, r.target_counts, r.actual_counts, r.statusword
+            )?;
+        }
+        Ok(())
+    }
+
+    /// A node's NMT state ([`NmtState::BootUp`] while initialising), drive state and actual
+    /// position; `None` for a node that is not simulated.
+    pub fn node_state(&self, node: NodeId) -> Option<(NmtState, cia402::State, i32)> {
+        self.node(node).map(SimNode::state)
+    }
+
+    /// What a node ignored or lost.
+    pub fn counters(&self, node: NodeId) -> Option<NodeCounters> {
+        self.node(node).map(SimNode::counters)
+    }
+
+    fn node(&self, node: NodeId) -> Option<&SimNode> {
+        self.nodes.iter().find(|n| n.id() == node)
+    }
+}
