@@ -144,6 +144,9 @@ pub struct Faults {
     pub never_boots: bool,
     /// Drop every n-th frame this node would send.
     pub drop_every: Option<u32>,
+    /// From this SYNC count on, drop every frame this node would send (a broken cable or a
+    /// dead transceiver): the master must notice missing feedback and heartbeats.
+    pub silent_from_sync: Option<u64>,
 }
 
 /// One node at one SYNC in operational: the target that took effect and what the drive

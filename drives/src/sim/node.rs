@@ -43,6 +43,8 @@ pub struct SimNode {
     /// SYNCs since NMT start, for TPDO transmission types 2..=240.
     syncs_operational: u64,
     last_tpdo: Option<CanFrame>,
+    /// The last SYNC count seen, for `silent_from_sync`.
+    last_sync: u64,
     /// Frames this node tried to send, for `drop_every`.
     attempts: u64,
     counters: NodeCounters,
@@ -68,6 +70,7 @@ impl SimNode {
             syncs_operational: 0,
             last_tpdo: None,
             attempts: 0,
+            last_sync: 0,
             counters: NodeCounters::default(),
         };
         node.dict
@@ -96,10 +99,15 @@ impl SimNode {
         self.nmt != NmtState::BootUp
     }
 
-    /// Sends `frame` unless `drop_every` drops it.
+    /// Sends `frame` unless `drop_every` or `silent_from_sync` drops it.
     fn emit(&mut self, frame: CanFrame, out: &mut dyn FnMut(CanFrame)) {
         self.attempts += 1;
+        let silent = self
+            .faults
+            .silent_from_sync
+            .is_some_and(|s| self.last_sync >= s);
         match self.faults.drop_every {
+            _ if silent => self.counters.dropped += 1,
             Some(n) if n > 0 && self.attempts % u64::from(n) == 0 => self.counters.dropped += 1,
             _ => out(frame),
         }
@@ -301,6 +309,7 @@ impl SimNode {
         records: &mut Vec<Record>,
         out: &mut dyn FnMut(CanFrame),
     ) {
+        self.last_sync = count;
         if !self.booted() {
             return;
         }
