@@ -3,6 +3,7 @@
 //! exit codes.
 
 pub mod setup;
+pub mod simdrives;
 pub mod simulate;
 
 use std::path::Path;

@@ -1,6 +1,7 @@
 //! `dnurbs`: real-time 5-axis double-NURBS interpolation.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use dnurbs_tools::simdrives;
 use dnurbs_tools::simulate::{run, summarize, write_trace};
 use dnurbs_tools::{load_machine, load_program, setup::MachineSetup, InputError};
 use nc::interp::Method;
@@ -54,6 +55,41 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Play every drive of the machine's bus on a CAN interface: boot-up, NMT slave, SDO
+    /// server, PDO mapping, CiA-402 state machine, CSP motor model, heartbeats. For tests
+    /// and demonstrations without hardware; stop it with Ctrl-C.
+    SimDrives {
+        /// CAN interface, e.g. vcan0 (`ip link add dev vcan0 type vcan`).
+        #[arg(long)]
+        iface: String,
+        /// Machine file whose [[bus]] on this interface (or only bus) lists the drives.
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Write every target received: CSV sync,node,target_counts,actual_counts,statusword.
+        #[arg(long, value_name = "FILE.csv")]
+        record: Option<PathBuf>,
+        /// Motor lag: time constant of the actual position following the target, ms.
+        #[arg(long, default_value_t = 0.0)]
+        lag_ms: f64,
+        /// Exit after this many seconds (default: run until stopped).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Drive fault (EMCY 0x8611, statusword Fault) on NODE at SYNC count N.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        fault_at: Vec<(u8, u64)>,
+        /// NODE stops sending heartbeats after SYNC count N.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        heartbeat_stops: Vec<(u8, u64)>,
+        /// NODE never boots: silent from power-on.
+        #[arg(long, value_name = "NODE")]
+        never_boots: Vec<u8>,
+        /// NODE drops every N-th frame it sends.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u32>)]
+        drop_every: Vec<(u8, u32)>,
+        /// NODE sends nothing from SYNC count N on (a broken cable).
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        silent_from: Vec<(u8, u64)>,
+    },
     /// Print the worst-case CAN bus load of a machine file, per bus: SYNC plus one 6-byte
     /// RPDO and TPDO per drive each cycle, at 55 + 10 n bits per frame (stuffing and
     /// interframe space included). vcan has no bit timing, so this is computed, not measured.
@@ -86,6 +122,35 @@ fn main() -> ExitCode {
         } => simulate(program, machine, method, trace, json),
         Command::Compare { programs, machine } => compare(programs, machine),
         Command::Busload { machine } => busload(machine),
+        Command::SimDrives {
+            iface,
+            machine,
+            record,
+            lag_ms,
+            duration,
+            fault_at,
+            heartbeat_stops,
+            never_boots,
+            drop_every,
+            silent_from,
+        } => load_machine(&machine)
+            .map_err(anyhow::Error::from)
+            .and_then(|machine| {
+                simdrives::run(simdrives::SimArgs {
+                    iface,
+                    machine,
+                    record,
+                    lag_ms,
+                    duration_s: duration,
+                    faults: simdrives::FaultArgs {
+                        fault_at,
+                        heartbeat_stops,
+                        never_boots,
+                        drop_every,
+                        silent_from,
+                    },
+                })
+            }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,159 @@
+//! Real SocketCAN in a real kernel (run by tests/vcan/run inside the PREEMPT_RT guest):
+//! `dnurbs sim-drives` as its own process on vcan0, the master's full set-up against it,
+//! at least 1000 cycles of a ramp, disable; then the targets the simulated drives recorded
+//! are checked against what the master sent.
+
+mod common;
+use common::*;
+use drives::cia402::{Goal, State};
+use drives::link::SocketLink;
+use drives::master::{configure, Master, SetupOptions, Supervision};
+use drives::wire::NodeId;
+use std::time::{Duration, Instant};
+
+#[test]
+#[ignore = "needs a SocketCAN interface: run by tests/vcan/run in the PREEMPT_RT guest"]
+fn vcan_master_sets_up_and_drives_sim_drives_process() {
+    let iface = std::env::var("DNURBS_VCAN").unwrap_or_else(|_| "vcan0".into());
+    let out = std::path::PathBuf::from(
+        std::env::var("VCAN_OUT").unwrap_or_else(|_| std::env::temp_dir().display().to_string()),
+    );
+    let record = out.join("sim-record.csv");
+    let machine_file = data("vcan-machine.toml");
+    let machine = config::load(&machine_file).expect("vcan machine file");
+    let period = machine.period_s;
+    let mut sim = std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args([
+            "sim-drives",
+            "--iface",
+            &iface,
+            "--machine",
+            machine_file.to_str().unwrap(),
+            "--record",
+            record.to_str().unwrap(),
+        ])
+        .spawn()
+        .expect("start dnurbs sim-drives");
+    std::thread::sleep(Duration::from_millis(500));
+
+    let nodes: Vec<NodeId> = machine
+        .drives
+        .iter()
+        .filter_map(|d| NodeId::new(d.node))
+        .collect();
+    let mut link = SocketLink::open(&iface).expect("open vcan");
+    let mut opts = SetupOptions::new(period);
+    opts.boot_timeout = Duration::from_secs(5);
+    opts.sdo_timeout = Duration::from_millis(500);
+    let setup = configure(&mut link, &nodes, &opts, &mut |_| {});
+    let initial = match setup {
+        Ok(i) => i,
+        Err(e) => {
+            let _ = sim.kill();
+            panic!("set-up failed: {e}");
+        }
+    };
+    let t0 = Instant::now();
+    // Software emulation runs 10-50x slower and three processes share two virtual CPUs:
+    // supervise generously here (three seconds), the function is what this test checks.
+    let sup = Supervision {
+        heartbeat_timeout_s: 3.0,
+        feedback_timeout_cycles: (3.0 / period) as u32,
+    };
+    let mut m = Master::new(link, &nodes, &initial, sup, 0.0).unwrap();
+    let mut next = Instant::now();
+    let mut tick = |m: &mut Master<SocketLink>, targets: &[i32]| {
+        m.cycle(targets, t0.elapsed().as_secs_f64());
+        next += Duration::from_secs_f64(period);
+        if let Some(wait) = next.checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        }
+    };
+    m.set_goal(Goal::Enabled);
+    for _ in 0..500 {
+        tick(&mut m, &initial);
+        if m.all_in(State::OperationEnabled) {
+            break;
+        }
+    }
+    assert!(
+        m.all_in(State::OperationEnabled),
+        "not enabled: {:?}",
+        m.status()
+    );
+    let mut targets = initial.clone();
+    for k in 1..=1000 {
+        for (t, i) in targets.iter_mut().zip(&initial) {
+            *t = i + 5 * k;
+        }
+        tick(&mut m, &targets);
+    }
+    assert_eq!(m.fault(), None, "{:?}", m.fault());
+    m.set_goal(Goal::Disabled);
+    for _ in 0..200 {
+        tick(&mut m, &targets);
+        if m.all_in(State::SwitchOnDisabled) {
+            break;
+        }
+    }
+    assert!(
+        m.all_in(State::SwitchOnDisabled),
+        "not disabled: {:?}",
+        m.status()
+    );
+    std::thread::sleep(Duration::from_millis(400)); // let sim-drives flush its records
+    let _ = sim.kill();
+    let _ = sim.wait();
+
+    let text = std::fs::read_to_string(&record).expect("sim-drives wrote its record");
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("sync,node,target_counts,actual_counts,statusword")
+    );
+    let rows: Vec<[i64; 5]> = lines
+        .map(|l| {
+            let v: Vec<i64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2], v[3], v[4]]
+        })
+        .collect();
+    for (i, node) in nodes.iter().enumerate() {
+        let mine: Vec<&[i64; 5]> = rows
+            .iter()
+            .filter(|r| r[1] == i64::from(node.get()))
+            .collect();
+        assert!(
+            mine.len() >= 1000,
+            "node {}: {} records",
+            node.get(),
+            mine.len()
+        );
+        for w in mine.windows(2) {
+            let step = (w[1][2] - w[0][2]).abs();
+            assert!(
+                step <= 5,
+                "node {}: target jumped by {step} at sync {}",
+                node.get(),
+                w[1][0]
+            );
+        }
+        let last = mine.last().unwrap();
+        assert_eq!(
+            last[2],
+            i64::from(targets[i]),
+            "node {} last target",
+            node.get()
+        );
+        assert_eq!(
+            last[3],
+            i64::from(targets[i]),
+            "node {} ends on its last target",
+            node.get()
+        );
+    }
+    println!(
+        "vcan: {} records from sim-drives, {} cycles",
+        rows.len(),
+        m.cycles()
+    );
+}
