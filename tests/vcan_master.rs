@@ -157,3 +157,78 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
         m.cycles()
     );
 }
+
+/// The master's SDO client and NMT against an independent CANopen implementation:
+/// python-canopen's LocalNode (tests/vcan/canopen_node.py) on vcan0. The device reports the
+/// values the master wrote once it is started.
+#[test]
+#[ignore = "needs a SocketCAN interface and python-canopen: run by tests/vcan/run in the PREEMPT_RT guest"]
+fn vcan_master_configures_python_canopen_local_node() {
+    let iface = std::env::var("DNURBS_VCAN").unwrap_or_else(|_| "vcan0".into());
+    let python = std::env::var("DNURBS_PYTHON").unwrap_or_else(|_| "python3".into());
+    let out = std::path::PathBuf::from(
+        std::env::var("VCAN_OUT").unwrap_or_else(|_| std::env::temp_dir().display().to_string()),
+    );
+    let report = out.join("canopen-node.json");
+    let _ = std::fs::remove_file(&report);
+    let mut device = std::process::Command::new(&python)
+        .arg(root().join("tests/vcan/canopen_node.py"))
+        .args([
+            iface.as_str(),
+            "--node",
+            "7",
+            "--position",
+            "12345",
+            "--out",
+            report.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .expect("start the python-canopen device");
+    // Wait for "ready" (python start-up is slow under emulation).
+    let mut line = String::new();
+    let mut stdout = std::io::BufReader::new(device.stdout.take().unwrap());
+    std::io::BufRead::read_line(&mut stdout, &mut line).expect("device output");
+    assert_eq!(line.trim(), "ready");
+
+    let mut link = SocketLink::open(&iface).expect("open vcan");
+    let mut opts = SetupOptions::new(0.010);
+    opts.boot_timeout = Duration::from_secs(10);
+    opts.sdo_timeout = Duration::from_secs(2);
+    let node = NodeId::new(7).unwrap();
+    let result = configure(&mut link, &[node], &opts, &mut |_| {});
+    let status = device.wait().expect("device exits after NMT start");
+    let initial =
+        result.unwrap_or_else(|e| panic!("set-up of the python-canopen node failed: {e}"));
+    assert_eq!(initial, vec![12345], "actual position read over SDO");
+    assert!(status.success(), "the device was not started (NMT start)");
+
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(report["started"], true);
+    let v = |key: &str| {
+        report["values"][key]
+            .as_i64()
+            .unwrap_or_else(|| panic!("{key} not written: {report}"))
+    };
+    assert_eq!(v("6060:00"), 8, "CSP");
+    assert_eq!(v("6061:00"), 8);
+    assert_eq!((v("60C2:01"), v("60C2:02")), (1, -2), "10 ms = 1 * 10^-2 s");
+    assert_eq!(v("1400:01"), 0x207, "RPDO1 re-enabled on 0x200 + node");
+    assert_eq!(v("1400:02"), 1, "RPDO1 every SYNC");
+    assert_eq!(
+        (v("1600:00"), v("1600:01"), v("1600:02")),
+        (2, 0x6040_0010, 0x607A_0020)
+    );
+    assert_eq!(v("1800:01"), 0x187);
+    assert_eq!(v("1800:02"), 1);
+    assert_eq!(
+        (v("1A00:00"), v("1A00:01"), v("1A00:02")),
+        (2, 0x6041_0010, 0x6064_0020)
+    );
+    assert_eq!(v("1017:00"), 100, "heartbeat producer, ms");
+    println!(
+        "vcan: python-canopen LocalNode configured: {}",
+        report["values"]
+    );
+}
