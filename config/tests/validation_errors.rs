@@ -391,3 +391,23 @@ fn drive_rules() {
         assert_mentions(&shown, &[ORIGIN, key, words]);
     }
 }
+
+#[test]
+fn two_buses_split_the_load() {
+    // Five drives at 1 ms overload one 1 Mbit/s bus (120.5 %). Split 3 + 2 over two buses
+    // they fit under a max_load of 80 %: 55 + 6 * 115 = 745 bits (74.5 %) and
+    // 55 + 4 * 115 = 515 bits (51.5 %).
+    let mut text = with_drives("1.0", "1000000");
+    text.push_str("\n[[bus]]\nname = \"can1\"\ninterface = \"can1\"\nmax_load = 0.8\n");
+    let text = text
+        .replacen("bus = \"can0\"\nnode = 4", "bus = \"can1\"\nnode = 4", 1)
+        .replacen("bus = \"can0\"\nnode = 5", "bus = \"can1\"\nnode = 5", 1)
+        .replace("bitrate = 1000000\n", "bitrate = 1000000\nmax_load = 0.8\n");
+    let m = common::parse(&text).unwrap();
+    assert_eq!(m.buses.len(), 2);
+    let on = |b: usize| m.drives.iter().filter(|d| d.bus == b).count() as u32;
+    assert_eq!((on(0), on(1)), (3, 2));
+    assert_eq!(config::bus::cycle_bits(3), 745);
+    assert!((config::bus::load(3, 1_000_000, m.period_s) - 0.745).abs() < 1e-12);
+    assert!((config::bus::load(2, 1_000_000, m.period_s) - 0.515).abs() < 1e-12);
+}
