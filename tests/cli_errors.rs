@@ -274,3 +274,49 @@ fn busload_prints_the_design_md_numbers_and_refuses_an_overloaded_bus() {
         "{err}"
     );
 }
+
+#[test]
+fn latency_writes_the_report_and_rejects_bad_durations() {
+    let dir = temp("latency-report");
+    let out = dnurbs(&[
+        "latency",
+        "--period",
+        "1ms",
+        "--duration",
+        "300ms",
+        "--no-rt",
+        "--report",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("wakeup latency") && text.contains("p99.99"),
+        "{text}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in ["cycles", "overruns", "underruns"] {
+        assert!(json[key].is_u64(), "{key} missing: {json}");
+    }
+    assert!(json["cycles"].as_u64().unwrap() > 200, "{json}");
+    for h in ["wakeup_latency_ns", "compute_ns", "cycle_ns"] {
+        for k in ["min", "p50", "p90", "p99", "p99_9", "p99_99", "max"] {
+            assert!(json["histograms"][h][k].is_u64(), "{h}.{k} missing: {json}");
+        }
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("summary.txt")).unwrap(),
+        text.to_string()
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    for bad in [["--period", "1parsec"], ["--duration", "0s"]] {
+        let out = dnurbs(&["latency", bad[0], bad[1], "--no-rt"]);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(bad[1]));
+    }
+}

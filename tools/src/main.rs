@@ -90,6 +90,29 @@ enum Command {
         #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
         silent_from: Vec<(u8, u64)>,
     },
+    /// Measure this computer's real-time wake-up latency: the real-time loop with nothing
+    /// to do (like cyclictest), same set-up and report as `dnurbs run`. Run it on a
+    /// controller PC before deploying.
+    Latency {
+        /// Period, e.g. 1ms, 500us, 2ms.
+        #[arg(long, default_value = "1ms", value_parser = parse_duration_ns)]
+        period: u64,
+        /// How long to measure, e.g. 10s, 5min.
+        #[arg(long, default_value = "10s", value_parser = parse_duration_ns)]
+        duration: u64,
+        /// SCHED_FIFO priority of the loop thread (1..=99).
+        #[arg(long, default_value_t = 80, value_parser = clap::value_parser!(i32).range(1..=99))]
+        priority: i32,
+        /// Pin the loop thread to this CPU (pair with isolcpus= on the kernel command line).
+        #[arg(long)]
+        cpu: Option<usize>,
+        /// Run the same loop without mlockall and SCHED_FIFO (development machines).
+        #[arg(long)]
+        no_rt: bool,
+        /// Write summary.txt and summary.json into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+    },
     /// Print the worst-case CAN bus load of a machine file, per bus: SYNC plus one 6-byte
     /// RPDO and TPDO per drive each cycle, at 55 + 10 n bits per frame (stuffing and
     /// interframe space included). vcan has no bit timing, so this is computed, not measured.
@@ -122,6 +145,22 @@ fn main() -> ExitCode {
         } => simulate(program, machine, method, trace, json),
         Command::Compare { programs, machine } => compare(programs, machine),
         Command::Busload { machine } => busload(machine),
+        Command::Latency {
+            period,
+            duration,
+            priority,
+            cpu,
+            no_rt,
+            report,
+        } => latency(
+            period,
+            duration,
+            rt_loop::latency::RtSettings {
+                priority: (!no_rt).then_some(priority),
+                cpu,
+            },
+            report,
+        ),
         Command::SimDrives {
             iface,
             machine,
@@ -259,6 +298,69 @@ fn busload(machine: PathBuf) -> anyhow::Result<()> {
             config::bus::load(n, b.bitrate, m.period_s) * 100.0,
             b.max_load * 100.0
         );
+    }
+    Ok(())
+}
+
+/// Parse `500us`, `1ms`, `1.5ms`, `2s`, `5min` into nanoseconds.
+fn parse_duration_ns(s: &str) -> Result<u64, String> {
+    let split = s
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(s.len());
+    let (num, unit) = s.split_at(split);
+    let value: f64 = num
+        .parse()
+        .map_err(|_| format!("{s:?}: expected a number with a unit, like 1ms"))?;
+    let scale = match unit {
+        "ns" => 1.0,
+        "us" | "µs" => 1e3,
+        "ms" => 1e6,
+        "s" => 1e9,
+        "min" => 60e9,
+        _ => return Err(format!("{s:?}: unit must be ns, us, ms, s or min")),
+    };
+    let ns = value * scale;
+    if !(1.0..1e15).contains(&ns) {
+        return Err(format!("{s:?}: out of range"));
+    }
+    Ok(ns.round() as u64)
+}
+
+fn latency(
+    period: u64,
+    duration: u64,
+    rt: rt_loop::latency::RtSettings,
+    report: Option<PathBuf>,
+) -> anyhow::Result<()> {
+    if period > duration {
+        return Err(InputError(format!(
+            "--period {period} ns is longer than --duration {duration} ns"
+        ))
+        .into());
+    }
+    eprintln!(
+        "dnurbs latency: {} periods of {} us{}",
+        duration / period,
+        period as f64 / 1000.0,
+        if rt.priority.is_some() {
+            ", SCHED_FIFO"
+        } else {
+            ", without real-time privileges (--no-rt)"
+        }
+    );
+    let stats = rt_loop::latency::run(period, duration, rt)?;
+    let summary = stats.summary();
+    print!("{}", summary.text());
+    if let Some(dir) = report {
+        std::fs::create_dir_all(&dir)
+            .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+        let write = |name: &str, body: String| {
+            let path = dir.join(name);
+            std::fs::write(&path, body)
+                .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+        };
+        write("summary.txt", summary.text())?;
+        write("summary.json", serde_json::to_string_pretty(&summary)?)?;
     }
     Ok(())
 }

@@ -1,0 +1,180 @@
+//! Every Linux real-time call dnurbs makes, in one place.
+//!
+//! * [`lock_memory`]: `mlockall(MCL_CURRENT | MCL_FUTURE)`, so no page of the process is
+//!   ever paged out or faulted in lazily during the loop.
+//! * [`prefault_stack`]: touch the stack the loop will use, so its pages exist before the
+//!   first period.
+//! * [`set_fifo`]: `SCHED_FIFO` at a priority (needs CAP_SYS_NICE or an rtprio limit).
+//! * [`pin_to_cpu`]: CPU affinity (pair it with `isolcpus=` on the kernel command line).
+//! * [`set_timer_slack`]: 1 ns, instead of the 50 us normal threads get.
+//! * [`now`], [`sleep_until`]: `CLOCK_MONOTONIC` and `clock_nanosleep(TIMER_ABSTIME)`, so
+//!   periods do not drift with the time spent computing.
+//!
+//! A missing privilege is an [`RtError`] that says which one and how to grant it.
+
+use nix::sys::mman::{mlockall, MlockAllFlags};
+use nix::sys::resource::{getrlimit, Resource};
+use nix::sys::time::TimeSpec;
+use nix::time::{clock_gettime, clock_nanosleep, ClockId, ClockNanosleepFlags};
+
+/// A real-time set-up step that failed, with the way to fix it.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum RtError {
+    #[error(
+        "cannot lock memory (mlockall: {errno}); RLIMIT_MEMLOCK is {limit}: raise it with \
+         `ulimit -l unlimited`, `LimitMEMLOCK=infinity` in the systemd unit, or a `memlock` \
+         line in /etc/security/limits.conf; or run with --no-rt for development"
+    )]
+    MemoryLock {
+        errno: nix::errno::Errno,
+        limit: String,
+    },
+    #[error(
+        "cannot switch to SCHED_FIFO priority {priority} ({errno}): grant CAP_SYS_NICE \
+         (`setcap cap_sys_nice,cap_ipc_lock+ep $(which dnurbs)`), an `rtprio` limit in \
+         /etc/security/limits.conf, or `LimitRTPRIO=99` in the systemd unit; or run with --no-rt"
+    )]
+    Scheduler {
+        priority: i32,
+        errno: nix::errno::Errno,
+    },
+    #[error("cannot pin the real-time thread to CPU {cpu} ({errno})")]
+    Affinity {
+        cpu: usize,
+        errno: nix::errno::Errno,
+    },
+    #[error("the real-time thread {0}")]
+    Thread(&'static str),
+}
+
+fn memlock_limit() -> String {
+    match getrlimit(Resource::RLIMIT_MEMLOCK) {
+        Ok((soft, _)) if soft == nix::libc::RLIM_INFINITY => "unlimited".into(),
+        Ok((soft, _)) => format!("{} KiB", soft / 1024),
+        Err(e) => format!("unknown ({e})"),
+    }
+}
+
+/// Lock all current and future pages of the process into RAM.
+pub fn lock_memory() -> Result<(), RtError> {
+    mlockall(MlockAllFlags::MCL_CURRENT | MlockAllFlags::MCL_FUTURE).map_err(|errno| {
+        RtError::MemoryLock {
+            errno,
+            limit: memlock_limit(),
+        }
+    })
+}
+
+/// Touch `bytes` of stack below the caller so those pages are resident before the loop.
+#[inline(never)]
+pub fn prefault_stack(bytes: usize) {
+    const CHUNK: usize = 16 * 1024;
+    let buf = [0u8; CHUNK];
+    std::hint::black_box(&buf);
+    if bytes > CHUNK {
+        prefault_stack(bytes - CHUNK);
+    }
+}
+
+/// Switch the calling thread to SCHED_FIFO at `priority` (1..=99).
+pub fn set_fifo(priority: i32) -> Result<(), RtError> {
+    let param = nix::libc::sched_param {
+        sched_priority: priority,
+    };
+    // SAFETY: sched_setscheduler reads `param` during the call only; pid 0 is this thread.
+    let rc = unsafe { nix::libc::sched_setscheduler(0, nix::libc::SCHED_FIFO, &param) };
+    if rc == 0 {
+        Ok(())
+    } else {
+        Err(RtError::Scheduler {
+            priority,
+            errno: nix::errno::Errno::last(),
+        })
+    }
+}
+
+/// Timer slack of the calling thread, ns. Normal threads get 50 us by default, which makes
+/// every wake-up up to 50 us late; SCHED_FIFO threads have none. The loop sets 1 ns in every
+/// mode so that `--no-rt` measures the machine, not the default slack.
+pub fn set_timer_slack(ns: u64) {
+    // Fails only for a value the kernel rejects; the loop then just keeps the default.
+    let _ = nix::sys::prctl::set_timerslack(ns as _);
+}
+
+/// Pin the calling thread to one CPU.
+pub fn pin_to_cpu(cpu: usize) -> Result<(), RtError> {
+    let mut set = nix::sched::CpuSet::new();
+    set.set(cpu)
+        .map_err(|errno| RtError::Affinity { cpu, errno })?;
+    nix::sched::sched_setaffinity(nix::unistd::Pid::from_raw(0), &set)
+        .map_err(|errno| RtError::Affinity { cpu, errno })
+}
+
+/// Monotonic time in nanoseconds.
+pub fn now() -> u64 {
+    // CLOCK_MONOTONIC cannot fail on Linux; 0 would only make one sample look late.
+    clock_gettime(ClockId::CLOCK_MONOTONIC).map_or(0, |t| to_ns(&t))
+}
+
+fn to_ns(t: &TimeSpec) -> u64 {
+    (t.tv_sec() as u64)
+        .saturating_mul(1_000_000_000)
+        .saturating_add(t.tv_nsec() as u64)
+}
+
+/// Sleep until the monotonic time `deadline_ns` (absolute; returns at once if past).
+pub fn sleep_until(deadline_ns: u64) {
+    let ts = TimeSpec::new(
+        (deadline_ns / 1_000_000_000) as _,
+        (deadline_ns % 1_000_000_000) as _,
+    );
+    // EINTR (a signal) just ends this sleep early; the loop measures the wake-up anyway.
+    let _ = clock_nanosleep(
+        ClockId::CLOCK_MONOTONIC,
+        ClockNanosleepFlags::TIMER_ABSTIME,
+        &ts,
+    );
+}
+
+/// Minor page faults of the process so far (getrusage), for the no-fault tests.
+pub fn minor_faults() -> i64 {
+    nix::sys::resource::getrusage(nix::sys::resource::UsageWho::RUSAGE_SELF)
+        .map_or(-1, |u| u.minor_page_faults())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sleep_until_is_absolute_and_monotonic() {
+        let t0 = now();
+        sleep_until(t0 + 2_000_000);
+        let t1 = now();
+        assert!(
+            t1 >= t0 + 2_000_000,
+            "woke {} ns early",
+            t0 + 2_000_000 - t1
+        );
+        sleep_until(t0); // in the past: returns at once
+        assert!(now() >= t1);
+    }
+
+    #[test]
+    fn privilege_errors_say_how_to_grant_them() {
+        let e = RtError::Scheduler {
+            priority: 80,
+            errno: nix::errno::Errno::EPERM,
+        };
+        let text = e.to_string();
+        assert!(
+            text.contains("CAP_SYS_NICE") && text.contains("rtprio") && text.contains("--no-rt"),
+            "{text}"
+        );
+        let e = RtError::MemoryLock {
+            errno: nix::errno::Errno::ENOMEM,
+            limit: "8192 KiB".into(),
+        };
+        assert!(e.to_string().contains("ulimit -l unlimited"));
+    }
+}
