@@ -5,6 +5,8 @@
 //! The interpolating loop that drives the CAN bus (issue 4's `dnurbs run` and `dnurbs demo`)
 //! builds on the same pieces.
 
+pub mod interval;
 pub mod latency;
 pub mod os;
+pub mod report;
 pub mod stats;

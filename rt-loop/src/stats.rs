@@ -61,6 +61,17 @@ impl Stats {
         self.minor_faults = -1;
     }
 
+    /// Add another run's or interval's statistics (outside the real-time thread).
+    pub fn add(&mut self, other: &Stats) {
+        // Same bounds on both sides: the additions cannot fail.
+        let _ = self.wakeup.add(&other.wakeup);
+        let _ = self.compute.add(&other.compute);
+        let _ = self.cycle.add(&other.cycle);
+        self.cycles += other.cycles;
+        self.overruns += other.overruns;
+        self.underruns += other.underruns;
+    }
+
     /// Record one period. Allocation-free.
     #[inline]
     pub fn record(&mut self, wakeup_ns: u64, compute_ns: u64, cycle_ns: u64) {

@@ -109,7 +109,8 @@ enum Command {
         /// Run the same loop without mlockall and SCHED_FIFO (development machines).
         #[arg(long)]
         no_rt: bool,
-        /// Write summary.txt and summary.json into this directory.
+        /// Write summary.txt, summary.json, latency.hlog (HdrHistogram interval log) and
+        /// latency.svg (percentile plot) into this directory.
         #[arg(long, value_name = "DIR")]
         report: Option<PathBuf>,
     },
@@ -348,12 +349,15 @@ fn latency(
             ", without real-time privileges (--no-rt)"
         }
     );
-    let stats = rt_loop::latency::run(period, duration, rt)?;
+    if let Some(dir) = &report {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+    }
+    let hlog = report.as_ref().map(|d| d.join("latency.hlog"));
+    let stats = rt_loop::latency::run(period, duration, rt, hlog.as_deref())?;
     let summary = stats.summary();
     print!("{}", summary.text());
     if let Some(dir) = report {
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
         let write = |name: &str, body: String| {
             let path = dir.join(name);
             std::fs::write(&path, body)
@@ -361,6 +365,15 @@ fn latency(
         };
         write("summary.txt", summary.text())?;
         write("summary.json", serde_json::to_string_pretty(&summary)?)?;
+        let title = format!(
+            "dnurbs latency: {} periods of {} us",
+            summary.cycles,
+            period as f64 / 1000.0
+        );
+        let svg = dir.join("latency.svg");
+        rt_loop::report::write_svg(&svg, &stats, &title)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", svg.display()))?;
+        eprintln!("report: {}", dir.display());
     }
     Ok(())
 }
