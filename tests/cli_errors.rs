@@ -320,3 +320,21 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
         assert!(String::from_utf8_lossy(&out.stderr).contains(bad[1]));
     }
 }
+
+#[test]
+fn angle_words_for_another_machine_are_refused() {
+    // B/C angles on the paper's A/C machine: refused at the first B word, never read as A.
+    check(
+        "b-words-on-an-a-machine",
+        "G01 X0 Y0 Z0 F100\nG01 X10 B20 C30\n",
+        "2:9",
+        "B angle words on a machine whose tilting axis is A",
+    );
+    // Lower-case words are the same words.
+    check(
+        "lower-case-b",
+        "g01 x0 y0 z0 f100\ng01 x10 b20 c30\n",
+        "2:9",
+        "tilting axis is A",
+    );
+}

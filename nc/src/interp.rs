@@ -301,6 +301,7 @@ mod tests {
                 Block::Nurbs(b),
             ],
             end: None,
+            tilt_word: None,
         }
     }
 

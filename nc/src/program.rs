@@ -117,4 +117,7 @@ pub struct Program {
     pub blocks: Vec<Block>,
     /// Where `M02`/`M30` stood, if the program had one.
     pub end: Option<SrcPos>,
+    /// The tilting-axis letter the program's angle words use (`'A'` or `'B'`) and where it
+    /// first stood; `None` if the program gives no angles. The machine must match it.
+    pub tilt_word: Option<(char, SrcPos)>,
 }

@@ -172,8 +172,8 @@ pub enum BuildErrorKind {
     NoStart,
     #[error("the first block must be a G00/G01 start pose, not a NURBS block")]
     NurbsFirst,
-    #[error("{0} angle words on a machine whose tilting axis is {1}")]
-    WrongTilt(&'static str, &'static str),
+    #[error("{word} angle words on a machine whose tilting axis is {machine}: the program is for another machine")]
+    WrongTilt { word: char, machine: char },
     #[error("the orientation curve comes within {dist:.3e} mm of the cutter curve at u = {u:.6} (minimum {MIN_TOOL_VECTOR_MM} mm): the tool axis is undefined there")]
     ToolVectorTooShort { u: f64, dist: f64 },
     #[error("the tool axis at the start of the block differs from the current tool axis by {deg:.4} deg (at most {MAX_ORIENTATION_STEP_DEG} deg): the rotary axes would jump")]
@@ -217,6 +217,15 @@ pub fn build(
     limits: &BuildLimits,
 ) -> Result<Path, BuildError> {
     let err = |pos, kind| BuildError { pos, kind };
+    let machine = match kin.tilt_kind() {
+        Tilt::A => 'A',
+        Tilt::B => 'B',
+    };
+    if let Some((word, pos)) = program.tilt_word {
+        if word != machine {
+            return Err(err(pos, BuildErrorKind::WrongTilt { word, machine }));
+        }
+    }
     let first = match program.blocks.first() {
         None => return Err(err(SrcPos::default(), BuildErrorKind::NoStart)),
         Some(Block::Nurbs(b)) => return Err(err(b.pos, BuildErrorKind::NurbsFirst)),
@@ -464,12 +473,4 @@ fn nurbs(
         },
         tooling,
     })
-}
-
-/// The tilt letter of a machine, for messages.
-pub fn tilt_letter(t: Tilt) -> &'static str {
-    match t {
-        Tilt::A => "A",
-        Tilt::B => "B",
-    }
 }

@@ -114,6 +114,7 @@ impl Parser {
             None => Ok(Program {
                 blocks: self.blocks,
                 end: self.end,
+                tilt_word: self.rotary,
             }),
         }
     }
