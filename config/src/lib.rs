@@ -29,6 +29,7 @@
 //! | `[interpolation] chord_tolerance_mm` | mm |
 //! | `[interpolation] path_acceleration`, `path_jerk` | mm/s^2, mm/s^3 |
 //! | `[interpolation] max_feed_mm_min`, `rapid_feed_mm_min` | mm/min |
+//! | `[realtime] *_ms` | ms (stored in s) |
 //!
 //! # File layout
 //!
@@ -58,6 +59,15 @@
 //! jerk = 50000.0
 //! # [axes.a] (paper, xyzac-trt) or [axes.b] (xyzbc-trt): same keys, required.
 //! # [axes.c]: same keys; min and max may both be omitted for a continuous table.
+//!
+//! [realtime]                # optional, as is every key in it
+//! priority = 80             # SCHED_FIFO priority of the real-time thread, 1..=99
+//! # cpu = 1                 # pin the real-time thread to this CPU (default: not pinned)
+//! queue_depth = 64          # planned segments queued ahead of the interpolator, 1..=1024
+//! heartbeat_timeout_ms = 300    # a drive without heartbeat this long is lost
+//! feedback_timeout_ms = 20      # ... without TPDO feedback (default max(20, 5 periods))
+//! boot_timeout_ms = 3000        # wait for the boot-ups after the NMT reset
+//! sdo_timeout_ms = 200          # wait for one SDO answer during set-up
 //! ```
 //!
 //! Example files: `config/machines/*.toml`.
@@ -73,7 +83,8 @@ use std::path::Path;
 
 pub use error::{ConfigError, LineCol, Location};
 pub use machine::{
-    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, RotaryName, UnknownMethod,
+    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
+    UnknownMethod,
 };
 
 /// Reads and validates the machine configuration file at `path`.

@@ -22,6 +22,7 @@ pub struct Machine {
     pub buses: Vec<crate::bus::Bus>,
     /// One drive per axis in joint order (X Y Z tilt C) when `buses` is not empty, else none.
     pub drives: Vec<crate::bus::Drive>,
+    pub realtime: Realtime,
 }
 
 impl Machine {
@@ -201,6 +202,45 @@ impl FromStr for Method {
             .into_iter()
             .find(|m| m.name() == s)
             .ok_or_else(|| UnknownMethod(s.to_owned()))
+    }
+}
+
+/// `[realtime]`: the real-time thread and drive supervision.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Realtime {
+    /// SCHED_FIFO priority, 1..=99.
+    pub priority: i32,
+    /// CPU the real-time thread is pinned to, if any.
+    pub cpu: Option<usize>,
+    /// Segments the planner may keep queued ahead of the interpolator, 1..=1024.
+    pub queue_depth: usize,
+    /// A drive whose heartbeat is older than this is lost, s.
+    pub heartbeat_timeout_s: f64,
+    /// A drive without position feedback for this long is lost, s.
+    pub feedback_timeout_s: f64,
+    /// Wait for the drives' boot-up messages, s.
+    pub boot_timeout_s: f64,
+    /// Wait for one SDO answer during set-up, s.
+    pub sdo_timeout_s: f64,
+}
+
+impl Realtime {
+    /// Deepest allowed `queue_depth` (the preallocated queue's capacity).
+    pub const MAX_QUEUE_DEPTH: usize = 1024;
+}
+
+impl Default for Realtime {
+    /// The values used when `[realtime]` or one of its keys is omitted.
+    fn default() -> Self {
+        Realtime {
+            priority: 80,
+            cpu: None,
+            queue_depth: 64,
+            heartbeat_timeout_s: 0.3,
+            feedback_timeout_s: 0.02,
+            boot_timeout_s: 3.0,
+            sdo_timeout_s: 0.2,
+        }
     }
 }
 

@@ -23,6 +23,27 @@ pub(crate) struct RawFile {
     /// `[[bus]]`: CAN buses; absent for a machine that is only simulated.
     #[serde(default)]
     pub bus: Vec<RawBus>,
+    pub realtime: Option<RawRealtime>,
+}
+
+/// `[realtime]`: the real-time thread and drive supervision; every key optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawRealtime {
+    /// SCHED_FIFO priority 1..=99.
+    pub priority: Option<i64>,
+    /// CPU to pin the real-time thread to.
+    pub cpu: Option<i64>,
+    /// Segments the planner may have queued ahead of the interpolator.
+    pub queue_depth: Option<i64>,
+    /// ms without a heartbeat before a drive counts as lost.
+    pub heartbeat_timeout_ms: Option<f64>,
+    /// ms without position feedback (TPDO) before a drive counts as lost.
+    pub feedback_timeout_ms: Option<f64>,
+    /// ms to wait for every drive's boot-up after the NMT reset.
+    pub boot_timeout_ms: Option<f64>,
+    /// ms to wait for one SDO answer during set-up.
+    pub sdo_timeout_ms: Option<f64>,
 }
 
 /// `[[bus]]`: one CAN bus.

@@ -6,8 +6,12 @@
 
 use crate::bus::{self, Bus, Drive};
 use crate::error::ConfigError;
-use crate::machine::{Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, RotaryName};
-use crate::raw::{RawAxes, RawAxis, RawBus, RawFile, RawInterpolation, RawKinematics, RawMachine};
+use crate::machine::{
+    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
+};
+use crate::raw::{
+    RawAxes, RawAxis, RawBus, RawFile, RawInterpolation, RawKinematics, RawMachine, RawRealtime,
+};
 use crate::source::Source;
 
 /// Converts the raw file into a validated [`Machine`].
@@ -19,6 +23,7 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     let interpolation = check.interpolation(&raw.interpolation.unwrap_or_default())?;
     let buses = check.buses(&raw.bus)?;
     let drives = check.drives(&raw.axes, &axes, &buses, period_s)?;
+    let realtime = check.realtime(&raw.realtime.unwrap_or_default(), period_s)?;
     Ok(Machine {
         name,
         period_s,
@@ -27,6 +32,7 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
         interpolation,
         buses,
         drives,
+        realtime,
     })
 }
 
@@ -267,6 +273,75 @@ impl Check<'_, '_> {
 }
 
 impl Check<'_, '_> {
+    fn realtime(&self, r: &RawRealtime, period_s: f64) -> Result<Realtime, ConfigError> {
+        let d = Realtime::default();
+        let path = |field: &'static str| ["realtime", field];
+        let int = |field, v: Option<i64>, default: i64, lo: i64, hi: i64, what: &str| {
+            let x = v.unwrap_or(default);
+            if (lo..=hi).contains(&x) {
+                Ok(x)
+            } else {
+                let rule = format!("must be an integer in {lo}..={hi} ({what})");
+                Err(self.invalid(&path(field), Some(x.to_string()), rule))
+            }
+        };
+        let priority = int(
+            "priority",
+            r.priority,
+            i64::from(d.priority),
+            1,
+            99,
+            "SCHED_FIFO priority",
+        )?;
+        let cpu = match r.cpu {
+            None => None,
+            Some(c) => Some(int("cpu", Some(c), 0, 0, 4095, "CPU number")? as usize),
+        };
+        let depth = int(
+            "queue_depth",
+            r.queue_depth,
+            d.queue_depth as i64,
+            1,
+            Realtime::MAX_QUEUE_DEPTH as i64,
+            "segments",
+        )?;
+        // Timeouts are given in ms; supervision shorter than two periods would fault on the
+        // first late frame.
+        let ms = |field, v: Option<f64>, default_s: f64, min_s: f64| {
+            let x = v.unwrap_or(default_s * 1000.0);
+            if x.is_finite() && x / 1000.0 >= min_s && x <= 600_000.0 {
+                Ok(x / 1000.0)
+            } else {
+                let rule = format!("must be in {}..=600000 (ms)", min_s * 1000.0);
+                Err(self.invalid(&path(field), Some(x.to_string()), rule))
+            }
+        };
+        Ok(Realtime {
+            priority: priority as i32,
+            cpu,
+            queue_depth: depth as usize,
+            heartbeat_timeout_s: ms(
+                "heartbeat_timeout_ms",
+                r.heartbeat_timeout_ms,
+                d.heartbeat_timeout_s,
+                2.0 * period_s,
+            )?,
+            feedback_timeout_s: ms(
+                "feedback_timeout_ms",
+                r.feedback_timeout_ms,
+                d.feedback_timeout_s.max(5.0 * period_s),
+                2.0 * period_s,
+            )?,
+            boot_timeout_s: ms(
+                "boot_timeout_ms",
+                r.boot_timeout_ms,
+                d.boot_timeout_s,
+                0.001,
+            )?,
+            sdo_timeout_s: ms("sdo_timeout_ms", r.sdo_timeout_ms, d.sdo_timeout_s, 0.001)?,
+        })
+    }
+
     fn buses(&self, raw: &[RawBus]) -> Result<Vec<Bus>, ConfigError> {
         let mut out: Vec<Bus> = Vec::with_capacity(raw.len());
         for (i, b) in raw.iter().enumerate() {

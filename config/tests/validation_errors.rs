@@ -411,3 +411,40 @@ fn two_buses_split_the_load() {
     assert!((config::bus::load(3, 1_000_000, m.period_s) - 0.745).abs() < 1e-12);
     assert!((config::bus::load(2, 1_000_000, m.period_s) - 0.515).abs() < 1e-12);
 }
+
+#[test]
+fn realtime_settings_have_ranges_and_defaults() {
+    let with = |key: &str, value: &str| {
+        let text = format!("{MINIMAL}\n[realtime]\n{key} = {value}\n");
+        let (err, shown) = fail(&text);
+        assert!(matches!(err, ConfigError::Invalid { .. }), "{err:?}");
+        let pos = pos_of(&text, &format!("{key} = {value}"));
+        assert!(
+            shown.starts_with(&format!(
+                "{ORIGIN}:{}:{}: realtime.{key} = {value}: ",
+                pos.line,
+                pos.column + key.len() + 3
+            )),
+            "{shown}"
+        );
+        shown
+    };
+    assert!(with("priority", "0").ends_with("must be an integer in 1..=99 (SCHED_FIFO priority)"));
+    assert!(with("priority", "100").contains("1..=99"));
+    assert!(with("queue_depth", "0").contains("1..=1024 (segments)"));
+    assert!(with("queue_depth", "5000").contains("1..=1024"));
+    assert!(with("cpu", "-1").contains("CPU number"));
+    // Supervision shorter than two periods (2 ms here) would fault on the first late frame.
+    assert!(with("heartbeat_timeout_ms", "3").contains("must be in 4..=600000 (ms)"));
+    assert!(with("feedback_timeout_ms", "nan").contains("(ms)"));
+    let m = config::from_str(MINIMAL, std::path::Path::new(ORIGIN)).unwrap();
+    assert_eq!(m.realtime, config::Realtime::default());
+    let text = format!("{MINIMAL}\n[realtime]\npriority = 42\ncpu = 1\nqueue_depth = 8\n");
+    let m = config::from_str(&text, std::path::Path::new(ORIGIN)).unwrap();
+    assert_eq!(
+        (m.realtime.priority, m.realtime.cpu, m.realtime.queue_depth),
+        (42, Some(1), 8)
+    );
+    let unknown = format!("{MINIMAL}\n[realtime]\nprio = 42\n");
+    assert!(fail(&unknown).1.contains("prio"));
+}

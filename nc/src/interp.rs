@@ -252,7 +252,7 @@ impl<'a> Interpolator<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::arclen::ArcTable;
     use crate::kinematics::Kinematics;

@@ -25,3 +25,4 @@ pub mod plan;
 pub mod program;
 pub mod scurve;
 pub mod segment;
+pub mod stream;

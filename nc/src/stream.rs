@@ -1,0 +1,672 @@
+//! Streaming: planned segments handed from the non-real-time planner thread to the real-time
+//! interpolator through preallocated `heapless` SPSC queues, with feed hold.
+//!
+//! The planner plans the feed over the whole program (look-ahead over everything it has read)
+//! and cuts the result into [`Chunk`]s: one segment with its arc-length table and the profile
+//! phases that cover it. Chunks travel as `Box`es, so a queue moves pointers: the real-time
+//! side allocates nothing and frees nothing. A second queue carries consumed chunks back to
+//! the planner thread, which frees them. The planner keeps at most `depth` chunks alive (in
+//! the queues or held by the interpolator); `depth` comes from the machine file.
+//!
+//! **Feed hold.** The interpolator follows the plan in plan time `tau`, advanced by
+//! `k * Ts` each period. The override `k` in [0, 1] is driven by a rate- and jerk-limited
+//! tracker toward 1, or toward 0 when the path that has arrived ends within the distance
+//! needed to stop (an underrun: the planner fell behind), or when a stop is requested
+//! (SIGINT, a fault). Geometry is untouched, so the tool slows along the path and stops on
+//! it, then resumes the plan where it left off; the position never jumps. The tracker's rate
+//! is limited to `hold_acc / v` and its rate of change to `hold_jerk / v`, with `v` the
+//! highest planned speed of the chunks at hand, so holding adds at most `hold_acc` of path
+//! acceleration and `hold_jerk` of path jerk to the plan's own.
+
+use crate::interp::Setpoint;
+use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
+use crate::plan::FeedProfile;
+use crate::scurve::{Motion, Phase};
+use crate::segment::{Path, Pose, Segment};
+use heapless::spsc::{Consumer, Producer, Queue};
+use heapless::Deque;
+
+/// Deepest segment queue a machine file may ask for.
+pub const MAX_DEPTH: usize = 1024;
+/// Queue storage (an SPSC queue of N holds N - 1).
+pub const QUEUE_N: usize = MAX_DEPTH + 1;
+/// Chunks the interpolator looks ahead over (taken from the queue as they arrive).
+pub const LOOKAHEAD: usize = 64;
+
+/// One segment with its share of the feed plan.
+#[derive(Debug)]
+pub struct Chunk {
+    /// 0-based segment index.
+    pub index: usize,
+    pub segment: Segment,
+    /// Path position of the segment's start and end.
+    pub s0: f64,
+    pub s1: f64,
+    /// The profile's phases that cover the segment (absolute time and path position).
+    pub phases: Vec<Phase>,
+    /// Time at which the plan leaves the segment.
+    pub t_end: f64,
+    /// Highest planned speed over `phases`.
+    pub vmax: f64,
+}
+
+/// The program's start, known before any chunk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Start {
+    pub pose: Pose,
+    pub joints: Joints,
+    /// Number of chunks the program has.
+    pub chunks: usize,
+}
+
+fn phase_vmax(p: &Phase) -> f64 {
+    let mut v = p.v0.max(p.end().v);
+    // Constant jerk: v is quadratic in time, with an extremum where a = 0.
+    if p.j != 0.0 {
+        let tau = -p.a0 / p.j;
+        if tau > 0.0 && tau < p.dur {
+            v = v.max(p.at(tau).v);
+        }
+    }
+    v.max(0.0)
+}
+
+/// Cut a planned path into chunks (outside the real-time thread).
+pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
+    let start = Start {
+        pose: path.start,
+        joints: path.start_joints,
+        chunks: path.segments.len(),
+    };
+    let mut out = Vec::with_capacity(path.segments.len());
+    let eps = 1e-9 * profile.length.max(1.0);
+    let mut first = 0;
+    for (index, segment) in path.segments.into_iter().enumerate() {
+        let s0 = profile.seg_start[index];
+        let s1 = profile.seg_start[index + 1];
+        // Phases are in time order and s never decreases: skip those that end before s0.
+        while first + 1 < profile.phases.len() && profile.phases[first].end().s < s0 - eps {
+            first += 1;
+        }
+        let mut last = first;
+        while last + 1 < profile.phases.len() && profile.phases[last + 1].s0 <= s1 + eps {
+            last += 1;
+        }
+        let phases: Vec<Phase> = profile.phases.get(first..=last).unwrap_or(&[]).to_vec();
+        let t_end = phases
+            .last()
+            .map_or(profile.duration, |p| p.t0 + p.dur)
+            .min(profile.duration);
+        let vmax = phases.iter().map(phase_vmax).fold(0.0, f64::max);
+        out.push(Box::new(Chunk {
+            index,
+            segment,
+            s0,
+            s1,
+            phases,
+            t_end,
+            vmax,
+        }));
+    }
+    (start, out)
+}
+
+/// The two queues; create them before the threads, then [`Queues::split`].
+pub struct Queues {
+    ready: Queue<Box<Chunk>, QUEUE_N>,
+    retired: Queue<Box<Chunk>, QUEUE_N>,
+}
+
+impl Default for Queues {
+    fn default() -> Self {
+        Queues {
+            ready: Queue::new(),
+            retired: Queue::new(),
+        }
+    }
+}
+
+impl Queues {
+    /// Boxed: two queues of pointers, 16 KiB.
+    pub fn new() -> Box<Queues> {
+        Box::default()
+    }
+
+    /// The planner's end and the interpolator's end. `depth` (1..=[`MAX_DEPTH`]) is the most
+    /// chunks alive at once.
+    pub fn split(&mut self, depth: usize) -> (Feeder<'_>, Inlet<'_>) {
+        let (rp, rc) = self.ready.split();
+        let (tp, tc) = self.retired.split();
+        (
+            Feeder {
+                ready: rp,
+                retired: tc,
+                depth: depth.clamp(1, MAX_DEPTH),
+                alive: 0,
+                pushed: 0,
+            },
+            Inlet {
+                ready: rc,
+                retired: tp,
+            },
+        )
+    }
+}
+
+/// The planner's side of the queues.
+pub struct Feeder<'q> {
+    ready: Producer<'q, Box<Chunk>>,
+    retired: Consumer<'q, Box<Chunk>>,
+    depth: usize,
+    alive: usize,
+    pushed: usize,
+}
+
+impl Feeder<'_> {
+    /// Free the chunks the interpolator is done with, then push from `source` while fewer
+    /// than `depth` are alive. Returns how many were pushed.
+    pub fn feed(&mut self, source: &mut impl Iterator<Item = Box<Chunk>>) -> usize {
+        while let Some(done) = self.retired.dequeue() {
+            drop(done);
+            self.alive -= 1;
+        }
+        let mut n = 0;
+        while self.alive < self.depth {
+            let Some(c) = source.next() else { break };
+            match self.ready.enqueue(c) {
+                Ok(()) => {
+                    self.alive += 1;
+                    self.pushed += 1;
+                    n += 1;
+                }
+                // Cannot happen (alive < depth <= capacity); dropping here is outside the
+                // real-time thread, but the chunk would be lost: stop feeding instead.
+                Err(_) => break,
+            }
+        }
+        n
+    }
+
+    /// Chunks pushed so far.
+    pub fn pushed(&self) -> usize {
+        self.pushed
+    }
+}
+
+/// The interpolator's side of the queues.
+pub struct Inlet<'q> {
+    ready: Consumer<'q, Box<Chunk>>,
+    retired: Producer<'q, Box<Chunk>>,
+}
+
+/// Feed-hold and stop limits, in path units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoldConfig {
+    pub period: f64,
+    /// Path acceleration and jerk a hold may add to the plan's.
+    pub acc: f64,
+    pub jerk: f64,
+}
+
+impl HoldConfig {
+    /// Half the path's acceleration and jerk limits.
+    pub fn from_plan(cfg: &crate::plan::PlanConfig) -> Self {
+        HoldConfig {
+            period: cfg.period,
+            acc: cfg.path_acc / 2.0,
+            jerk: cfg.path_jerk / 2.0,
+        }
+    }
+}
+
+/// Counters of a streamed run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamCounters {
+    /// Holds started because the path that had arrived was about to run out.
+    pub underruns: u64,
+    /// Periods spent holding for data (k < 1 for lack of data).
+    pub hold_periods: u64,
+    /// Periods where the path ran out before the hold stopped the tool (the tool was stopped
+    /// at the end of the data: on the path, but without deceleration). Should stay 0.
+    pub hard_stops: u64,
+    /// Chunks that could not be handed back (cannot happen by the depth rule; leaked
+    /// rather than freed in the real-time thread).
+    pub leaked: u64,
+}
+
+/// The real-time interpolator over streamed chunks (arc-length method).
+pub struct Follower<'q> {
+    inlet: Inlet<'q>,
+    local: Deque<Box<Chunk>, LOOKAHEAD>,
+    kin: MachineKinematics,
+    lim: RotaryLimits,
+    hold: HoldConfig,
+    start: Start,
+    received: usize,
+    cycle: u64,
+    tau: f64,
+    k: f64,
+    r: f64,
+    phase: usize,
+    motion: Motion,
+    stop_requested: bool,
+    holding: bool,
+    done: bool,
+    pose: Pose,
+    joints: Joints,
+    block: u32,
+    counters: StreamCounters,
+}
+
+impl<'q> Follower<'q> {
+    pub fn new(
+        inlet: Inlet<'q>,
+        start: Start,
+        kin: MachineKinematics,
+        lim: RotaryLimits,
+        hold: HoldConfig,
+    ) -> Self {
+        Follower {
+            inlet,
+            local: Deque::new(),
+            kin,
+            lim,
+            hold,
+            start,
+            received: 0,
+            cycle: 0,
+            tau: 0.0,
+            k: 1.0,
+            r: 0.0,
+            phase: 0,
+            motion: Motion::default(),
+            stop_requested: false,
+            holding: false,
+            done: start.chunks == 0,
+            pose: start.pose,
+            joints: start.joints,
+            block: 1,
+            counters: StreamCounters::default(),
+        }
+    }
+
+    /// Decelerate along the path to a stop and stay there (SIGINT, a drive fault).
+    pub fn request_stop(&mut self) {
+        self.stop_requested = true;
+    }
+
+    /// At rest after [`Self::request_stop`], or at the end of the program.
+    pub fn is_stopped(&self) -> bool {
+        self.done || (self.stop_requested && self.k == 0.0 && self.r == 0.0)
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    pub fn counters(&self) -> StreamCounters {
+        self.counters
+    }
+
+    /// Path position, plan time and override of the last step.
+    pub fn state(&self) -> (f64, f64, f64) {
+        (self.motion.s, self.tau, self.k)
+    }
+
+    /// Fraction of the program's chunks finished, 0..=1.
+    pub fn progress(&self) -> f64 {
+        if self.start.chunks == 0 || self.done {
+            return 1.0;
+        }
+        let cur = self.local.front().map_or(0, |c| c.index);
+        cur as f64 / self.start.chunks as f64
+    }
+
+    /// Take what the planner has pushed, up to the look-ahead.
+    fn pull(&mut self) {
+        while !self.local.is_full() {
+            match self.inlet.ready.dequeue() {
+                Some(c) => {
+                    self.received += 1;
+                    // The deque is not full: cannot fail.
+                    if let Err(c) = self.local.push_back(c) {
+                        self.give_back(c);
+                    }
+                }
+                None => break,
+            }
+        }
+    }
+
+    fn give_back(&mut self, c: Box<Chunk>) {
+        if let Err(c) = self.inlet.retired.enqueue(c) {
+            core::mem::forget(c);
+            self.counters.leaked += 1;
+        }
+    }
+
+    fn retire_front(&mut self) {
+        if let Some(c) = self.local.pop_front() {
+            self.give_back(c);
+        }
+        self.phase = 0;
+    }
+
+    /// Distance needed to bring the override to 0 from its current state, travelling at
+    /// most `v` (a bound, not the exact figure).
+    fn stop_distance(&self, v: f64, rmax: f64, jmax: f64) -> f64 {
+        let rise = self.r.max(0.0);
+        let kpk = (self.k + rise * rise / (2.0 * jmax)).min(1.0);
+        let t = rise / jmax + kpk / rmax + 2.0 * rmax / jmax + 2.0 * self.hold.period;
+        v * kpk * t + 2.0 * v * self.hold.period
+    }
+
+    /// Move the override one period toward `target` with rate <= rmax, rate change <= jmax.
+    fn track(&mut self, target: f64, rmax: f64, jmax: f64) {
+        let ts = self.hold.period;
+        let d = target - self.k;
+        let want = d.signum() * rmax.min((2.0 * jmax * d.abs()).sqrt());
+        let dr = (want - self.r).clamp(-jmax * ts, jmax * ts);
+        let r_new = self.r + dr;
+        let mut k = self.k + 0.5 * (self.r + r_new) * ts;
+        let mut r = r_new;
+        if (target - k) * d <= 0.0 || d.abs() < 1e-12 {
+            // Reached (or passed) the target this period.
+            k = target;
+            r = 0.0;
+        }
+        self.k = k.clamp(0.0, 1.0);
+        self.r = r;
+    }
+
+    fn motion_in(c: &Chunk, tau: f64, cursor: &mut usize) -> Motion {
+        let n = c.phases.len();
+        if n == 0 {
+            return Motion {
+                s: c.s1,
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        while *cursor + 1 < n && tau >= c.phases[*cursor + 1].t0 {
+            *cursor += 1;
+        }
+        let ph = &c.phases[(*cursor).min(n - 1)];
+        let mut m = ph.at((tau - ph.t0).clamp(0.0, ph.dur));
+        m.v = m.v.max(0.0);
+        m
+    }
+
+    /// One period: the next setpoint. Allocation-free; loops bounded by [`LOOKAHEAD`].
+    pub fn step(&mut self) -> Setpoint {
+        self.pull();
+        let ts = self.hold.period;
+        let cycle = self.cycle;
+        self.cycle += 1;
+        if cycle == 0 || self.done {
+            return self.setpoint(cycle, 0.0);
+        }
+        // Nothing arrived yet: stay at the start (the plan starts from rest at tau = 0).
+        if self.local.is_empty() {
+            self.k = 0.0;
+            self.r = 0.0;
+            if self.received < self.start.chunks && !self.stop_requested {
+                self.counters.hold_periods += 1;
+            }
+            return self.setpoint(cycle, 0.0);
+        }
+        let vb = self
+            .local
+            .iter()
+            .map(|c| c.vmax)
+            .fold(1e-9, f64::max)
+            .max(self.motion.v);
+        let rmax = self.hold.acc / vb;
+        let jmax = self.hold.jerk / vb;
+        let complete = self.received >= self.start.chunks;
+        let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
+        let target = if self.stop_requested {
+            0.0
+        } else if !complete && avail_end - self.motion.s <= self.stop_distance(vb, rmax, jmax) {
+            if !self.holding {
+                self.holding = true;
+                self.counters.underruns += 1;
+            }
+            0.0
+        } else {
+            self.holding = false;
+            1.0
+        };
+        if self.holding {
+            self.counters.hold_periods += 1;
+        }
+        let k_old = self.k;
+        self.track(target, rmax, jmax);
+        let tau = self.tau + 0.5 * (k_old + self.k) * ts;
+        // Find the chunk that holds tau; bounded by the look-ahead.
+        let mut m = self.motion;
+        for _ in 0..=LOOKAHEAD {
+            let Some(c) = self.local.front() else { break };
+            m = Self::motion_in(c, tau, &mut self.phase);
+            if c.index + 1 == self.start.chunks {
+                if tau >= c.t_end {
+                    self.done = true;
+                    m = Motion {
+                        s: c.s1,
+                        v: 0.0,
+                        a: 0.0,
+                    };
+                }
+                break;
+            }
+            if m.s <= c.s1 && tau <= c.t_end {
+                break;
+            }
+            if self.local.len() > 1 {
+                self.retire_front();
+            } else {
+                // The data ran out before the hold had stopped: stop at its end, on the path.
+                let s1 = c.s1;
+                self.counters.hard_stops += 1;
+                self.k = 0.0;
+                self.r = 0.0;
+                self.motion.s = self.motion.s.max(s1.min(m.s));
+                self.motion.v = 0.0;
+                self.motion.a = 0.0;
+                return self.pose_setpoint(cycle);
+            }
+        }
+        self.tau = tau;
+        m.v *= self.k;
+        self.motion = m;
+        self.pose_setpoint(cycle)
+    }
+
+    fn pose_setpoint(&mut self, cycle: u64) -> Setpoint {
+        if let Some(c) = self.local.front() {
+            self.block = c.segment.block;
+            self.pose = c.segment.pose(self.motion.s - c.s0);
+        }
+        self.joints = self.pose.joints(&self.kin, &self.joints, &self.lim);
+        if self.done {
+            // The program's last chunk is finished: hand it back now.
+            self.retire_front();
+        }
+        self.setpoint(cycle, self.motion.v)
+    }
+
+    fn setpoint(&self, cycle: u64, feed: f64) -> Setpoint {
+        Setpoint {
+            cycle,
+            t: cycle as f64 * self.hold.period,
+            block: self.block,
+            u: self.pose.u,
+            p: self.pose.p,
+            tool: self.pose.axis(&self.kin),
+            feed: if self.done { 0.0 } else { feed },
+            joints: self.joints,
+            done: self.done,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::interp::tests::{machine, paper_program};
+    use crate::interp::{Interpolator, Method};
+    use crate::plan::plan;
+    use crate::segment::build;
+
+    fn planned(src: Option<&str>) -> (Path, FeedProfile, HoldConfig) {
+        let (kin, cfg, bl) = machine();
+        let program = match src {
+            Some(s) => crate::parse::parse(s).unwrap(),
+            None => paper_program(),
+        };
+        let path = build(&program, &kin, &bl).unwrap();
+        let profile = plan(&path, &kin, &cfg);
+        (path, profile, HoldConfig::from_plan(&cfg))
+    }
+
+    const TWO: &str = include_str!("../../tests/data/two-blocks-g2.nc");
+    const G01: &str = include_str!("../../tests/data/g01-5axis.nc");
+
+    /// Run with the planner pushing `per_push` chunks every `every` periods (0: all at once).
+    fn stream(
+        src: Option<&str>,
+        depth: usize,
+        every: u64,
+        stop_at: Option<u64>,
+    ) -> (Vec<Setpoint>, StreamCounters, Path) {
+        let (path, profile, hold) = planned(src);
+        let (kin, cfg, _) = machine();
+        let keep = path.clone();
+        let (start, all) = chunks(path, &profile);
+        let mut source = all.into_iter();
+        let mut q = Queues::new();
+        let (mut feeder, inlet) = q.split(depth);
+        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+        let mut out = Vec::new();
+        feeder.feed(&mut source.by_ref().take(1));
+        for i in 0..400_000u64 {
+            if every == 0 || i % every == 0 {
+                let mut one = source
+                    .by_ref()
+                    .take(if every == 0 { usize::MAX } else { 1 });
+                feeder.feed(&mut one);
+            }
+            if stop_at == Some(i) {
+                f.request_stop();
+            }
+            let sp = f.step();
+            out.push(sp);
+            if sp.done || (stop_at.is_some() && f.is_stopped()) {
+                break;
+            }
+        }
+        feeder.feed(&mut std::iter::empty());
+        (out, f.counters(), keep)
+    }
+
+    #[test]
+    fn with_all_data_at_hand_it_follows_the_plan_like_the_interpolator() {
+        for src in [None, Some(TWO), Some(G01)] {
+            let (path, profile, _) = planned(src);
+            let (kin, cfg, _) = machine();
+            let mut ip = Interpolator::new(
+                &path,
+                &profile,
+                kin,
+                cfg.rotary,
+                Method::ArcLength,
+                cfg.period,
+                0.0,
+            );
+            let (sps, counters, _) = stream(src, 16, 0, None);
+            let mut n = 0;
+            for sp in &sps {
+                let want = ip.step();
+                assert!(
+                    (sp.p - want.p).norm() < 1e-9,
+                    "cycle {}: {} vs {}",
+                    sp.cycle,
+                    sp.p,
+                    want.p
+                );
+                for j in 0..5 {
+                    assert!((sp.joints[j] - want.joints[j]).abs() < 1e-9);
+                }
+                assert_eq!(sp.done, want.done, "cycle {}", sp.cycle);
+                n += 1;
+            }
+            assert!(sps.last().unwrap().done && n > 100);
+            assert_eq!(counters, StreamCounters::default());
+        }
+    }
+
+    /// Path distance per period, and its first and second differences.
+    fn check_smooth(sps: &[Setpoint], hold: &HoldConfig, vmax: f64, acc: f64) {
+        let ts = hold.period;
+        let d: Vec<f64> = sps.windows(2).map(|w| (w[1].p - w[0].p).norm()).collect();
+        for (i, x) in d.iter().enumerate() {
+            assert!(
+                *x <= vmax * ts * (1.0 + 1e-6) + 1e-12,
+                "jump of {x} mm at {i}"
+            );
+        }
+        for (i, w) in d.windows(2).enumerate() {
+            // Chord lengths approximate arc lengths to well under 1e-6 mm here.
+            let a = (w[1] - w[0]).abs() / (ts * ts);
+            assert!(
+                a <= acc + 1e-3 / (ts * ts) * 1e-3,
+                "path acceleration {a} at {i}"
+            );
+        }
+    }
+
+    #[test]
+    fn an_underrunning_planner_makes_the_tool_hold_on_the_path_and_resume() {
+        let (_, _, hold) = planned(Some(G01));
+        let (_, cfg, _) = machine();
+        // One chunk every 400 periods (0.8 s): slower than the program needs.
+        let (sps, counters, path) = stream(Some(G01), 4, 400, None);
+        assert!(counters.underruns >= 2, "{counters:?}");
+        assert!(counters.hold_periods > 100, "{counters:?}");
+        assert_eq!(counters.hard_stops, 0);
+        assert_eq!(counters.leaked, 0);
+        let last = sps.last().unwrap();
+        assert!(last.done);
+        let seg = path.segments.last().unwrap();
+        assert!((last.p - seg.pose(seg.length).p).norm() < 1e-9);
+        // At rest somewhere mid-program (a hold), not only at the ends.
+        let stops = sps
+            .windows(2)
+            .skip(5)
+            .filter(|w| (w[1].p - w[0].p).norm() < 1e-12 && !w[1].done)
+            .count();
+        assert!(stops > 100, "{stops} periods at rest");
+        let vmax = path.segments.iter().map(|s| s.feed).fold(0.0, f64::max);
+        check_smooth(&sps, &hold, vmax, 1.5 * cfg.path_acc + hold.acc);
+    }
+
+    #[test]
+    fn a_stop_request_decelerates_along_the_path_and_stays() {
+        let (_, cfg, _) = machine();
+        let (_, _, hold) = planned(None);
+        let (sps, counters, path) = stream(None, 8, 0, Some(3000));
+        let last = sps.last().unwrap();
+        assert!(
+            !last.done && sps.len() > 3000 && sps.len() < 3300,
+            "{}",
+            sps.len()
+        );
+        assert_eq!(counters.underruns, 0);
+        // The stop point is on the curve.
+        let (curve, _) = path.segments[0].nurbs().unwrap();
+        let (c, _) = curve.both(last.u.unwrap(), 0);
+        assert!((c.p - last.p).norm() < 1e-9);
+        let v = 400.0 / 60.0;
+        check_smooth(&sps, &hold, v, 1.5 * cfg.path_acc + hold.acc);
+    }
+}
