@@ -71,7 +71,9 @@ fn phase_vmax(p: &Phase) -> f64 {
     v.max(0.0)
 }
 
-/// Cut a planned path into chunks (outside the real-time thread).
+/// Cut a planned path into chunks (outside the real-time thread). Boxed, because the boxes
+/// travel through the queues as pointers.
+#[allow(clippy::vec_box)]
 pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
     let start = Start {
         pose: path.start,

@@ -1,12 +1,11 @@
 //! The real-time side of dnurbs: Linux real-time set-up ([`os`]), preallocated latency
-//! histograms ([`stats`]) and the periodic loop ([`latency`]: the loop without interpolation
-//! or bus, like cyclictest, to characterise a controller PC before deploying).
-//!
-//! The interpolating loop that drives the CAN bus (issue 4's `dnurbs run` and `dnurbs demo`)
-//! builds on the same pieces.
+//! histograms ([`stats`]) handed to a reporter without locks ([`interval`]), the loop without
+//! work ([`latency`]: like cyclictest, to characterise a controller PC before deploying), and
+//! the machine's period ([`pipeline`]: streamed interpolation, drive counts, RPDOs + SYNC).
 
 pub mod interval;
 pub mod latency;
 pub mod os;
+pub mod pipeline;
 pub mod report;
 pub mod stats;

@@ -10,6 +10,9 @@
 //! * [`now`], [`sleep_until`]: `CLOCK_MONOTONIC` and `clock_nanosleep(TIMER_ABSTIME)`, so
 //!   periods do not drift with the time spent computing.
 //!
+//! * [`install_stop_handler`], [`stop_requested`]: SIGINT and SIGTERM set a flag that the
+//!   loop reads each period (a controlled stop, never an abrupt exit).
+//!
 //! A missing privilege is an [`RtError`] that says which one and how to grant it.
 
 use nix::sys::mman::{mlockall, MlockAllFlags};
@@ -45,6 +48,35 @@ pub enum RtError {
     },
     #[error("the real-time thread {0}")]
     Thread(&'static str),
+    #[error("cannot install the SIGINT/SIGTERM handler ({0})")]
+    Signal(nix::errno::Errno),
+}
+
+static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+extern "C" fn on_stop_signal(_: nix::libc::c_int) {
+    // Async-signal-safe: one atomic store.
+    STOP.store(true, std::sync::atomic::Ordering::SeqCst);
+}
+
+/// Make SIGINT and SIGTERM request a controlled stop instead of killing the process.
+pub fn install_stop_handler() -> Result<(), RtError> {
+    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
+    let sa = SigAction::new(
+        SigHandler::Handler(on_stop_signal),
+        SaFlags::SA_RESTART,
+        SigSet::empty(),
+    );
+    for sig in [Signal::SIGINT, Signal::SIGTERM] {
+        // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+        unsafe { sigaction(sig, &sa) }.map_err(RtError::Signal)?;
+    }
+    Ok(())
+}
+
+/// The flag SIGINT/SIGTERM set (after [`install_stop_handler`]).
+pub fn stop_requested() -> &'static std::sync::atomic::AtomicBool {
+    &STOP
 }
 
 fn memlock_limit() -> String {
@@ -136,9 +168,10 @@ pub fn sleep_until(deadline_ns: u64) {
     );
 }
 
-/// Minor page faults of the process so far (getrusage), for the no-fault tests.
+/// Minor page faults of the calling thread so far (getrusage RUSAGE_THREAD): the loop
+/// thread measures its own, not those of the planner or reporter threads.
 pub fn minor_faults() -> i64 {
-    nix::sys::resource::getrusage(nix::sys::resource::UsageWho::RUSAGE_SELF)
+    nix::sys::resource::getrusage(nix::sys::resource::UsageWho::RUSAGE_THREAD)
         .map_or(-1, |u| u.minor_page_faults())
 }
 

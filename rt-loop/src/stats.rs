@@ -81,6 +81,13 @@ impl Stats {
         self.cycles += 1;
     }
 
+    /// A period without interpolation (drives enabling or disabling): no compute sample.
+    pub fn record_idle(&mut self, wakeup_ns: u64, cycle_ns: u64) {
+        self.wakeup.saturating_record(wakeup_ns.max(1));
+        self.cycle.saturating_record(cycle_ns.max(1));
+        self.cycles += 1;
+    }
+
     pub fn summary(&self) -> Summary {
         Summary {
             cycles: self.cycles,

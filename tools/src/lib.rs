@@ -2,6 +2,7 @@
 //! use the same code paths as the binary. `main.rs` only parses arguments and maps errors to
 //! exit codes.
 
+pub mod run;
 pub mod setup;
 pub mod simdrives;
 pub mod simulate;

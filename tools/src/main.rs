@@ -36,6 +36,46 @@ enum MethodArg {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job on built-in defaults: the paper's example program on the paper's machine,
+    /// its five CiA-402 drives simulated on an in-process CAN link (no hardware, no root).
+    /// The real-time thread runs with SCHED_FIFO and locked memory when the privileges allow,
+    /// without them otherwise (said in the output). Prints the latency report.
+    Demo {
+        /// Write summary.txt, summary.json, latency.hlog and latency.svg into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Do not even try SCHED_FIFO and mlockall.
+        #[arg(long)]
+        no_rt: bool,
+    },
+    /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
+    /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
+    /// thread while a planner thread streams planned segments, disable, print the latency
+    /// report.
+    ///
+    /// The axes must be at the program's start pose (its first block) unless --approach is
+    /// given. SIGINT (Ctrl-C) or SIGTERM stops along the path, then disables the drives.
+    /// A drive fault quick-stops and disables every drive and names the node and the cause.
+    /// Real-time settings come from the machine file's [realtime] section.
+    ///
+    /// Exit codes: 0 program completed, 1 stopped early or failed, 2 bad program or machine.
+    Run {
+        /// NC program.
+        program: PathBuf,
+        /// Machine file (TOML) with [[bus]] and [axes.*.drive].
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Write summary.txt, summary.json, latency.hlog and latency.svg into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Before the program, move all axes from where the drives are to the program's start
+        /// in one jerk-limited straight move in axis space (mind the fixtures).
+        #[arg(long)]
+        approach: bool,
+        /// Run without mlockall and SCHED_FIFO (development machines; timing not guaranteed).
+        #[arg(long)]
+        no_rt: bool,
+    },
     /// Run the interpolator offline, period by period, exactly as the real-time thread does,
     /// and report feed fluctuation, chord error and axis loads.
     Simulate {
@@ -137,6 +177,14 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Demo { report, no_rt } => demo(report, no_rt),
+        Command::Run {
+            program,
+            machine,
+            report,
+            approach,
+            no_rt,
+        } => run_cmd(program, machine, report, approach, no_rt),
         Command::Simulate {
             program,
             machine,
@@ -325,6 +373,114 @@ fn parse_duration_ns(s: &str) -> Result<u64, String> {
         return Err(format!("{s:?}: out of range"));
     }
     Ok(ns.round() as u64)
+}
+
+fn write_report(
+    dir: &std::path::Path,
+    stats: &rt_loop::stats::Stats,
+    title: &str,
+) -> anyhow::Result<()> {
+    let summary = stats.summary();
+    let write = |name: &str, body: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, body)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+    };
+    write("summary.txt", summary.text())?;
+    write("summary.json", serde_json::to_string_pretty(&summary)?)?;
+    let svg = dir.join("latency.svg");
+    rt_loop::report::write_svg(&svg, stats, title)
+        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", svg.display()))?;
+    eprintln!("report: {}", dir.display());
+    Ok(())
+}
+
+/// Print the report and outcome of a run; an early stop is an error (exit 1).
+fn finish_run(
+    r: &dnurbs_tools::run::RunResult,
+    report: Option<PathBuf>,
+    title: &str,
+) -> anyhow::Result<()> {
+    print!("{}", r.stats.summary().text());
+    print!("{}", dnurbs_tools::run::outcome_text(r));
+    if let Some(dir) = report {
+        write_report(&dir, &r.stats, title)?;
+    }
+    match &r.reason {
+        None => Ok(()),
+        Some(why) => Err(anyhow::anyhow!("{why}")),
+    }
+}
+
+fn demo(report: Option<PathBuf>, no_rt: bool) -> anyhow::Result<()> {
+    let opts = dnurbs_tools::run::RunOptions {
+        name: "paper-example.nc".into(),
+        approach: true,
+        rt: rt_loop::latency::RtSettings {
+            priority: (!no_rt).then_some(80),
+            cpu: None,
+        },
+        rt_fallback: true,
+        report: report.clone(),
+        progress: true,
+    };
+    eprintln!(
+        "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
+         CiA-402 drives on an in-process CAN link, 2 ms period"
+    );
+    let (r, records) = dnurbs_tools::run::demo(&opts)?;
+    println!("simulated drives received {} targets", records.len());
+    finish_run(&r, report, "dnurbs demo: paper example, 2 ms")
+}
+
+fn run_cmd(
+    program: PathBuf,
+    machine: PathBuf,
+    report: Option<PathBuf>,
+    approach: bool,
+    no_rt: bool,
+) -> anyhow::Result<()> {
+    let m = load_machine(&machine)?;
+    let src = std::fs::read_to_string(&program).map_err(|e| {
+        InputError(format!(
+            "{}: cannot read the program: {e}",
+            program.display()
+        ))
+    })?;
+    let mut links = Vec::new();
+    for b in &m.buses {
+        links.push(drives::link::SocketLink::open(&b.interface).map_err(|e| {
+            anyhow::anyhow!(
+                "cannot open CAN interface {:?} (bus {:?}): {e}; is it up? \
+                 `ip link set {} up type can bitrate {}`",
+                b.interface,
+                b.name,
+                b.interface,
+                b.bitrate
+            )
+        })?);
+    }
+    let opts = dnurbs_tools::run::RunOptions {
+        name: program.display().to_string(),
+        approach,
+        rt: rt_loop::latency::RtSettings {
+            priority: (!no_rt).then_some(m.realtime.priority),
+            cpu: m.realtime.cpu,
+        },
+        rt_fallback: false,
+        report: report.clone(),
+        progress: true,
+    };
+    eprintln!(
+        "dnurbs run: {} on {} ({} drives, {} ms period)",
+        program.display(),
+        m.name,
+        m.drives.len(),
+        m.period_s * 1000.0
+    );
+    let r = dnurbs_tools::run::run(&src, &m, links, &opts)?;
+    let title = format!("dnurbs run: {} on {}", program.display(), m.name);
+    finish_run(&r, report, &title)
 }
 
 fn latency(

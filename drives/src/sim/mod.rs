@@ -95,6 +95,7 @@ mod dictionary;
 mod node;
 #[cfg(test)]
 mod tests;
+mod thread;
 
 use std::io::{self, Write};
 
@@ -106,6 +107,7 @@ use crate::wire::{cob, sync, NodeId};
 
 pub use dictionary::DEVICE_TYPE_SERVO;
 pub use node::FAULT_ERROR_REGISTER;
+pub use thread::SimThread;
 
 use node::SimNode;
 

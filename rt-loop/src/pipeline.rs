@@ -1,0 +1,522 @@
+//! One period of the machine: interpolate, convert to drive counts, send the RPDOs and SYNC.
+//!
+//! [`Pipeline::cycle`] is what the real-time thread calls each period. It allocates nothing,
+//! blocks on nothing, and its loops are bounded by the number of drives and the look-ahead.
+//! Its stages:
+//!
+//! 1. **Enabling**: every bus's [`Master`] steps its drives to Operation enabled (targets are
+//!    the drives' own positions meanwhile). A drive that is not enabled within
+//!    `enable_timeout_cycles` ends the run.
+//! 2. **Approach** (only if asked for): a jerk-limited straight move in axis space from where
+//!    the drives are to the program's start, every axis within its limits, all arriving
+//!    together. Without it, a drive farther than [`AT_START_UNITS`] from the start refuses
+//!    the run before anything moves (checked by [`Pipeline::new`]).
+//! 3. **Running**: the streamed interpolator's step, the axis positions converted to counts
+//!    per drive (rotary radians to degrees first), sent as targets.
+//! 4. **Stopping**: after a stop request (SIGINT/SIGTERM) or a target that does not fit the
+//!    drive's 32-bit counts, the interpolator decelerates along the path to rest.
+//! 5. **Disabling**: the CiA-402 disable sequence; the run ends when every drive has left
+//!    Operation enabled.
+//!
+//! A drive fault is handled by the master itself (quick stop, then disable, targets = actual
+//! positions, so nothing jumps); the pipeline stops interpolating and waits for that to end.
+
+use crate::os;
+use config::bus::Drive;
+use drives::cia402::{Goal, State};
+use drives::link::CanLink;
+use drives::master::{DriveFault, Master, MAX_NODES};
+use heapless::Vec as HVec;
+use nc::kinematics::Joints;
+use nc::scurve::{change_dist, push_change, reachable, Motion, Phase};
+use nc::stream::Follower;
+
+/// A drive within this distance of the program's start (mm or degrees) is at the start.
+pub const AT_START_UNITS: f64 = 0.001;
+
+/// Where the run is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    Enabling,
+    Approach,
+    Running,
+    Stopping,
+    Disabling,
+    Finished,
+}
+
+/// Why a run stopped before the program's end.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum StopReason {
+    #[error("stop requested (SIGINT/SIGTERM): stopped along the path, drives disabled")]
+    Requested,
+    #[error("drive fault: {0}; drives quick-stopped and disabled")]
+    Fault(DriveFault),
+    #[error("drives not Operation enabled within {0} cycles; disabled")]
+    EnableTimeout(u64),
+    #[error(
+        "axis {axis} target {position:.4} does not fit the drive's 32-bit counts; \
+         stopped along the path"
+    )]
+    CountOverflow { axis: usize, position: f64 },
+}
+
+/// The drives of one bus and the master driving them.
+pub struct BusDrives<L: CanLink> {
+    pub master: Master<L>,
+    /// In the master's node order.
+    pub drives: HVec<Drive, MAX_NODES>,
+    targets: [i32; MAX_NODES],
+}
+
+impl<L: CanLink> BusDrives<L> {
+    /// `drives` in the order of the master's nodes; at most [`MAX_NODES`].
+    pub fn new(master: Master<L>, drives: &[Drive]) -> Option<Self> {
+        let mut v = HVec::new();
+        for d in drives {
+            v.push(d.clone()).ok()?;
+        }
+        let mut targets = [0; MAX_NODES];
+        for (t, s) in targets.iter_mut().zip(master.status()) {
+            *t = s.actual;
+        }
+        Some(BusDrives {
+            master,
+            drives: v,
+            targets,
+        })
+    }
+}
+
+/// Axis limits for the approach, in axis units (mm or degrees), joint order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ApproachLimits {
+    pub velocity: [f64; 5],
+    pub acceleration: [f64; 5],
+    pub jerk: [f64; 5],
+}
+
+/// The jerk-limited straight move to the start, planned before the loop.
+#[derive(Clone, Debug)]
+struct Approach {
+    from: [f64; 5],
+    to: [f64; 5],
+    phases: Vec<Phase>,
+    duration: f64,
+    cursor: usize,
+    t: f64,
+}
+
+impl Approach {
+    fn new(from: [f64; 5], to: [f64; 5], lim: &ApproachLimits) -> Approach {
+        // lambda runs 0 -> 1; axis j moves by d_j * lambda.
+        let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+        for k in 0..5 {
+            let d = (to[k] - from[k]).abs();
+            if d > 1e-12 {
+                v = v.min(lim.velocity[k] / d);
+                a = a.min(lim.acceleration[k] / d);
+                j = j.min(lim.jerk[k] / d);
+            }
+        }
+        let mut phases = Vec::new();
+        if v.is_finite() {
+            let vc = v.min(reachable(0.0, 0.5, a, j));
+            let (t1, m1) = push_change(&mut phases, 0.0, Motion::default(), vc, a, j);
+            let cruise = (1.0 - 2.0 * change_dist(0.0, vc, a, j)).max(0.0);
+            let mut t = t1;
+            let mut m = m1;
+            if cruise > 0.0 {
+                let ph = Phase {
+                    t0: t,
+                    dur: cruise / vc,
+                    s0: m.s,
+                    v0: vc,
+                    a0: 0.0,
+                    j: 0.0,
+                };
+                phases.push(ph);
+                t += ph.dur;
+                m = ph.end();
+            }
+            push_change(&mut phases, t, m, 0.0, a, j);
+        }
+        let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
+        Approach {
+            from,
+            to,
+            phases,
+            duration,
+            cursor: 0,
+            t: 0.0,
+        }
+    }
+
+    /// Advance one period; the axis positions, and whether the move is over.
+    fn step(&mut self, period: f64) -> ([f64; 5], bool) {
+        self.t += period;
+        if self.t >= self.duration || self.phases.is_empty() {
+            return (self.to, true);
+        }
+        let n = self.phases.len();
+        while self.cursor + 1 < n && self.t >= self.phases[self.cursor + 1].t0 {
+            self.cursor += 1;
+        }
+        let ph = &self.phases[self.cursor];
+        let l = ph.at((self.t - ph.t0).clamp(0.0, ph.dur)).s.clamp(0.0, 1.0);
+        (
+            core::array::from_fn(|k| self.from[k] + (self.to[k] - self.from[k]) * l),
+            false,
+        )
+    }
+}
+
+/// What [`Pipeline::new`] refuses.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    #[error(
+        "axis {axis} is at {actual:.4} but the program starts at {start:.4}: move it there \
+         first, or pass --approach to have dnurbs move all axes to the start"
+    )]
+    NotAtStart {
+        axis: &'static str,
+        actual: f64,
+        start: f64,
+    },
+}
+
+/// Counts of one cycle, for progress and the report.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CycleInfo {
+    /// Interpolation compute time: from the start of the step to the last axis's counts.
+    pub compute_ns: u64,
+    pub finished: bool,
+}
+
+/// Everything the real-time thread works with.
+pub struct Pipeline<'q, L: CanLink> {
+    pub follower: Follower<'q>,
+    pub buses: Vec<BusDrives<L>>,
+    stage: Stage,
+    reason: Option<StopReason>,
+    approach: Option<Approach>,
+    period: f64,
+    enable_timeout_cycles: u64,
+    stage_cycles: u64,
+    /// Added to the C axis (degrees): the program's C moved to the drive's turn.
+    c_shift_deg: f64,
+    rotary_deg: [bool; 5],
+    cycles: u64,
+}
+
+/// Axis names in joint order (for messages).
+const AXES: [&str; 5] = ["X", "Y", "Z", "tilt (A/B)", "C"];
+
+impl<'q, L: CanLink> Pipeline<'q, L> {
+    /// `start_joints`: the program's start (mm, radians). `approach`: limits for the move to
+    /// the start, or `None` to require the drives to be there already. `c_continuous`: the C
+    /// axis has no travel limits, so the program may be shifted by whole turns to where the
+    /// drive is.
+    pub fn new(
+        follower: Follower<'q>,
+        buses: Vec<BusDrives<L>>,
+        start_joints: Joints,
+        period: f64,
+        approach: Option<ApproachLimits>,
+        c_continuous: bool,
+        enable_timeout_cycles: u64,
+    ) -> Result<Self, PipelineError> {
+        let rotary_deg = [false, false, false, true, true];
+        let start: [f64; 5] = core::array::from_fn(|j| {
+            if rotary_deg[j] {
+                start_joints[j].to_degrees()
+            } else {
+                start_joints[j]
+            }
+        });
+        let mut actual = start;
+        for b in &buses {
+            for (d, s) in b.drives.iter().zip(b.master.status()) {
+                if d.axis < 5 {
+                    actual[d.axis] = d.position(s.actual);
+                }
+            }
+        }
+        let c_shift_deg = if c_continuous {
+            ((actual[4] - start[4]) / 360.0).round() * 360.0
+        } else {
+            0.0
+        };
+        let mut target = start;
+        target[4] += c_shift_deg;
+        let approach = match approach {
+            Some(lim) => Some(Approach::new(actual, target, &lim)),
+            None => {
+                for j in 0..5 {
+                    if (actual[j] - target[j]).abs() > AT_START_UNITS {
+                        return Err(PipelineError::NotAtStart {
+                            axis: AXES[j],
+                            actual: actual[j],
+                            start: target[j],
+                        });
+                    }
+                }
+                None
+            }
+        };
+        Ok(Pipeline {
+            follower,
+            buses,
+            stage: Stage::Enabling,
+            reason: None,
+            approach,
+            period,
+            enable_timeout_cycles,
+            stage_cycles: 0,
+            c_shift_deg,
+            rotary_deg,
+            cycles: 0,
+        })
+    }
+
+    pub fn stage(&self) -> Stage {
+        self.stage
+    }
+
+    /// Why the run stopped early, if it did.
+    pub fn reason(&self) -> Option<StopReason> {
+        self.reason
+    }
+
+    fn enter(&mut self, stage: Stage) {
+        self.stage = stage;
+        self.stage_cycles = 0;
+    }
+
+    fn stop(&mut self, reason: StopReason) {
+        if self.reason.is_none() {
+            self.reason = Some(reason);
+        }
+        self.follower.request_stop();
+    }
+
+    /// Axis positions (mm, degrees) to targets; `false` if one did not fit.
+    fn set_targets(&mut self, axes: &[f64; 5]) -> Result<(), StopReason> {
+        for b in self.buses.iter_mut() {
+            for (d, t) in b.drives.iter().zip(b.targets.iter_mut()) {
+                let Some(&p) = axes.get(d.axis) else { continue };
+                match d.counts(p) {
+                    Some(c) => *t = c,
+                    None => {
+                        return Err(StopReason::CountOverflow {
+                            axis: d.axis,
+                            position: p,
+                        })
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn joints_to_axes(&self, j: &Joints) -> [f64; 5] {
+        core::array::from_fn(|k| {
+            if self.rotary_deg[k] {
+                j[k].to_degrees() + if k == 4 { self.c_shift_deg } else { 0.0 }
+            } else {
+                j[k]
+            }
+        })
+    }
+
+    fn all_in(&self, f: impl Fn(State) -> bool) -> bool {
+        self.buses
+            .iter()
+            .all(|b| b.master.status().iter().all(|s| s.state.is_some_and(&f)))
+    }
+
+    /// One period at monotonic time `now_ns`. `stop` is the stop request (signal flag).
+    pub fn cycle(&mut self, now_ns: u64, stop: bool) -> CycleInfo {
+        let now = now_ns as f64 * 1e-9;
+        self.cycles += 1;
+        self.stage_cycles += 1;
+        if stop && self.reason.is_none() && self.stage != Stage::Finished {
+            self.stop(StopReason::Requested);
+        }
+        let mut compute_ns = 0;
+        match self.stage {
+            Stage::Enabling => {
+                if self.reason.is_some() {
+                    self.enter(Stage::Disabling);
+                } else if self.all_in(|s| s == State::OperationEnabled) {
+                    let next = if self.approach.is_some() {
+                        Stage::Approach
+                    } else {
+                        Stage::Running
+                    };
+                    self.enter(next);
+                } else if self.stage_cycles > self.enable_timeout_cycles {
+                    self.reason = Some(StopReason::EnableTimeout(self.enable_timeout_cycles));
+                    self.enter(Stage::Disabling);
+                }
+            }
+            Stage::Approach => {
+                if self.reason.is_some() {
+                    // A straight axis move, not a path: the drives stop by their own
+                    // quick-stop ramp (CiA-402), then are disabled.
+                    for b in self.buses.iter_mut() {
+                        b.master.set_goal(Goal::QuickStop);
+                    }
+                    self.enter(Stage::Disabling);
+                } else if let Some(ap) = self.approach.as_mut() {
+                    let (axes, done) = ap.step(self.period);
+                    if let Err(r) = self.set_targets(&axes) {
+                        self.reason = Some(r);
+                    }
+                    if done {
+                        self.enter(Stage::Running);
+                    }
+                }
+            }
+            Stage::Running | Stage::Stopping => {
+                let t0 = os::now();
+                let sp = self.follower.step();
+                let axes = self.joints_to_axes(&sp.joints);
+                let overflow = self.set_targets(&axes);
+                compute_ns = os::now().saturating_sub(t0);
+                if let Err(r) = overflow {
+                    self.stop(r);
+                }
+                if self.reason.is_some() && self.stage == Stage::Running {
+                    self.enter(Stage::Stopping);
+                }
+                if sp.done || self.follower.is_stopped() {
+                    self.enter(Stage::Disabling);
+                }
+            }
+            Stage::Disabling => {
+                let goal_quick = self
+                    .buses
+                    .iter()
+                    .any(|b| b.master.goal() == Goal::QuickStop);
+                for b in self.buses.iter_mut() {
+                    if !goal_quick || b.master.fault().is_some() {
+                        b.master.set_goal(Goal::Disabled);
+                    }
+                }
+                let stopped = |s: State| {
+                    matches!(
+                        s,
+                        State::SwitchOnDisabled
+                            | State::ReadyToSwitchOn
+                            | State::Fault
+                            | State::NotReadyToSwitchOn
+                    )
+                };
+                if self.all_in(stopped) || self.stage_cycles > self.enable_timeout_cycles {
+                    self.enter(Stage::Finished);
+                } else if goal_quick && self.all_in(|s| s != State::OperationEnabled) {
+                    for b in self.buses.iter_mut() {
+                        b.master.set_goal(Goal::Disabled);
+                    }
+                }
+            }
+            Stage::Finished => {}
+        }
+        if self.stage == Stage::Enabling && self.cycles == 1 {
+            for b in self.buses.iter_mut() {
+                b.master.set_goal(Goal::Enabled);
+            }
+        }
+        for b in self.buses.iter_mut() {
+            let n = b.master.status().len().min(MAX_NODES);
+            if let Some(f) = b.master.cycle(&b.targets[..n], now) {
+                if self.reason.is_none() {
+                    self.reason = Some(StopReason::Fault(f));
+                    self.follower.request_stop();
+                    if matches!(
+                        self.stage,
+                        Stage::Running | Stage::Approach | Stage::Enabling
+                    ) {
+                        self.stage = Stage::Disabling;
+                        self.stage_cycles = 0;
+                    }
+                }
+            }
+        }
+        CycleInfo {
+            compute_ns,
+            finished: self.stage == Stage::Finished,
+        }
+    }
+
+    /// Each drive's node, last target and actual position (counts), bus by bus.
+    pub fn drive_positions(&self) -> impl Iterator<Item = (usize, u8, i32, i32)> + '_ {
+        self.buses.iter().flat_map(|b| {
+            b.drives
+                .iter()
+                .zip(b.master.status())
+                .map(|(d, s)| (d.axis, d.node, s.target, s.actual))
+        })
+    }
+}
+
+/// What the real-time thread publishes for the progress line (lock-free).
+#[derive(Debug, Default)]
+pub struct Progress {
+    pub cycles: std::sync::atomic::AtomicU64,
+    pub overruns: std::sync::atomic::AtomicU64,
+    /// Program progress, parts per million.
+    pub ppm: std::sync::atomic::AtomicU64,
+    pub underruns: std::sync::atomic::AtomicU64,
+}
+
+/// The interpolating loop: sleep to the absolute deadline, run one [`Pipeline::cycle`],
+/// record wake-up latency, compute time and whole-cycle time, publish progress. Ends when
+/// the pipeline has finished, or after `max_cycles` (a bound for tests and a last resort).
+/// Allocation-free; overruns are counted and the missed deadlines skipped, never caught up.
+pub fn drive_loop<L: CanLink>(
+    rec: &mut crate::interval::Recorder<'_>,
+    pipeline: &mut Pipeline<'_, L>,
+    period_ns: u64,
+    stop: &std::sync::atomic::AtomicBool,
+    progress: &Progress,
+    max_cycles: u64,
+) {
+    use std::sync::atomic::Ordering::Relaxed;
+    let period = period_ns.max(1);
+    let mut next = os::now().saturating_add(period);
+    let (mut underruns, mut total_overruns) = (0, 0);
+    for _ in 0..max_cycles {
+        os::sleep_until(next);
+        let woke = os::now();
+        let info = pipeline.cycle(woke, stop.load(Relaxed));
+        let done = os::now();
+        let stats = rec.stats();
+        let (late, busy) = (woke.saturating_sub(next), done.saturating_sub(woke));
+        if info.compute_ns > 0 {
+            stats.record(late, info.compute_ns, busy);
+        } else {
+            stats.record_idle(late, busy);
+        }
+        next += period;
+        if done > next {
+            stats.overruns += 1;
+            total_overruns += 1;
+            next += (done - next) / period * period + period;
+        }
+        let c = pipeline.follower.counters();
+        stats.underruns += c.underruns - underruns;
+        underruns = c.underruns;
+        progress.cycles.fetch_add(1, Relaxed);
+        progress.overruns.store(total_overruns, Relaxed);
+        progress.underruns.store(c.underruns, Relaxed);
+        progress
+            .ppm
+            .store((pipeline.follower.progress() * 1e6) as u64, Relaxed);
+        rec.maybe_rotate(done);
+        if info.finished {
+            break;
+        }
+    }
+}

@@ -1,0 +1,442 @@
+//! `dnurbs run` and `dnurbs demo`: the whole machine.
+//!
+//! Three threads:
+//! * the **planner** parses and validates the program, builds the segments (arc-length
+//!   tables), plans the feed over the whole program, and streams the planned segments into
+//!   the preallocated queue (`nc::stream`), freeing the ones the interpolator hands back;
+//! * the **real-time thread** (SCHED_FIFO, memory locked, stack prefaulted) runs
+//!   [`rt_loop::pipeline::drive_loop`]: interpolation, drive counts, RPDOs + SYNC, histograms;
+//! * this thread sets the drives up (SDO), then reports: it writes the interval histograms to
+//!   `latency.hlog`, prints progress on stderr when that is a terminal, and at the end prints
+//!   and writes the latency report.
+
+use crate::setup::MachineSetup;
+use crate::InputError;
+use config::Machine;
+use drives::link::SocketLink;
+use drives::master::{configure, Master, SetupOptions, Supervision};
+use drives::wire::NodeId;
+use nc::plan::plan;
+use nc::segment::build;
+use nc::stream::{chunks, Follower, HoldConfig, Queues, Start};
+use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
+use rt_loop::latency::{RtSettings, INTERVAL_NS, STACK_PREFAULT};
+use rt_loop::os;
+use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, StopReason};
+use rt_loop::stats::Stats;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// How to run.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    /// Program name for messages (the file path).
+    pub name: String,
+    /// Move the axes to the program's start before it (otherwise they must be there).
+    pub approach: bool,
+    /// Real-time settings; `priority: None` is --no-rt.
+    pub rt: RtSettings,
+    /// If the real-time privileges are missing, run without them (demo) instead of failing.
+    pub rt_fallback: bool,
+    pub report: Option<PathBuf>,
+    /// Print progress on stderr (when it is a terminal).
+    pub progress: bool,
+}
+
+/// What a run did.
+#[derive(Debug)]
+pub struct RunResult {
+    pub stats: Stats,
+    /// Why it stopped early; `None` when the program ran to its end.
+    pub reason: Option<StopReason>,
+    /// Whether the loop ran with SCHED_FIFO and locked memory; if not, why.
+    pub realtime: Result<(), String>,
+    /// Per drive: axis, node, last target, last actual position (counts).
+    pub drives: Vec<(usize, u8, i32, i32)>,
+    /// Per drive: the program's end point in counts (same order as `drives`).
+    pub end_counts: Vec<Option<i32>>,
+    pub underruns: u64,
+    pub hard_stops: u64,
+}
+
+/// Planner output before streaming.
+#[allow(clippy::vec_box)] // the boxes travel through the queue as pointers
+fn plan_program(
+    src: &str,
+    name: &str,
+    setup: &MachineSetup,
+) -> Result<(Start, Vec<Box<nc::stream::Chunk>>, nc::kinematics::Joints), InputError> {
+    let program = nc::parse::parse(src).map_err(|e| InputError(format!("{name}:{e}")))?;
+    let path =
+        build(&program, &setup.kin, &setup.build).map_err(|e| InputError(format!("{name}:{e}")))?;
+    let profile = plan(&path, &setup.kin, &setup.plan);
+    // The program's end, for the closing check of the drive positions.
+    let end = match path.segments.last() {
+        Some(seg) => {
+            let mut prev = path.start_joints;
+            // Joint continuity: walk the last segment from its start to its end.
+            for i in 0..=64 {
+                prev = seg.pose(seg.length * f64::from(i) / 64.0).joints(
+                    &setup.kin,
+                    &prev,
+                    &setup.plan.rotary,
+                );
+            }
+            prev
+        }
+        None => path.start_joints,
+    };
+    let (start, list) = chunks(path, &profile);
+    Ok((start, list, end))
+}
+
+/// Every axis must have a drive for `run`.
+fn check_drives(m: &Machine) -> Result<(), InputError> {
+    for (j, (name, _)) in m.axes.all().iter().enumerate() {
+        if !m.drives.iter().any(|d| d.axis == j) {
+            return Err(InputError(format!(
+                "machine {:?}: axis {name} has no drive: add [axes.{}.drive] with bus, node and \
+                 counts_per_unit",
+                m.name,
+                name.to_lowercase()
+            )));
+        }
+    }
+    if m.buses.is_empty() {
+        return Err(InputError(format!(
+            "machine {:?} has no [[bus]]: dnurbs run needs the CAN bus of the drives",
+            m.name
+        )));
+    }
+    Ok(())
+}
+
+/// Run `src` on `machine`, with one link per `[[bus]]` (in the machine file's order).
+pub fn run(
+    src: &str,
+    machine: &Machine,
+    links: Vec<SocketLink>,
+    opts: &RunOptions,
+) -> anyhow::Result<RunResult> {
+    check_drives(machine)?;
+    let setup = MachineSetup::new(machine);
+    let rtc = &machine.realtime;
+    let period = machine.period_s;
+    let period_ns = (period * 1e9).round() as u64;
+    let mut queues = Queues::new();
+    let (mut feeder, inlet) = queues.split(rtc.queue_depth);
+    let finished = AtomicBool::new(false);
+    let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
+    let log = match &opts.report {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", dir.display()))?;
+            let p = dir.join("latency.hlog");
+            Some(
+                rt_loop::report::HlogFile::create(&p)
+                    .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", p.display()))?,
+            )
+        }
+        None => None,
+    };
+    os::install_stop_handler()?;
+    let stop = os::stop_requested();
+
+    std::thread::scope(|scope| -> anyhow::Result<RunResult> {
+        let finished = &finished;
+        let setup_ref = &setup;
+        // The planner thread.
+        let planner = std::thread::Builder::new()
+            .name("dnurbs-planner".into())
+            .spawn_scoped(scope, move || {
+                let planned = plan_program(src, &opts.name, setup_ref);
+                let mut source = match planned {
+                    Ok((start, list, end)) => {
+                        let _ = ready_tx.send(Ok((start, end)));
+                        list.into_iter()
+                    }
+                    Err(e) => {
+                        let _ = ready_tx.send(Err(e));
+                        return;
+                    }
+                };
+                while !finished.load(Ordering::Acquire) {
+                    feeder.feed(&mut source);
+                    std::thread::sleep(Duration::from_millis(1));
+                }
+                feeder.feed(&mut std::iter::empty());
+            })?;
+        let ready = ready_rx.recv();
+        let (start, end_joints) = match ready {
+            Ok(Ok(x)) => x,
+            Ok(Err(e)) => {
+                finished.store(true, Ordering::Release);
+                return Err(e.into());
+            }
+            Err(_) => {
+                finished.store(true, Ordering::Release);
+                let _ = planner.join();
+                anyhow::bail!("the planner thread ended without a result");
+            }
+        };
+        let result = (|| -> anyhow::Result<RunResult> {
+            // Drive set-up on every bus (SDO, PDO mapping, NMT start).
+            let mut sopts = SetupOptions::new(period);
+            sopts.boot_timeout = Duration::from_secs_f64(rtc.boot_timeout_s);
+            sopts.sdo_timeout = Duration::from_secs_f64(rtc.sdo_timeout_s);
+            let sup = Supervision {
+                heartbeat_timeout_s: rtc.heartbeat_timeout_s,
+                feedback_timeout_cycles: (rtc.feedback_timeout_s / period).ceil() as u32,
+            };
+            let mut buses = Vec::new();
+            for (bi, mut link) in links.into_iter().enumerate() {
+                let drives: Vec<config::bus::Drive> = machine
+                    .drives
+                    .iter()
+                    .filter(|d| d.bus == bi)
+                    .cloned()
+                    .collect();
+                let nodes: Vec<NodeId> =
+                    drives.iter().filter_map(|d| NodeId::new(d.node)).collect();
+                let bus_name = &machine.buses[bi].interface;
+                let initial = configure(&mut link, &nodes, &sopts, &mut |_| {})
+                    .map_err(|e| anyhow::anyhow!("drive set-up on {bus_name}: {e}"))?;
+                let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9)
+                    .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives on one bus"))?;
+                buses.push(
+                    BusDrives::new(master, &drives)
+                        .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives"))?,
+                );
+            }
+            let end_counts: Vec<Option<i32>> = buses
+                .iter()
+                .flat_map(|b| b.drives.iter())
+                .map(|d| {
+                    let v = end_joints[d.axis];
+                    d.counts(if d.axis >= 3 { v.to_degrees() } else { v })
+                })
+                .collect();
+            let lim = |f: fn(&config::AxisLimits) -> f64| -> [f64; 5] {
+                core::array::from_fn(|j| f(&setup.limits[j]))
+            };
+            let approach = opts.approach.then(|| ApproachLimits {
+                velocity: lim(|l| l.velocity),
+                acceleration: lim(|l| l.acceleration),
+                jerk: lim(|l| l.jerk),
+            });
+            let follower = Follower::new(
+                inlet,
+                start,
+                setup.kin,
+                setup.plan.rotary,
+                HoldConfig::from_plan(&setup.plan),
+            );
+            let enable_cycles = (rtc.boot_timeout_s / period).ceil() as u64;
+            let mut pipeline = Pipeline::new(
+                follower,
+                buses,
+                start.joints,
+                period,
+                approach,
+                machine.axes.c.is_unlimited(),
+                enable_cycles,
+            )
+            .map_err(|e| InputError(e.to_string()))?;
+            run_threads(&mut pipeline, period_ns, stop, opts, log, end_counts)
+        })();
+        finished.store(true, Ordering::Release);
+        let _ = planner.join();
+        result
+    })
+}
+
+fn run_threads(
+    pipeline: &mut Pipeline<'_, SocketLink>,
+    period_ns: u64,
+    stop: &'static AtomicBool,
+    opts: &RunOptions,
+    mut log: Option<rt_loop::report::HlogFile>,
+    end_counts: Vec<Option<i32>>,
+) -> anyhow::Result<RunResult> {
+    let (mut iq, first) = IntervalQueues::new();
+    let (full_p, mut full_c) = iq.full.split();
+    let (mut free_p, free_c) = iq.free.split();
+    let progress = Progress::default();
+    let done = AtomicBool::new(false);
+    let t0 = os::now();
+    let rt = opts.rt;
+    let fallback = opts.rt_fallback;
+    std::thread::scope(|scope| -> anyhow::Result<RunResult> {
+        let (progress, done) = (&progress, &done);
+        let pl = &mut *pipeline;
+        let rt_thread = std::thread::Builder::new()
+            .name("dnurbs-rt".into())
+            .stack_size(STACK_PREFAULT * 2)
+            .spawn_scoped(scope, move || {
+                let realtime = rt_setup(rt, fallback);
+                if let Err(e) = &realtime {
+                    if !fallback {
+                        done.store(true, Ordering::Release);
+                        return Err(e.clone());
+                    }
+                }
+                os::set_timer_slack(1);
+                os::prefault_stack(STACK_PREFAULT);
+                let mut rec = Recorder::new(first, full_p, free_c, INTERVAL_NS, os::now());
+                let faults = os::minor_faults();
+                drive_loop(&mut rec, pl, period_ns, stop, progress, u64::MAX);
+                let faults = os::minor_faults() - faults;
+                done.store(true, Ordering::Release);
+                Ok((rec.finish(os::now()), faults, realtime))
+            })?;
+        let mut totals = Stats::new();
+        let mut report = |iv: &Interval, totals: &mut Stats| -> anyhow::Result<()> {
+            totals.add(&iv.stats);
+            if let Some(l) = log.as_mut() {
+                l.append(iv, t0)?;
+            }
+            Ok(())
+        };
+        let tty = opts.progress && std::io::stderr().is_terminal();
+        let mut last_print = std::time::Instant::now();
+        loop {
+            let finished = done.load(Ordering::Acquire);
+            while let Some(mut iv) = full_c.dequeue() {
+                report(&iv, &mut totals)?;
+                iv.stats.clear();
+                let _ = free_p.enqueue(iv);
+            }
+            if finished {
+                break;
+            }
+            if tty && last_print.elapsed() >= Duration::from_millis(250) {
+                last_print = std::time::Instant::now();
+                eprint!(
+                    "\r{}: {:5.1} %   cycle {}   overruns {}   feed holds {}   ",
+                    opts.name,
+                    progress.ppm.load(Ordering::Relaxed) as f64 / 1e4,
+                    progress.cycles.load(Ordering::Relaxed),
+                    progress.overruns.load(Ordering::Relaxed),
+                    progress.underruns.load(Ordering::Relaxed),
+                );
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        if tty {
+            eprintln!();
+        }
+        let joined = rt_thread
+            .join()
+            .map_err(|_| anyhow::anyhow!("the real-time thread panicked"))?;
+        let (last, faults, realtime) = joined.map_err(|e| anyhow::anyhow!("{e}"))?;
+        report(&last, &mut totals)?;
+        totals.minor_faults = faults;
+        Ok(RunResult {
+            stats: totals,
+            reason: None,
+            realtime,
+            drives: Vec::new(),
+            end_counts,
+            underruns: 0,
+            hard_stops: 0,
+        })
+    })
+    .map(|mut r| {
+        r.reason = pipeline.reason();
+        r.drives = pipeline.drive_positions().collect();
+        let c = pipeline.follower.counters();
+        r.underruns = c.underruns;
+        r.hard_stops = c.hard_stops;
+        r
+    })
+}
+
+/// Lock memory, SCHED_FIFO, CPU; `Err` says what is missing.
+fn rt_setup(rt: RtSettings, fallback: bool) -> Result<(), String> {
+    let mut result = Ok(());
+    if let Some(priority) = rt.priority {
+        if let Err(e) = os::lock_memory().and_then(|()| os::set_fifo(priority)) {
+            result = Err(e.to_string());
+            if !fallback {
+                return result;
+            }
+        }
+    } else {
+        result = Err("--no-rt".to_owned());
+    }
+    if let Some(cpu) = rt.cpu {
+        if let Err(e) = os::pin_to_cpu(cpu) {
+            return Err(e.to_string());
+        }
+    }
+    result
+}
+
+/// The demo's machine: the paper's machine (its drives on an in-process bus).
+pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-table.toml");
+/// The demo's program: the paper's example.
+pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
+
+/// `dnurbs demo`: the paper's example on the paper's machine, its five drives simulated in a
+/// thread on the other end of an in-process link (the same socketcan code path as a bus).
+pub fn demo(opts: &RunOptions) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
+    let machine = config::from_str(
+        DEMO_MACHINE,
+        std::path::Path::new("config/machines/paper-ac-table.toml"),
+    )?;
+    let mut links = Vec::new();
+    let mut sims = Vec::new();
+    for bi in 0..machine.buses.len() {
+        let (master_end, drive_end) = SocketLink::pair()?;
+        let nodes = machine
+            .drives
+            .iter()
+            .filter(|d| d.bus == bi)
+            .filter_map(|d| {
+                let mut c = drives::sim::SimNodeConfig::new(NodeId::new(d.node)?);
+                c.initial_position = d.offset;
+                Some(c)
+            })
+            .collect();
+        sims.push(drives::sim::SimThread::start(
+            drive_end,
+            nodes,
+            machine.period_s,
+            Duration::from_micros(200),
+        )?);
+        links.push(master_end);
+    }
+    let result = run(DEMO_PROGRAM, &machine, links, opts);
+    let records = sims.into_iter().flat_map(|s| s.finish()).collect();
+    Ok((result?, records))
+}
+
+/// The closing lines of a run: outcome and drive positions against the program's end.
+pub fn outcome_text(r: &RunResult) -> String {
+    let mut s = String::new();
+    match &r.realtime {
+        Ok(()) => s.push_str("real-time: SCHED_FIFO, memory locked\n"),
+        Err(why) => s.push_str(&format!("real-time: no ({why})\n")),
+    }
+    s.push_str(&format!(
+        "feed holds (planner underruns): {}   hard stops: {}\n",
+        r.underruns, r.hard_stops
+    ));
+    for ((axis, node, target, actual), end) in r.drives.iter().zip(&r.end_counts) {
+        let name = ["X", "Y", "Z", "A/B", "C"]
+            .get(*axis)
+            .copied()
+            .unwrap_or("?");
+        let end = end.map_or("-".to_owned(), |e| e.to_string());
+        s.push_str(&format!(
+            "axis {name:<3} node {node:>3}: target {target:>11}  actual {actual:>11}  program end {end:>11} counts\n"
+        ));
+    }
+    match &r.reason {
+        None => s.push_str("program completed\n"),
+        Some(why) => s.push_str(&format!("stopped: {why}\n")),
+    }
+    s
+}
