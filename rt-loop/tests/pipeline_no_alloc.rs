@@ -1,0 +1,164 @@
+//! The whole pipeline touches neither the heap nor a new page: >= 100 000 periods of the
+//! streamed interpolator, unit conversion and the CiA-402 master over the in-process link,
+//! against simulated drives in another thread, while a planner thread streams segments
+//! through a 4-deep queue. A counting global allocator counts allocations and frees made
+//! by the loop's own thread (the planner and the drives allocate freely in theirs), and
+//! getrusage(RUSAGE_THREAD) counts its minor page faults. Its own test binary, one test.
+
+use config::bus::Drive;
+use drives::link::SocketLink;
+use drives::master::{configure, Master, SetupOptions, Supervision};
+use drives::sim::{SimNodeConfig, SimThread};
+use drives::wire::NodeId;
+use nc::kinematics::MachineKinematics;
+use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use rt_loop::interval::{Queues as IntervalQueues, Recorder};
+use rt_loop::os;
+use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, Stage};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::Duration;
+
+struct Counting;
+static EVENTS: AtomicU64 = AtomicU64::new(0);
+thread_local! {
+    static ARMED: Cell<bool> = const { Cell::new(false) };
+}
+
+fn armed() -> bool {
+    ARMED.try_with(Cell::get).unwrap_or(false)
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if armed() {
+            EVENTS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if armed() {
+            EVENTS.fetch_add(1, Ordering::Relaxed);
+        }
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static ALLOC: Counting = Counting;
+
+const PERIOD: f64 = 150e-6;
+const PAPER: &str = include_str!("../../tests/data/paper-example.nc");
+
+fn drive(axis: usize, node: u8, counts_per_unit: f64) -> Drive {
+    Drive {
+        axis,
+        bus: 0,
+        node,
+        counts_per_unit,
+        sign: 1,
+        offset: 0,
+    }
+}
+
+#[test]
+fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
+    let kin = MachineKinematics::Paper;
+    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
+    let program = nc::parse::parse(PAPER).unwrap();
+    let path = nc::segment::build(&program, &kin, &bl).unwrap();
+    let profile = nc::plan::plan(&path, &kin, &cfg);
+    let (start, list) = chunks(path, &profile);
+    let mut source = list.into_iter();
+
+    let drives = [
+        drive(0, 1, 10000.0),
+        drive(1, 2, 10000.0),
+        drive(2, 3, 10000.0),
+        drive(3, 4, 1000.0),
+        drive(4, 5, 1000.0),
+    ];
+    let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
+    let (mut link, drive_end) = SocketLink::pair().unwrap();
+    let sims = nodes.iter().map(|&n| SimNodeConfig::new(n)).collect();
+    let sim = SimThread::start(drive_end, sims, PERIOD, Duration::from_micros(20)).unwrap();
+    let mut opts = SetupOptions::new(PERIOD);
+    opts.boot_timeout = Duration::from_secs(5);
+    let initial = configure(&mut link, &nodes, &opts, &mut |_| {}).unwrap();
+    // Function, not timing, is tested here: supervision is lenient for a loaded CI machine.
+    let sup = Supervision {
+        heartbeat_timeout_s: 10.0,
+        feedback_timeout_cycles: 1_000_000,
+    };
+    let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9).unwrap();
+
+    let mut queues = Queues::new();
+    let (mut feeder, inlet) = queues.split(4);
+    feeder.feed(&mut source.by_ref().take(4));
+    let follower = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(&cfg));
+    let lim = ApproachLimits {
+        velocity: [250.0, 250.0, 250.0, 90.0, 90.0],
+        acceleration: [2500.0, 2500.0, 2500.0, 900.0, 900.0],
+        jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
+    };
+    let bus = BusDrives::new(master, &drives).unwrap();
+    let mut pipeline =
+        Pipeline::new(follower, vec![bus], start.joints, PERIOD, Some(lim), true, 100_000)
+            .unwrap();
+
+    let (mut iq, first) = IntervalQueues::new();
+    let (full, _full_c) = iq.full.split();
+    let (_free_p, free) = iq.free.split();
+    let progress = Progress::default();
+    let finished = AtomicBool::new(false);
+    let stop = AtomicBool::new(false);
+    let (events, faults) = std::thread::scope(|s| {
+        let (progress, finished, stop, pl) = (&progress, &finished, &stop, &mut pipeline);
+        let rt = std::thread::Builder::new()
+            .stack_size(1 << 20)
+            .spawn_scoped(s, move || {
+                // Locked memory if allowed (root in CI); the loop must not fault either way.
+                let _ = os::lock_memory();
+                os::set_timer_slack(1);
+                os::prefault_stack(256 * 1024);
+                let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
+                os::sleep_until(os::now());
+                let f0 = os::minor_faults();
+                let e0 = EVENTS.load(Ordering::SeqCst);
+                ARMED.with(|a| a.set(true));
+                drive_loop(&mut rec, pl, (PERIOD * 1e9) as u64, stop, progress, 2_000_000);
+                ARMED.with(|a| a.set(false));
+                let e = EVENTS.load(Ordering::SeqCst) - e0;
+                let f = os::minor_faults() - f0;
+                finished.store(true, Ordering::SeqCst);
+                (e, f)
+            })
+            .unwrap();
+        // The planner: stream the rest, free what comes back.
+        while !finished.load(Ordering::SeqCst) {
+            feeder.feed(&mut source);
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        rt.join().unwrap()
+    });
+    feeder.feed(&mut std::iter::empty());
+    let records = sim.finish();
+
+    let cycles = progress.cycles.load(Ordering::SeqCst);
+    assert_eq!(pipeline.stage(), Stage::Finished);
+    assert_eq!(pipeline.reason(), None, "stopped early");
+    assert!(cycles >= 100_000, "only {cycles} periods");
+    assert_eq!(events, 0, "heap allocations or frees in the loop over {cycles} periods");
+    assert_eq!(faults, 0, "minor page faults in the loop over {cycles} periods");
+    assert_eq!(pipeline.follower.counters().hard_stops, 0);
+    // The drives end at the program's end point (cutter X Y Z = machine X Y Z here).
+    let end = [-16963, 1636796, 58369];
+    for (axis, node, target, actual) in pipeline.drive_positions() {
+        if axis < 3 {
+            assert_eq!(target, end[axis], "node {node}");
+        }
+        assert!((target - actual).abs() <= 1, "node {node}: {target} vs {actual}");
+    }
+    assert!(records.len() as u64 > 5 * 100_000, "{} targets", records.len());
+}
