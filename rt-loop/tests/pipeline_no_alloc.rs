@@ -103,9 +103,16 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
         jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
     };
     let bus = BusDrives::new(master, &drives).unwrap();
-    let mut pipeline =
-        Pipeline::new(follower, vec![bus], start.joints, PERIOD, Some(lim), true, 100_000)
-            .unwrap();
+    let mut pipeline = Pipeline::new(
+        follower,
+        vec![bus],
+        start.joints,
+        PERIOD,
+        Some(lim),
+        true,
+        100_000,
+    )
+    .unwrap();
 
     let (mut iq, first) = IntervalQueues::new();
     let (full, _full_c) = iq.full.split();
@@ -127,7 +134,14 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
                 let f0 = os::minor_faults();
                 let e0 = EVENTS.load(Ordering::SeqCst);
                 ARMED.with(|a| a.set(true));
-                drive_loop(&mut rec, pl, (PERIOD * 1e9) as u64, stop, progress, 2_000_000);
+                drive_loop(
+                    &mut rec,
+                    pl,
+                    (PERIOD * 1e9) as u64,
+                    stop,
+                    progress,
+                    2_000_000,
+                );
                 ARMED.with(|a| a.set(false));
                 let e = EVENTS.load(Ordering::SeqCst) - e0;
                 let f = os::minor_faults() - f0;
@@ -149,8 +163,14 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
     assert_eq!(pipeline.stage(), Stage::Finished);
     assert_eq!(pipeline.reason(), None, "stopped early");
     assert!(cycles >= 100_000, "only {cycles} periods");
-    assert_eq!(events, 0, "heap allocations or frees in the loop over {cycles} periods");
-    assert_eq!(faults, 0, "minor page faults in the loop over {cycles} periods");
+    assert_eq!(
+        events, 0,
+        "heap allocations or frees in the loop over {cycles} periods"
+    );
+    assert_eq!(
+        faults, 0,
+        "minor page faults in the loop over {cycles} periods"
+    );
     assert_eq!(pipeline.follower.counters().hard_stops, 0);
     // The drives end at the program's end point (cutter X Y Z = machine X Y Z here).
     let end = [-16963, 1636796, 58369];
@@ -158,7 +178,14 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
         if axis < 3 {
             assert_eq!(target, end[axis], "node {node}");
         }
-        assert!((target - actual).abs() <= 1, "node {node}: {target} vs {actual}");
+        assert!(
+            (target - actual).abs() <= 1,
+            "node {node}: {target} vs {actual}"
+        );
     }
-    assert!(records.len() as u64 > 5 * 100_000, "{} targets", records.len());
+    assert!(
+        records.len() as u64 > 5 * 100_000,
+        "{} targets",
+        records.len()
+    );
 }

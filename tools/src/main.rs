@@ -447,19 +447,22 @@ fn run_cmd(
             program.display()
         ))
     })?;
-    let mut links = Vec::new();
-    for b in &m.buses {
-        links.push(drives::link::SocketLink::open(&b.interface).map_err(|e| {
-            anyhow::anyhow!(
-                "cannot open CAN interface {:?} (bus {:?}): {e}; is it up? \
-                 `ip link set {} up type can bitrate {}`",
-                b.interface,
-                b.name,
-                b.interface,
-                b.bitrate
-            )
-        })?);
-    }
+    let open_links = || -> anyhow::Result<Vec<drives::link::SocketLink>> {
+        let mut links = Vec::new();
+        for b in &m.buses {
+            links.push(drives::link::SocketLink::open(&b.interface).map_err(|e| {
+                anyhow::anyhow!(
+                    "cannot open CAN interface {:?} (bus {:?}): {e}; is it up? \
+                     `ip link set {} up type can bitrate {}`",
+                    b.interface,
+                    b.name,
+                    b.interface,
+                    b.bitrate
+                )
+            })?);
+        }
+        Ok(links)
+    };
     let opts = dnurbs_tools::run::RunOptions {
         name: program.display().to_string(),
         approach,
@@ -478,7 +481,7 @@ fn run_cmd(
         m.drives.len(),
         m.period_s * 1000.0
     );
-    let r = dnurbs_tools::run::run(&src, &m, links, &opts)?;
+    let r = dnurbs_tools::run::run(&src, &m, open_links, &opts)?;
     let title = format!("dnurbs run: {} on {}", program.display(), m.name);
     finish_run(&r, report, &title)
 }

@@ -113,11 +113,13 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
     Ok(())
 }
 
-/// Run `src` on `machine`, with one link per `[[bus]]` (in the machine file's order).
+/// Run `src` on `machine`. `open_links` gives one link per `[[bus]]` (in the machine file's
+/// order); it is called once the program has been parsed, built and planned, so a bad
+/// program is reported before anything touches the bus.
 pub fn run(
     src: &str,
     machine: &Machine,
-    links: Vec<SocketLink>,
+    open_links: impl FnOnce() -> anyhow::Result<Vec<SocketLink>>,
     opts: &RunOptions,
 ) -> anyhow::Result<RunResult> {
     check_drives(machine)?;
@@ -191,7 +193,7 @@ pub fn run(
                 feedback_timeout_cycles: (rtc.feedback_timeout_s / period).ceil() as u32,
             };
             let mut buses = Vec::new();
-            for (bi, mut link) in links.into_iter().enumerate() {
+            for (bi, mut link) in open_links()?.into_iter().enumerate() {
                 let drives: Vec<config::bus::Drive> = machine
                     .drives
                     .iter()
@@ -408,7 +410,7 @@ pub fn demo(opts: &RunOptions) -> anyhow::Result<(RunResult, Vec<drives::sim::Re
         )?);
         links.push(master_end);
     }
-    let result = run(DEMO_PROGRAM, &machine, links, opts);
+    let result = run(DEMO_PROGRAM, &machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))
 }

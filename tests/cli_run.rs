@@ -1,0 +1,102 @@
+//! `dnurbs demo` and `dnurbs run` through the real binary: the demo runs the paper example
+//! against simulated drives on the in-process link and ends on the program's end point;
+//! `run` reports a bad program or machine before touching a bus.
+
+mod common;
+
+use common::{data, dnurbs, machine, temp};
+
+#[test]
+fn demo_runs_the_paper_example_to_its_end_and_writes_the_report() {
+    let dir = temp("demo-report");
+    // --no-rt: the same loop without SCHED_FIFO, so the test needs no privileges.
+    let out = dnurbs(&["demo", "--no-rt", "--report", dir.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("program completed"), "{stdout}");
+    assert!(stdout.contains("real-time: no (--no-rt)"), "{stdout}");
+    // Every drive ends where the program ends, to the count, and follows its target.
+    let axes: Vec<&str> = stdout.lines().filter(|l| l.starts_with("axis ")).collect();
+    assert_eq!(axes.len(), 5, "{stdout}");
+    for line in axes {
+        let n: Vec<i64> = line
+            .split_whitespace()
+            .filter_map(|w| w.trim_end_matches(':').parse().ok())
+            .collect();
+        // node, target, actual, program end
+        assert_eq!(n.len(), 4, "{line}");
+        assert_eq!(n[1], n[3], "target is not the program end: {line}");
+        assert!((n[2] - n[3]).abs() <= 1, "actual is off the end: {line}");
+    }
+    // X Y Z of the paper's end point, 10000 counts/mm.
+    assert!(stdout.contains("-16963") && stdout.contains("1636796") && stdout.contains("58369"));
+    for f in ["summary.txt", "summary.json", "latency.hlog", "latency.svg"] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let cycles = json["cycles"].as_u64().unwrap();
+    // 17.87 s of program at 2 ms, plus the approach and the enable/disable cycles.
+    assert!(cycles > 8938, "{cycles}");
+    assert_eq!(json["underruns"], 0);
+    for h in ["wakeup_latency_ns", "compute_ns", "cycle_ns"] {
+        for k in ["min", "p50", "p90", "p99", "p99_9", "p99_99", "max"] {
+            assert!(json["histograms"][h][k].as_u64().unwrap() > 0, "{h}.{k}");
+        }
+    }
+    let hlog = std::fs::read_to_string(dir.join("latency.hlog")).unwrap();
+    assert!(hlog.contains("Tag=compute,") && hlog.contains("Tag=wakeup,"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn run_reports_a_bad_program_with_its_position_before_touching_the_bus() {
+    let prog = temp("bad.nc");
+    std::fs::write(&prog, "N10 G01 X0 Y0 Z0 F100\nN20 G01 X1 Q5\n").unwrap();
+    let m = machine("paper-ac-table.toml");
+    let out = dnurbs(&[
+        "run",
+        prog.to_str().unwrap(),
+        "--machine",
+        m.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!("{}:2:12: word Q5", prog.display())),
+        "{err}"
+    );
+    assert!(!err.contains("CAN interface"), "{err}");
+}
+
+#[test]
+fn run_refuses_a_machine_without_drives() {
+    let out = dnurbs(&[
+        "run",
+        data("paper-example.nc").to_str().unwrap(),
+        "--machine",
+        machine("xyzac-trt-mill.toml").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("axis X has no drive: add [axes.x.drive]"),
+        "{err}"
+    );
+}
+
+#[test]
+fn run_help_explains_the_start_pose_and_the_stop() {
+    let out = dnurbs(&["run", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    for s in [
+        "--approach",
+        "SIGINT",
+        "disables the drives",
+        "[realtime]",
+        "Exit codes",
+    ] {
+        assert!(help.contains(s), "{s} missing from:\n{help}");
+    }
+}
