@@ -207,7 +207,11 @@ pub struct Pipeline<'q, L: CanLink> {
     c_shift_deg: f64,
     rotary_deg: [bool; 5],
     cycles: u64,
+    settle: u64,
 }
+
+/// Most periods to wait at the end for the drives to reach their last target.
+pub const SETTLE_CYCLES: u64 = 500;
 
 /// Axis names in joint order (for messages).
 const AXES: [&str; 5] = ["X", "Y", "Z", "tilt (A/B)", "C"];
@@ -276,6 +280,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             c_shift_deg,
             rotary_deg,
             cycles: 0,
+            settle: 0,
         })
     }
 
@@ -326,6 +331,17 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             } else {
                 j[k]
             }
+        })
+    }
+
+    /// Every drive within one count of its target.
+    fn settled(&self) -> bool {
+        self.buses.iter().all(|b| {
+            b.master
+                .status()
+                .iter()
+                .zip(&b.targets)
+                .all(|(s, t)| (s.actual.wrapping_sub(*t)).abs() <= 1)
         })
     }
 
@@ -390,8 +406,13 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 if self.reason.is_some() && self.stage == Stage::Running {
                     self.enter(Stage::Stopping);
                 }
+                // At rest: let the drives reach the last target (their own lag) before
+                // disabling, so they stop where the path ends; bounded by SETTLE_CYCLES.
                 if sp.done || self.follower.is_stopped() {
-                    self.enter(Stage::Disabling);
+                    self.settle += 1;
+                    if self.settled() || self.settle > SETTLE_CYCLES {
+                        self.enter(Stage::Disabling);
+                    }
                 }
             }
             Stage::Disabling => {
