@@ -55,7 +55,7 @@ fn run_on_vcan(program: &str) {
     let bin = env!("CARGO_BIN_EXE_dnurbs");
     let prog = data(program);
 
-    let sim = Command::new(bin)
+    let mut sim = Command::new(bin)
         .args(["sim-drives", "--iface", &iface, "--machine"])
         .arg(&machine_file)
         .arg("--record")
@@ -76,6 +76,7 @@ fn run_on_vcan(program: &str) {
     // sim-drives flushes its record every 100 ms; let it write the last targets.
     std::thread::sleep(Duration::from_millis(400));
     let _ = Command::new("kill").arg(sim.id().to_string()).status();
+    let _ = sim.wait();
     let stdout = String::from_utf8_lossy(&run.stdout);
     let stderr = String::from_utf8_lossy(&run.stderr);
     println!("dnurbs run {program}:\n{stdout}{stderr}");
