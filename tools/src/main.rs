@@ -481,6 +481,13 @@ fn run_cmd(
         m.drives.len(),
         m.period_s * 1000.0
     );
+    if m.interpolation.method != config::Method::Arclength {
+        eprintln!(
+            "dnurbs run: note: the real-time interpolator uses the arclength method; \
+             [interpolation] method = \"{}\" applies to simulate and compare",
+            m.interpolation.method
+        );
+    }
     let r = dnurbs_tools::run::run(&src, &m, open_links, &opts)?;
     let title = format!("dnurbs run: {} on {}", program.display(), m.name);
     finish_run(&r, report, &title)
