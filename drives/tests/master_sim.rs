@@ -8,59 +8,17 @@ use drives::link::{CanLink, SocketLink};
 use drives::master::{
     configure, DriveFault, FaultCause, Master, SetupErrorKind, SetupOptions, Supervision,
 };
-use drives::sim::{Faults, Record, SimBus, SimNodeConfig};
+use drives::sim::{Faults, Record, SimBus, SimNodeConfig, SimThread};
 use drives::wire::NodeId;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 const PERIOD: f64 = 0.002;
 
 /// The simulated drives in a thread of their own, serving one end of the link.
-struct Drives {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<Vec<Record>>>,
-}
-
-impl Drives {
-    fn start(mut link: SocketLink, nodes: Vec<SimNodeConfig>) -> Drives {
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = stop.clone();
-        let thread = std::thread::spawn(move || {
-            let mut bus = SimBus::new(nodes, PERIOD);
-            let t0 = Instant::now();
-            let mut out = Vec::new();
-            while !flag.load(Ordering::Relaxed) {
-                let now = t0.elapsed().as_secs_f64();
-                let mut idle = true;
-                while let Ok(Some(f)) = link.recv() {
-                    bus.on_frame(&f, now, &mut |o| out.push(o));
-                    idle = false;
-                }
-                bus.poll(now, &mut |o| out.push(o));
-                for f in out.drain(..) {
-                    let _ = link.send(&f);
-                }
-                if idle {
-                    std::thread::sleep(Duration::from_micros(50));
-                }
-            }
-            bus.records().to_vec()
-        });
-        Drives {
-            stop,
-            thread: Some(thread),
-        }
-    }
-
-    fn finish(mut self) -> Vec<Record> {
-        self.stop.store(true, Ordering::Relaxed);
-        self.thread
-            .take()
-            .map(|t| t.join().expect("sim thread"))
-            .unwrap_or_default()
-    }
+fn sim_thread(link: SocketLink, nodes: Vec<SimNodeConfig>) -> SimThread {
+    SimThread::start(link, nodes, PERIOD, Duration::from_micros(50)).expect("sim thread")
 }
 
 fn nodes(n: u8) -> Vec<NodeId> {
@@ -91,9 +49,12 @@ const SUPERVISION: Supervision = Supervision {
 };
 
 /// Set up, enable and return a running master.
-fn start(n: u8, faults: impl Fn(u8) -> Faults) -> (Master<SocketLink>, Drives, Instant, Vec<i32>) {
+fn start(
+    n: u8,
+    faults: impl Fn(u8) -> Faults,
+) -> (Master<SocketLink>, SimThread, Instant, Vec<i32>) {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
-    let drives = Drives::start(drive_end, sim_nodes(n, faults));
+    let drives = sim_thread(drive_end, sim_nodes(n, faults));
     let initial =
         configure(&mut link, &nodes(n), &options(), &mut |_| {}).expect("set-up succeeds");
     let t0 = Instant::now();
@@ -276,7 +237,7 @@ fn occasional_lost_frames_are_retried_and_tolerated() {
 #[test]
 fn a_node_that_never_boots_is_a_set_up_error_naming_it() {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
-    let drives = Drives::start(
+    let drives = sim_thread(
         drive_end,
         sim_nodes(4, |i| Faults {
             never_boots: i == 4,
