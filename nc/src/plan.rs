@@ -25,7 +25,7 @@
 //! period without allocation.
 
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
-use crate::scurve::{change_dist, push_change, reachable, Motion, Phase};
+use crate::scurve::{push_section, reachable, Motion, Phase};
 use crate::segment::{Geometry, Path, Segment};
 
 /// Limits of one machine axis, in mm or radians and seconds.
@@ -234,61 +234,6 @@ fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64,
     (acc.max(A_FLOOR), jerk.max(A_FLOOR))
 }
 
-/// Phases of one section from `va` to `vb` over `len`, cruising at most at `vmax`.
-fn section(
-    out: &mut Vec<Phase>,
-    t0: f64,
-    s0: f64,
-    (va, vb): (f64, f64),
-    len: f64,
-    vmax: f64,
-    (acc, jerk): (f64, f64),
-) -> f64 {
-    let lo = va.max(vb);
-    let fits = |vc: f64| change_dist(va, vc, acc, jerk) + change_dist(vc, vb, acc, jerk) <= len;
-    let vc = if vmax <= lo {
-        lo
-    } else if fits(vmax) {
-        vmax
-    } else {
-        let (mut l, mut h) = (lo, vmax);
-        for _ in 0..80 {
-            let m = 0.5 * (l + h);
-            if fits(m) {
-                l = m;
-            } else {
-                h = m;
-            }
-        }
-        l
-    };
-    let start = Motion {
-        s: s0,
-        v: va,
-        a: 0.0,
-    };
-    let (t1, m1) = push_change(out, t0, start, vc, acc, jerk);
-    let d2 = change_dist(vc, vb, acc, jerk);
-    let cruise = (len - (m1.s - s0) - d2).max(0.0);
-    let mut t = t1;
-    let mut m = m1;
-    if cruise > 0.0 && vc > 0.0 {
-        let ph = Phase {
-            t0: t,
-            dur: cruise / vc,
-            s0: m.s,
-            v0: vc,
-            a0: 0.0,
-            j: 0.0,
-        };
-        out.push(ph);
-        t += ph.dur;
-        m = ph.end();
-    }
-    let (t2, _) = push_change(out, t, m, vb, acc, jerk);
-    t2
-}
-
 /// Speed of a section's phases at path position `s` (bisection in time inside the phase).
 fn speed_at(phases: &[Phase], s: f64) -> f64 {
     let i = phases.partition_point(|p| p.s0 <= s).saturating_sub(1);
@@ -359,7 +304,7 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
             let ((ia, va), (ib, vb)) = (w[0], w[1]);
             let vmax = st[ia..=ib].iter().map(|x| x.vlim).fold(0.0, f64::max);
             let first = phases.len();
-            t = section(
+            t = push_section(
                 &mut phases,
                 t,
                 st[ia].s,

@@ -118,6 +118,63 @@ pub fn push_change(
     (t, m)
 }
 
+/// Append the phases of one section from `va` to `vb` over `len` starting at time `t0` and
+/// position `s0`: accelerate, cruise at the highest speed up to `vmax` that fits, decelerate,
+/// with acceleration and jerk limits `(acc, jerk)`. Returns the end time.
+pub fn push_section(
+    out: &mut Vec<Phase>,
+    t0: f64,
+    s0: f64,
+    (va, vb): (f64, f64),
+    len: f64,
+    vmax: f64,
+    (acc, jerk): (f64, f64),
+) -> f64 {
+    let lo = va.max(vb);
+    let fits = |vc: f64| change_dist(va, vc, acc, jerk) + change_dist(vc, vb, acc, jerk) <= len;
+    let vc = if vmax <= lo {
+        lo
+    } else if fits(vmax) {
+        vmax
+    } else {
+        let (mut l, mut h) = (lo, vmax);
+        for _ in 0..80 {
+            let m = 0.5 * (l + h);
+            if fits(m) {
+                l = m;
+            } else {
+                h = m;
+            }
+        }
+        l
+    };
+    let start = Motion {
+        s: s0,
+        v: va,
+        a: 0.0,
+    };
+    let (t1, m1) = push_change(out, t0, start, vc, acc, jerk);
+    let d2 = change_dist(vc, vb, acc, jerk);
+    let cruise = (len - (m1.s - s0) - d2).max(0.0);
+    let mut t = t1;
+    let mut m = m1;
+    if cruise > 0.0 && vc > 0.0 {
+        let ph = Phase {
+            t0: t,
+            dur: cruise / vc,
+            s0: m.s,
+            v0: vc,
+            a0: 0.0,
+            j: 0.0,
+        };
+        out.push(ph);
+        t += ph.dur;
+        m = ph.end();
+    }
+    let (t2, _) = push_change(out, t, m, vb, acc, jerk);
+    t2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -28,7 +28,7 @@ use drives::link::CanLink;
 use drives::master::{DriveFault, Master, MAX_NODES};
 use heapless::Vec as HVec;
 use nc::kinematics::Joints;
-use nc::scurve::{change_dist, push_change, reachable, Motion, Phase};
+use nc::scurve::{push_section, Phase};
 use nc::stream::Follower;
 
 /// A drive within this distance of the program's start (mm or degrees) is at the start.
@@ -121,25 +121,7 @@ impl Approach {
         }
         let mut phases = Vec::new();
         if v.is_finite() {
-            let vc = v.min(reachable(0.0, 0.5, a, j));
-            let (t1, m1) = push_change(&mut phases, 0.0, Motion::default(), vc, a, j);
-            let cruise = (1.0 - 2.0 * change_dist(0.0, vc, a, j)).max(0.0);
-            let mut t = t1;
-            let mut m = m1;
-            if cruise > 0.0 {
-                let ph = Phase {
-                    t0: t,
-                    dur: cruise / vc,
-                    s0: m.s,
-                    v0: vc,
-                    a0: 0.0,
-                    j: 0.0,
-                };
-                phases.push(ph);
-                t += ph.dur;
-                m = ph.end();
-            }
-            push_change(&mut phases, t, m, 0.0, a, j);
+            push_section(&mut phases, 0.0, 0.0, (0.0, 0.0), 1.0, v, (a, j));
         }
         let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
         Approach {
