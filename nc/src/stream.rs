@@ -258,6 +258,16 @@ pub struct Follower<'q> {
     joints: Joints,
     block: u32,
     counters: StreamCounters,
+    pending: Pending,
+}
+
+/// What [`Follower::advance`] leaves for [`Follower::evaluate`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pending {
+    /// The path position moved: evaluate the pose there (cycle).
+    Pose(u64),
+    /// The pose stands: report it again (cycle, feed).
+    Fixed(u64, f64),
 }
 
 impl<'q> Follower<'q> {
@@ -281,6 +291,7 @@ impl<'q> Follower<'q> {
             k: 1.0,
             r: 0.0,
             phase: 0,
+            pending: Pending::Fixed(0, 0.0),
             motion: Motion::default(),
             stop_requested: false,
             holding: false,
@@ -399,14 +410,23 @@ impl<'q> Follower<'q> {
         m
     }
 
-    /// One period: the next setpoint. Allocation-free; loops bounded by [`LOOKAHEAD`].
+    /// One period: the next setpoint ([`Follower::advance`] then [`Follower::evaluate`]).
+    /// Allocation-free; loops bounded by [`LOOKAHEAD`].
     pub fn step(&mut self) -> Setpoint {
+        self.advance();
+        self.evaluate()
+    }
+
+    /// The first half of a period: take arrived chunks, move the override and the plan time,
+    /// and find the new path position s. No curve is evaluated here.
+    pub fn advance(&mut self) {
         self.pull();
         let ts = self.hold.period;
         let cycle = self.cycle;
         self.cycle += 1;
         if cycle == 0 || self.done {
-            return self.setpoint(cycle, 0.0);
+            self.pending = Pending::Fixed(cycle, 0.0);
+            return;
         }
         // Nothing arrived yet: stay at the start (the plan starts from rest at tau = 0).
         if self.local.is_empty() {
@@ -415,7 +435,8 @@ impl<'q> Follower<'q> {
             if self.received < self.start.chunks && !self.stop_requested {
                 self.counters.hold_periods += 1;
             }
-            return self.setpoint(cycle, 0.0);
+            self.pending = Pending::Fixed(cycle, 0.0);
+            return;
         }
         let vb = self
             .local
@@ -475,13 +496,28 @@ impl<'q> Follower<'q> {
                 self.motion.s = self.motion.s.max(s1.min(m.s));
                 self.motion.v = 0.0;
                 self.motion.a = 0.0;
-                return self.pose_setpoint(cycle);
+                self.pending = Pending::Pose(cycle);
+                return;
             }
         }
         self.tau = tau;
         m.v *= self.k;
         self.motion = m;
-        self.pose_setpoint(cycle)
+        self.pending = Pending::Pose(cycle);
+    }
+
+    /// The second half of a period, the interpolation proper: u at the new path position
+    /// (arc-length inverse), both curves from one basis evaluation, the tool axis, inverse
+    /// kinematics. Calling it again before the next [`Follower::advance`] repeats the setpoint.
+    pub fn evaluate(&mut self) -> Setpoint {
+        match self.pending {
+            Pending::Fixed(cycle, feed) => self.setpoint(cycle, feed),
+            Pending::Pose(cycle) => {
+                let sp = self.pose_setpoint(cycle);
+                self.pending = Pending::Fixed(cycle, self.motion.v);
+                sp
+            }
+        }
     }
 
     fn pose_setpoint(&mut self, cycle: u64) -> Setpoint {

@@ -170,7 +170,8 @@ pub enum PipelineError {
 /// Counts of one cycle, for progress and the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct CycleInfo {
-    /// Interpolation compute time: from the start of the step to the last axis's counts.
+    /// Interpolation compute time: from the parameter update (u at the new arc length) through
+    /// the basis functions, both curves and inverse kinematics to the last axis's counts.
     pub compute_ns: u64,
     pub finished: bool,
 }
@@ -377,8 +378,12 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 }
             }
             Stage::Running | Stage::Stopping => {
+                // Feed, override and chunk hand-off first; the timed span is the paper's:
+                // parameter update (u at the new s), basis functions, both curves, tool axis,
+                // inverse kinematics, to the final axis positions in counts.
+                self.follower.advance();
                 let t0 = os::now();
-                let sp = self.follower.step();
+                let sp = self.follower.evaluate();
                 let axes = self.joints_to_axes(&sp.joints);
                 let overflow = self.set_targets(&axes);
                 compute_ns = os::now().saturating_sub(t0);
