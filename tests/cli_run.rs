@@ -1,5 +1,5 @@
 //! `dnurbs demo` and `dnurbs run` through the real binary: the demo runs the paper example
-//! against simulated drives on the in-process link and ends on the program's end point;
+//! against simulated drives on each in-process link and ends on the program's end point;
 //! `run` reports a bad program or machine before touching a bus.
 
 mod common;
@@ -8,12 +8,26 @@ use common::{data, dnurbs, machine, temp};
 
 #[test]
 fn demo_runs_the_paper_example_to_its_end_and_writes_the_report() {
-    let dir = temp("demo-report");
+    check_demo(None, "an in-memory CAN link");
+}
+
+#[test]
+fn demo_over_a_socketpair_runs_the_paper_example_to_its_end() {
+    check_demo(Some("socketpair"), "a socketpair CAN link");
+}
+
+fn check_demo(link: Option<&str>, bus: &str) {
+    let dir = temp(&format!("demo-report-{}", link.unwrap_or("default")));
     // --no-rt: the same loop without SCHED_FIFO, so the test needs no privileges.
-    let out = dnurbs(&["demo", "--no-rt", "--report", dir.to_str().unwrap()]);
+    let mut args = vec!["demo", "--no-rt", "--report", dir.to_str().unwrap()];
+    if let Some(l) = link {
+        args.extend(["--link", l]);
+    }
+    let out = dnurbs(&args);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stderr.contains(bus), "{stderr}");
     assert!(stdout.contains("program completed"), "{stdout}");
     assert!(stdout.contains("real-time: no (--no-rt)"), "{stdout}");
     // Every drive ends where the program ends, to the count, and follows its target.

@@ -1,5 +1,8 @@
 //! The one module that touches sockets: a non-blocking CAN link.
 //!
+//! [`MemLink`] is the in-memory bus of `dnurbs demo` and of tests that need no kernel:
+//! two bounded lock-free queues between the threads of one process.
+//!
 //! [`SocketLink`] wraps a `socketcan::CanSocket`. On a controller it is opened on a SocketCAN
 //! interface (`can0`, `vcan0`). For tests on a host without CAN support it is built on one
 //! end of an AF_UNIX `SOCK_SEQPACKET` socketpair ([`SocketLink::pair`]): each `can_frame`
@@ -14,9 +17,11 @@
 //!   counted and skipped (at most [`MAX_SKIPPED`] per call, so the loop is bounded).
 
 use crate::frame::CanFrame;
+use crossbeam_queue::ArrayQueue;
 use socketcan::{CanSocket, EmbeddedFrame, Id, Socket, StandardId};
 use std::io::{self, ErrorKind};
 use std::os::fd::OwnedFd;
+use std::sync::Arc;
 
 /// Most non-data frames skipped in one `recv` call before it returns `None`.
 pub const MAX_SKIPPED: usize = 64;
@@ -55,6 +60,64 @@ pub trait CanLink {
     fn send(&mut self, frame: &CanFrame) -> Result<Sent, LinkError>;
     /// The next received data frame, or `None` if none is waiting. Never blocks.
     fn recv(&mut self) -> Result<Option<CanFrame>, LinkError>;
+}
+
+/// One end of an in-memory CAN bus between two threads: frames sent at one end are received,
+/// in order, at the other. Each direction is a bounded lock-free queue allocated by
+/// [`MemLink::pair`]; `send` and `recv` never allocate, lock or make a system call.
+/// A full queue drops and counts the frame, like a full socket buffer.
+#[derive(Debug)]
+pub struct MemLink {
+    tx: Arc<ArrayQueue<CanFrame>>,
+    rx: Arc<ArrayQueue<CanFrame>>,
+    dropped: u64,
+}
+
+impl MemLink {
+    /// Two connected ends, each direction holding up to `capacity` frames (at least 1).
+    pub fn pair(capacity: usize) -> (MemLink, MemLink) {
+        let a = Arc::new(ArrayQueue::new(capacity.max(1)));
+        let b = Arc::new(ArrayQueue::new(capacity.max(1)));
+        let end = |tx: &Arc<_>, rx: &Arc<_>| MemLink {
+            tx: Arc::clone(tx),
+            rx: Arc::clone(rx),
+            dropped: 0,
+        };
+        (end(&a, &b), end(&b, &a))
+    }
+
+    /// Frames not sent because the other end's queue was full.
+    pub fn dropped(&self) -> u64 {
+        self.dropped
+    }
+
+    /// The other end has been dropped (each queue is shared by exactly the two ends).
+    fn peer_gone(&self) -> bool {
+        Arc::strong_count(&self.tx) < 2
+    }
+}
+
+impl CanLink for MemLink {
+    fn send(&mut self, frame: &CanFrame) -> Result<Sent, LinkError> {
+        if self.peer_gone() {
+            return Err(LinkError::Closed);
+        }
+        match self.tx.push(*frame) {
+            Ok(()) => Ok(Sent::Queued),
+            Err(_) => {
+                self.dropped += 1;
+                Ok(Sent::Dropped)
+            }
+        }
+    }
+
+    fn recv(&mut self) -> Result<Option<CanFrame>, LinkError> {
+        match self.rx.pop() {
+            Some(f) => Ok(Some(f)),
+            None if self.peer_gone() => Err(LinkError::Closed),
+            None => Ok(None),
+        }
+    }
 }
 
 /// A non-blocking SocketCAN socket (or one end of an in-process link).
@@ -204,6 +267,63 @@ mod tests {
             master.dropped()
         );
         assert_eq!(sent + master.dropped(), 100_000);
+    }
+
+    #[test]
+    fn the_memory_link_carries_frames_in_order_and_counts_a_full_queue() {
+        let (mut master, mut drives) = MemLink::pair(4);
+        assert_eq!(drives.recv(), Ok(None));
+        let seq = [
+            "000#0100",
+            "080#",
+            "605#2B40600006000000",
+            "201#0F00A0860100",
+        ];
+        for v in seq {
+            assert_eq!(master.send(&f(v)), Ok(Sent::Queued));
+        }
+        assert_eq!(master.send(&f("7FF#01")), Ok(Sent::Dropped));
+        assert_eq!(master.dropped(), 1);
+        for v in seq {
+            assert_eq!(drives.recv(), Ok(Some(f(v))));
+        }
+        assert_eq!(drives.recv(), Ok(None));
+        assert_eq!(drives.send(&f("701#05")), Ok(Sent::Queued));
+        assert_eq!(master.recv(), Ok(Some(f("701#05"))));
+        // Across threads, every frame arrives once and in order.
+        let (mut a, mut b) = MemLink::pair(16);
+        let sender = std::thread::spawn(move || {
+            for i in 0..10_000u32 {
+                let frame = CanFrame::new(0x201, &i.to_le_bytes()).expect("valid frame");
+                while a.send(&frame) != Ok(Sent::Queued) {
+                    std::thread::yield_now();
+                }
+            }
+            a
+        });
+        let mut next = 0u32;
+        while next < 10_000 {
+            match b.recv() {
+                Ok(Some(fr)) => {
+                    assert_eq!(fr.data(), &next.to_le_bytes());
+                    next += 1;
+                }
+                Ok(None) => std::thread::yield_now(),
+                Err(e) => panic!("{e}"),
+            }
+        }
+        sender.join().expect("the sending thread finishes");
+    }
+
+    #[test]
+    fn a_closed_memory_peer_is_an_error() {
+        let (mut master, mut drives) = MemLink::pair(4);
+        assert_eq!(drives.send(&f("701#05")), Ok(Sent::Queued));
+        drop(drives);
+        assert_eq!(master.send(&f("080#")), Err(LinkError::Closed));
+        // What was sent before the peer left can still be read, then the link reports it.
+        assert_eq!(master.recv(), Ok(Some(f("701#05"))));
+        assert_eq!(master.recv(), Err(LinkError::Closed));
     }
 
     #[test]

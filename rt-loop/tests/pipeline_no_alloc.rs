@@ -3,10 +3,12 @@
 //! against simulated drives in another thread, while a planner thread streams segments
 //! through a 4-deep queue. A counting global allocator counts allocations and frees made
 //! by the loop's own thread (the planner and the drives allocate freely in theirs), and
-//! getrusage(RUSAGE_THREAD) counts its minor page faults. Its own test binary, one test.
+//! getrusage(RUSAGE_THREAD) counts its minor page faults. Run once over the kernel
+//! socketpair link (the socketcan code path) and once over the in-memory link of
+//! `dnurbs demo`; the counts are per thread, so the two tests may run side by side.
 
 use config::bus::Drive;
-use drives::link::SocketLink;
+use drives::link::{CanLink, MemLink, SocketLink};
 use drives::master::{configure, Master, SetupOptions, Supervision};
 use drives::sim::{SimNodeConfig, SimThread};
 use drives::wire::NodeId;
@@ -17,30 +19,33 @@ use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, Stage};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 struct Counting;
-static EVENTS: AtomicU64 = AtomicU64::new(0);
 thread_local! {
     static ARMED: Cell<bool> = const { Cell::new(false) };
+    /// Allocations and frees made by this thread while armed.
+    static EVENTS: Cell<u64> = const { Cell::new(0) };
 }
 
-fn armed() -> bool {
-    ARMED.try_with(Cell::get).unwrap_or(false)
+fn count() {
+    if ARMED.try_with(Cell::get).unwrap_or(false) {
+        let _ = EVENTS.try_with(|e| e.set(e.get() + 1));
+    }
+}
+
+fn events() -> u64 {
+    EVENTS.with(Cell::get)
 }
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if armed() {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
+        count();
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        if armed() {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
+        count();
         unsafe { System.dealloc(ptr, layout) }
     }
 }
@@ -63,7 +68,18 @@ fn drive(axis: usize, node: u8, counts_per_unit: f64) -> Drive {
 }
 
 #[test]
-fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
+fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods_on_a_socketpair() {
+    let (link, drive_end) = SocketLink::pair().unwrap();
+    prove(link, drive_end);
+}
+
+#[test]
+fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods_on_the_memory_link() {
+    let (link, drive_end) = MemLink::pair(1024);
+    prove(link, drive_end);
+}
+
+fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(mut link: L, drive_end: D) {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let program = nc::parse::parse(PAPER).unwrap();
@@ -80,7 +96,6 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
         drive(4, 5, 1000.0),
     ];
     let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
-    let (mut link, drive_end) = SocketLink::pair().unwrap();
     let sims = nodes.iter().map(|&n| SimNodeConfig::new(n)).collect();
     let sim = SimThread::start(drive_end, sims, PERIOD, Duration::from_micros(20)).unwrap();
     let mut opts = SetupOptions::new(PERIOD);
@@ -132,7 +147,7 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
                 let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
                 os::sleep_until(os::now());
                 let f0 = os::minor_faults();
-                let e0 = EVENTS.load(Ordering::SeqCst);
+                let e0 = events();
                 ARMED.with(|a| a.set(true));
                 drive_loop(
                     &mut rec,
@@ -143,7 +158,7 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods() {
                     2_000_000,
                 );
                 ARMED.with(|a| a.set(false));
-                let e = EVENTS.load(Ordering::SeqCst) - e0;
+                let e = events() - e0;
                 let f = os::minor_faults() - f0;
                 finished.store(true, Ordering::SeqCst);
                 (e, f)

@@ -1,6 +1,7 @@
 //! `dnurbs`: real-time 5-axis double-NURBS interpolation.
 
 use clap::{Parser, Subcommand, ValueEnum};
+use dnurbs_tools::run::DemoLink;
 use dnurbs_tools::simdrives;
 use dnurbs_tools::simulate::{run, summarize, write_trace};
 use dnurbs_tools::{load_machine, load_program, setup::MachineSetup, InputError};
@@ -34,6 +35,12 @@ enum MethodArg {
     Taylor2,
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum DemoLinkArg {
+    Memory,
+    Socketpair,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// The main job on built-in defaults: the paper's example program on the paper's machine,
@@ -47,6 +54,11 @@ enum Command {
         /// Do not even try SCHED_FIFO and mlockall.
         #[arg(long)]
         no_rt: bool,
+        /// The in-process bus between the master and the simulated drives: `memory` (lock-free
+        /// queues, no system call per frame) or `socketpair` (a kernel socket carrying
+        /// can_frame structs through the same socketcan calls as a CAN interface).
+        #[arg(long, value_enum, default_value_t = DemoLinkArg::Memory)]
+        link: DemoLinkArg,
     },
     /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
     /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
@@ -177,7 +189,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Demo { report, no_rt } => demo(report, no_rt),
+        Command::Demo {
+            report,
+            no_rt,
+            link,
+        } => demo(report, no_rt, link),
         Command::Run {
             program,
             machine,
@@ -412,7 +428,7 @@ fn finish_run(
     }
 }
 
-fn demo(report: Option<PathBuf>, no_rt: bool) -> anyhow::Result<()> {
+fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLinkArg) -> anyhow::Result<()> {
     let opts = dnurbs_tools::run::RunOptions {
         name: "paper-example.nc".into(),
         approach: true,
@@ -424,11 +440,15 @@ fn demo(report: Option<PathBuf>, no_rt: bool) -> anyhow::Result<()> {
         report: report.clone(),
         progress: true,
     };
+    let (link, bus) = match link {
+        DemoLinkArg::Memory => (DemoLink::Memory, "an in-memory CAN link"),
+        DemoLinkArg::Socketpair => (DemoLink::Socketpair, "a socketpair CAN link"),
+    };
     eprintln!(
         "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
-         CiA-402 drives on an in-process CAN link, 2 ms period"
+         CiA-402 drives on {bus}, 2 ms period"
     );
-    let (r, records) = dnurbs_tools::run::demo(&opts)?;
+    let (r, records) = dnurbs_tools::run::demo(&opts, link)?;
     println!("simulated drives received {} targets", records.len());
     finish_run(&r, report, "dnurbs demo: paper example, 2 ms")
 }

@@ -13,7 +13,7 @@
 use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
-use drives::link::SocketLink;
+use drives::link::{CanLink, MemLink, SocketLink};
 use drives::master::{configure, Master, SetupOptions, Supervision};
 use drives::wire::NodeId;
 use nc::plan::plan;
@@ -116,10 +116,10 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
 /// Run `src` on `machine`. `open_links` gives one link per `[[bus]]` (in the machine file's
 /// order); it is called once the program has been parsed, built and planned, so a bad
 /// program is reported before anything touches the bus.
-pub fn run(
+pub fn run<L: CanLink + Send>(
     src: &str,
     machine: &Machine,
-    open_links: impl FnOnce() -> anyhow::Result<Vec<SocketLink>>,
+    open_links: impl FnOnce() -> anyhow::Result<Vec<L>>,
     opts: &RunOptions,
 ) -> anyhow::Result<RunResult> {
     check_drives(machine)?;
@@ -254,8 +254,8 @@ pub fn run(
     })
 }
 
-fn run_threads(
-    pipeline: &mut Pipeline<'_, SocketLink>,
+fn run_threads<L: CanLink + Send>(
+    pipeline: &mut Pipeline<'_, L>,
     period_ns: u64,
     stop: &'static AtomicBool,
     opts: &RunOptions,
@@ -381,17 +381,44 @@ pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-tabl
 /// The demo's program: the paper's example.
 pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
 
+/// The in-process bus of `dnurbs demo`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DemoLink {
+    /// [`MemLink`]: lock-free queues in memory; the cycle makes no system call for the bus.
+    Memory,
+    /// [`SocketLink::pair`]: a kernel socketpair carrying `can_frame` structs through the
+    /// same socketcan read/write calls as a CAN interface, one system call per frame.
+    Socketpair,
+}
+
+/// Frames each direction of the demo's memory bus holds (a few hundred periods' worth).
+pub const DEMO_QUEUE_FRAMES: usize = 1024;
+
 /// `dnurbs demo`: the paper's example on the paper's machine, its five drives simulated in a
-/// thread on the other end of an in-process link (the same socketcan code path as a bus).
-pub fn demo(opts: &RunOptions) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
+/// thread on the other end of an in-process link.
+pub fn demo(
+    opts: &RunOptions,
+    link: DemoLink,
+) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
     let machine = config::from_str(
         DEMO_MACHINE,
         std::path::Path::new("config/machines/paper-ac-table.toml"),
     )?;
+    match link {
+        DemoLink::Memory => demo_on(&machine, opts, || Ok(MemLink::pair(DEMO_QUEUE_FRAMES))),
+        DemoLink::Socketpair => demo_on(&machine, opts, SocketLink::pair),
+    }
+}
+
+fn demo_on<L: CanLink + Send + 'static>(
+    machine: &Machine,
+    opts: &RunOptions,
+    pair: impl Fn() -> std::io::Result<(L, L)>,
+) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
     let mut links = Vec::new();
     let mut sims = Vec::new();
     for bi in 0..machine.buses.len() {
-        let (master_end, drive_end) = SocketLink::pair()?;
+        let (master_end, drive_end) = pair()?;
         let nodes = machine
             .drives
             .iter()
@@ -410,7 +437,7 @@ pub fn demo(opts: &RunOptions) -> anyhow::Result<(RunResult, Vec<drives::sim::Re
         )?);
         links.push(master_end);
     }
-    let result = run(DEMO_PROGRAM, &machine, move || Ok(links), opts);
+    let result = run(DEMO_PROGRAM, machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))
 }
