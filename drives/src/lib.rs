@@ -23,7 +23,7 @@
 //! - [`cia402`]: the device-control state machine, the master's [`Sequencer`] and a
 //!   drive-side [`DriveModel`] for the simulated drive.
 //! - [`od`]: object dictionary indices used by the master.
-//! - [`link`]: the non-blocking CAN link: SocketCAN, or an in-process socketpair for tests.
+//! - [`link`]: the non-blocking CAN link: SocketCAN, an in-process socketpair, or memory.
 //! - [`sim`]: simulated CiA-402 drives (the slave side of the bus, sans-I/O), for
 //!   `dnurbs sim-drives` and for testing the master. Not real-time: it allocates.
 //!
@@ -32,9 +32,10 @@
 //!
 //! Nothing in these modules allocates (`sim` excepted), blocks, reads a clock or panics on
 //! any input; time, when it matters (SDO timeouts, heartbeat supervision), will be passed in by the transport
-//! layer. The modules are `#![forbid(unsafe_code)]` each, so that a transport module that
-//! needs `unsafe` for socket set-up can relax only the crate-level attribute below.
-#![forbid(unsafe_code)]
+//! layer. `unsafe` is denied crate-wide; the only exception is in `link`: the two
+//! `sendmmsg`/`recvmmsg` wrappers that batch a cycle's frames into one system call each,
+//! each with its SAFETY argument.
+#![deny(unsafe_code)]
 
 pub mod cia402;
 pub mod frame;

@@ -15,16 +15,22 @@
 //!   decides what a lost frame means.
 //! * [`CanLink::recv`] returns `None` when nothing is waiting. Remote and error frames are
 //!   counted and skipped (at most [`MAX_SKIPPED`] per call, so the loop is bounded).
+//! * [`CanLink::send_all`] and [`CanLink::recv_all`] move a cycle's frames in batches. On a
+//!   [`SocketLink`] each is one `sendmmsg`/`recvmmsg` system call instead of one call per
+//!   frame (the master sends 5 RPDOs and a SYNC and reads as many frames per period); these
+//!   two wrappers are the crate's only `unsafe` code.
 
 use crate::frame::CanFrame;
 use crossbeam_queue::ArrayQueue;
 use socketcan::{CanSocket, EmbeddedFrame, Id, Socket, StandardId};
 use std::io::{self, ErrorKind};
-use std::os::fd::OwnedFd;
+use std::os::fd::{AsRawFd, OwnedFd, RawFd};
 use std::sync::Arc;
 
 /// Most non-data frames skipped in one `recv` call before it returns `None`.
 pub const MAX_SKIPPED: usize = 64;
+/// Frames per `sendmmsg` / `recvmmsg` call of [`SocketLink`].
+pub const BATCH: usize = 32;
 
 /// What happened to a frame handed to [`CanLink::send`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,6 +50,13 @@ pub enum LinkError {
 }
 
 impl LinkError {
+    fn from_errno(e: i32) -> LinkError {
+        match e {
+            nix::libc::EPIPE | nix::libc::ECONNRESET => LinkError::Closed,
+            _ => LinkError::Os(e),
+        }
+    }
+
     fn from_io(e: &io::Error) -> LinkError {
         match e.kind() {
             ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
@@ -60,6 +73,32 @@ pub trait CanLink {
     fn send(&mut self, frame: &CanFrame) -> Result<Sent, LinkError>;
     /// The next received data frame, or `None` if none is waiting. Never blocks.
     fn recv(&mut self) -> Result<Option<CanFrame>, LinkError>;
+
+    /// Queue `frames` in order without blocking; returns how many were dropped (full queue).
+    /// A link may batch them into fewer system calls; the default sends one by one.
+    fn send_all(&mut self, frames: &[CanFrame]) -> Result<usize, LinkError> {
+        let mut dropped = 0;
+        for f in frames {
+            if self.send(f)? == Sent::Dropped {
+                dropped += 1;
+            }
+        }
+        Ok(dropped)
+    }
+
+    /// Fill `out` with waiting data frames, in order; returns how many. Never blocks; 0 when
+    /// none is waiting. The default receives one by one.
+    fn recv_all(&mut self, out: &mut [CanFrame]) -> Result<usize, LinkError> {
+        let mut n = 0;
+        for slot in out.iter_mut() {
+            match self.recv()? {
+                Some(f) => *slot = f,
+                None => break,
+            }
+            n += 1;
+        }
+        Ok(n)
+    }
 }
 
 /// One end of an in-memory CAN bus between two threads: frames sent at one end are received,
@@ -195,6 +234,63 @@ impl CanLink for SocketLink {
         }
     }
 
+    /// One `sendmmsg` for the whole batch (a few more only if the queue fills part-way).
+    fn send_all(&mut self, frames: &[CanFrame]) -> Result<usize, LinkError> {
+        let mut raw = [RawFrame::default(); BATCH];
+        let mut dropped = 0;
+        for chunk in frames.chunks(BATCH) {
+            for (r, f) in raw.iter_mut().zip(chunk) {
+                *r = RawFrame::from(f);
+            }
+            let mut done = 0;
+            // Each pass sends at least one frame or drops one: at most chunk.len() passes.
+            while done < chunk.len() {
+                match sendmmsg(self.sock.as_raw_fd(), &raw[done..chunk.len()]) {
+                    Ok(n) => done += n.max(1),
+                    Err(e) if e == nix::libc::EAGAIN || e == nix::libc::ENOBUFS => {
+                        done += 1;
+                        dropped += 1;
+                        self.dropped += 1;
+                    }
+                    Err(e) => return Err(LinkError::from_errno(e)),
+                }
+            }
+        }
+        Ok(dropped)
+    }
+
+    /// One `recvmmsg` per [`BATCH`] frames; remote, error and extended frames are skipped.
+    fn recv_all(&mut self, out: &mut [CanFrame]) -> Result<usize, LinkError> {
+        let mut raw = [RawFrame::default(); BATCH];
+        let mut n = 0;
+        // Bounded: each pass reads up to BATCH frames, at most MAX_SKIPPED of them skipped.
+        for _ in 0..out.len() + MAX_SKIPPED {
+            let want = (out.len() - n).min(BATCH);
+            if want == 0 {
+                break;
+            }
+            let got = match recvmmsg(self.sock.as_raw_fd(), &mut raw[..want]) {
+                Ok(0) => break,
+                Ok(got) => got,
+                Err(e) if e == nix::libc::EAGAIN => break,
+                Err(e) => return Err(LinkError::from_errno(e)),
+            };
+            for r in &raw[..got] {
+                match r.to_frame() {
+                    Some(f) => {
+                        out[n] = f;
+                        n += 1;
+                    }
+                    None => self.skipped += 1,
+                }
+            }
+            if got < want {
+                break;
+            }
+        }
+        Ok(n)
+    }
+
     fn recv(&mut self) -> Result<Option<CanFrame>, LinkError> {
         for _ in 0..MAX_SKIPPED {
             match self.sock.read_frame() {
@@ -213,6 +309,114 @@ impl CanLink for SocketLink {
         }
         Ok(None)
     }
+}
+
+/// The kernel's `struct can_frame` (linux/can.h): 32-bit id with flags, length, padding,
+/// 8 data bytes aligned to 8. SocketCAN and the socketpair both carry exactly this.
+#[repr(C, align(8))]
+#[derive(Clone, Copy, Default)]
+struct RawFrame {
+    can_id: u32,
+    len: u8,
+    pad: u8,
+    res0: u8,
+    len8_dlc: u8,
+    data: [u8; 8],
+}
+
+const _: () = assert!(std::mem::size_of::<RawFrame>() == 16);
+
+/// Flags in `can_id`: extended identifier, remote request, error frame.
+const CAN_FLAGS: u32 = 0xE000_0000;
+
+impl From<&CanFrame> for RawFrame {
+    fn from(f: &CanFrame) -> RawFrame {
+        let mut r = RawFrame {
+            can_id: u32::from(f.id()),
+            len: f.data().len() as u8,
+            ..RawFrame::default()
+        };
+        r.data[..f.data().len()].copy_from_slice(f.data());
+        r
+    }
+}
+
+impl RawFrame {
+    /// A standard-identifier data frame, or `None` for anything CANopen does not use.
+    fn to_frame(self) -> Option<CanFrame> {
+        if self.can_id & CAN_FLAGS != 0 || self.can_id > 0x7FF || self.len > 8 {
+            return None;
+        }
+        CanFrame::new(self.can_id as u16, &self.data[..usize::from(self.len)])
+    }
+}
+
+/// `sendmmsg(2)` of `frames`, non-blocking: how many the kernel took, or the errno.
+#[allow(unsafe_code)]
+fn sendmmsg(fd: RawFd, frames: &[RawFrame]) -> Result<usize, i32> {
+    use nix::libc;
+    let mut iov = [libc::iovec {
+        iov_base: std::ptr::null_mut(),
+        iov_len: 0,
+    }; BATCH];
+    // SAFETY: all-zero is a valid mmsghdr (null pointers, zero lengths).
+    let mut msgs: [libc::mmsghdr; BATCH] = unsafe { std::mem::zeroed() };
+    let n = frames.len().min(BATCH);
+    for i in 0..n {
+        iov[i].iov_base = std::ptr::from_ref(&frames[i]).cast_mut().cast();
+        iov[i].iov_len = std::mem::size_of::<RawFrame>();
+        msgs[i].msg_hdr.msg_iov = &mut iov[i];
+        msgs[i].msg_hdr.msg_iovlen = 1;
+    }
+    // SAFETY: msgs[..n] point at n live iovecs, each at one live 16-byte frame that the
+    // kernel only reads; all of them outlive the call.
+    let r = unsafe { libc::sendmmsg(fd, msgs.as_mut_ptr(), n as _, libc::MSG_DONTWAIT as _) };
+    if r < 0 {
+        Err(nix::errno::Errno::last_raw())
+    } else {
+        Ok(r as usize)
+    }
+}
+
+/// `recvmmsg(2)` into `frames`, non-blocking: how many arrived, or the errno.
+#[allow(unsafe_code)]
+fn recvmmsg(fd: RawFd, frames: &mut [RawFrame]) -> Result<usize, i32> {
+    use nix::libc;
+    let mut iov = [libc::iovec {
+        iov_base: std::ptr::null_mut(),
+        iov_len: 0,
+    }; BATCH];
+    // SAFETY: all-zero is a valid mmsghdr (null pointers, zero lengths).
+    let mut msgs: [libc::mmsghdr; BATCH] = unsafe { std::mem::zeroed() };
+    let n = frames.len().min(BATCH);
+    for i in 0..n {
+        iov[i].iov_base = std::ptr::from_mut(&mut frames[i]).cast();
+        iov[i].iov_len = std::mem::size_of::<RawFrame>();
+        msgs[i].msg_hdr.msg_iov = &mut iov[i];
+        msgs[i].msg_hdr.msg_iovlen = 1;
+    }
+    // SAFETY: msgs[..n] point at n live iovecs, each at one live, exclusively borrowed
+    // 16-byte frame; the kernel writes at most iov_len bytes into each.
+    let r = unsafe {
+        libc::recvmmsg(
+            fd,
+            msgs.as_mut_ptr(),
+            n as _,
+            libc::MSG_DONTWAIT as _,
+            std::ptr::null_mut(),
+        )
+    };
+    if r < 0 {
+        return Err(nix::errno::Errno::last_raw());
+    }
+    let got = r as usize;
+    // A datagram shorter than a can_frame is not one: mark it for skipping.
+    for (f, m) in frames.iter_mut().zip(&msgs).take(got) {
+        if (m.msg_len as usize) < std::mem::size_of::<RawFrame>() {
+            f.can_id = CAN_FLAGS;
+        }
+    }
+    Ok(got)
 }
 
 #[cfg(test)]
@@ -267,6 +471,85 @@ mod tests {
             master.dropped()
         );
         assert_eq!(sent + master.dropped(), 100_000);
+    }
+
+    #[test]
+    fn batches_cross_the_socketpair_unchanged_and_skip_what_canopen_does_not_use() {
+        use nix::sys::socket::{socketpair, AddressFamily, SockFlag, SockType};
+        let (a, b) = socketpair(
+            AddressFamily::Unix,
+            SockType::SeqPacket,
+            None,
+            SockFlag::SOCK_CLOEXEC,
+        )
+        .unwrap();
+        // One end through socketcan directly, to send what SocketLink never sends.
+        let raw = CanSocket::from(a);
+        let mut link = SocketLink::from_fd(b).unwrap();
+        let mut out = [f("080#"); 8];
+        assert_eq!(link.recv_all(&mut out), Ok(0));
+        let rtr = socketcan::CanFrame::new_remote(StandardId::new(0x181).unwrap(), 0).unwrap();
+        let ext =
+            socketcan::CanFrame::new(socketcan::ExtendedId::new(0x1234).unwrap(), &[1]).unwrap();
+        let data = |v: &str| {
+            let c = f(v);
+            socketcan::CanFrame::new(StandardId::new(c.id()).unwrap(), c.data()).unwrap()
+        };
+        for fr in [
+            data("181#3712A0860100"),
+            rtr,
+            data("701#05"),
+            ext,
+            data("081#0000"),
+        ] {
+            raw.write_frame(&fr).unwrap();
+        }
+        assert_eq!(link.recv_all(&mut out), Ok(3));
+        assert_eq!(
+            out[..3],
+            [f("181#3712A0860100"), f("701#05"), f("081#0000")]
+        );
+        assert_eq!(link.skipped(), 2);
+        // A batch sent in one call arrives whole and in order, and more than BATCH frames
+        // are split across calls.
+        let batch: Vec<CanFrame> = (0..BATCH as u16 + 7)
+            .map(|i| CanFrame::new(0x200 + (i % 16), &i.to_le_bytes()).unwrap())
+            .collect();
+        assert_eq!(link.send_all(&batch), Ok(0));
+        for want in &batch {
+            let got = raw.read_frame().unwrap();
+            assert_eq!(got.id(), Id::Standard(StandardId::new(want.id()).unwrap()));
+            assert_eq!(got.data(), want.data());
+        }
+    }
+
+    #[test]
+    fn a_full_queue_drops_and_counts_the_rest_of_a_batch() {
+        let (mut master, mut drives) = SocketLink::pair().unwrap();
+        let batch = [f("201#0F00A0860100"); 6];
+        let mut queued = 0usize;
+        let mut dropped = 0usize;
+        for _ in 0..20_000 {
+            let d = master.send_all(&batch).unwrap();
+            dropped += d;
+            queued += batch.len() - d;
+        }
+        assert!(
+            queued > 0 && dropped > 0,
+            "queued {queued}, dropped {dropped}"
+        );
+        assert_eq!(master.dropped() as usize, dropped);
+        // Exactly the queued ones arrive.
+        let mut out = [f("080#"); 64];
+        let mut got = 0;
+        loop {
+            let n = drives.recv_all(&mut out).unwrap();
+            if n == 0 {
+                break;
+            }
+            got += n;
+        }
+        assert_eq!(got, queued);
     }
 
     #[test]
@@ -366,7 +649,21 @@ mod tests {
             }
         }
         assert_eq!(got, seq.map(f));
+        // The same through the batched calls (sendmmsg / recvmmsg), as the master uses them.
+        assert_eq!(a.send_all(&seq.map(f)), Ok(0));
+        let mut buf = [f("080#"); 16];
+        let mut got = Vec::new();
+        for _ in 0..1000 {
+            let n = b.recv_all(&mut buf).unwrap();
+            got.extend_from_slice(&buf[..n]);
+            if got.len() >= seq.len() {
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        assert_eq!(got, seq.map(f));
         // The sender does not receive its own frames (CAN_RAW_RECV_OWN_MSGS is off).
         assert_eq!(a.recv(), Ok(None));
+        assert_eq!(a.recv_all(&mut buf), Ok(0));
     }
 }

@@ -16,7 +16,8 @@
 //! quick-stop ramp, never toward a stale target.
 
 use crate::cia402::{Goal, Sequencer, State, Statusword};
-use crate::link::{CanLink, LinkError, Sent};
+use crate::frame::CanFrame;
+use crate::link::{CanLink, LinkError};
 use crate::wire::emcy::{self, Emcy};
 use crate::wire::heartbeat::{self, NmtState};
 use crate::wire::pdo::{decode_tpdo1_csp, rpdo1_csp};
@@ -27,6 +28,8 @@ use heapless::Vec as HVec;
 pub const MAX_NODES: usize = 16;
 /// Most frames consumed per cycle.
 pub const MAX_RX_PER_CYCLE: usize = 8 * MAX_NODES + 16;
+/// Frames received per [`CanLink::recv_all`] call.
+const RX_BATCH: usize = 32;
 
 /// What the master knows of one drive.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -180,51 +183,64 @@ impl<L: CanLink> Master<L> {
     }
 
     fn receive(&mut self, now: f64) {
-        for _ in 0..MAX_RX_PER_CYCLE {
-            let frame = match self.link.recv() {
-                Ok(Some(f)) => f,
-                Ok(None) => break,
+        let mut buf = [sync::encode(); RX_BATCH];
+        let mut total = 0;
+        // Bounded: every pass that does not end the loop adds RX_BATCH or more to `total`.
+        while total < MAX_RX_PER_CYCLE {
+            let want = RX_BATCH.min(MAX_RX_PER_CYCLE - total);
+            let n = match self.link.recv_all(&mut buf[..want]) {
+                Ok(n) => n.min(want),
                 Err(e) => {
                     let node = self.nodes.first().map_or(0, |n| n.node.get());
                     self.raise(node, FaultCause::Link(e));
                     break;
                 }
             };
-            let Some(i) = (match classify(&frame) {
-                Received::Tpdo { node, .. }
-                | Received::Emcy { node }
-                | Received::Heartbeat { node } => self.nodes.iter().position(|n| n.node == node),
-                _ => None,
-            }) else {
-                continue;
-            };
-            let n = &mut self.nodes[i];
-            match classify(&frame) {
-                Received::Tpdo { n: 1, .. } => {
-                    if let Ok((_, fb)) = decode_tpdo1_csp(&frame) {
-                        n.statusword = fb.statusword;
-                        n.actual = fb.actual;
-                        n.state = State::from_statusword(fb.statusword);
-                        n.cycles_without_feedback = 0;
-                    }
-                }
-                Received::Emcy { .. } => {
-                    if let Ok((_, e)) = emcy::decode(&frame) {
-                        n.last_emcy = Some(e);
-                        if e.error_code != 0 {
-                            let node = n.node.get();
-                            self.raise(node, FaultCause::Emcy(e));
-                        }
-                    }
-                }
-                Received::Heartbeat { .. } => {
-                    if let Ok((_, state)) = heartbeat::decode(&frame) {
-                        n.nmt = Some(state);
-                        n.last_heartbeat = Some(now);
-                    }
-                }
-                _ => {}
+            for frame in &buf[..n] {
+                self.handle(frame, now);
             }
+            total += want;
+            if n < want {
+                break;
+            }
+        }
+    }
+
+    fn handle(&mut self, frame: &CanFrame, now: f64) {
+        let Some(i) = (match classify(frame) {
+            Received::Tpdo { node, .. }
+            | Received::Emcy { node }
+            | Received::Heartbeat { node } => self.nodes.iter().position(|n| n.node == node),
+            _ => None,
+        }) else {
+            return;
+        };
+        let n = &mut self.nodes[i];
+        match classify(frame) {
+            Received::Tpdo { n: 1, .. } => {
+                if let Ok((_, fb)) = decode_tpdo1_csp(frame) {
+                    n.statusword = fb.statusword;
+                    n.actual = fb.actual;
+                    n.state = State::from_statusword(fb.statusword);
+                    n.cycles_without_feedback = 0;
+                }
+            }
+            Received::Emcy { .. } => {
+                if let Ok((_, e)) = emcy::decode(frame) {
+                    n.last_emcy = Some(e);
+                    if e.error_code != 0 {
+                        let node = n.node.get();
+                        self.raise(node, FaultCause::Emcy(e));
+                    }
+                }
+            }
+            Received::Heartbeat { .. } => {
+                if let Ok((_, state)) = heartbeat::decode(frame) {
+                    n.nmt = Some(state);
+                    n.last_heartbeat = Some(now);
+                }
+            }
+            _ => {}
         }
     }
 
@@ -300,6 +316,7 @@ impl<L: CanLink> Master<L> {
         self.supervise(now);
         let goal = self.goal;
         let hold = self.fault.is_some();
+        let mut out: HVec<CanFrame, { MAX_NODES + 1 }> = HVec::new();
         for (i, n) in self.nodes.iter_mut().enumerate() {
             let state = n.state.unwrap_or(State::SwitchOnDisabled);
             let cw = n.seq.step(state, goal);
@@ -307,12 +324,13 @@ impl<L: CanLink> Master<L> {
                 (State::OperationEnabled, Some(&t)) if !hold => t,
                 _ => n.actual,
             };
-            if let Ok(Sent::Dropped) = self.link.send(&rpdo1_csp(n.node, cw.0, n.target)) {
-                self.dropped += 1;
-            }
+            // At most MAX_NODES nodes: there is room.
+            let _ = out.push(rpdo1_csp(n.node, cw.0, n.target));
         }
-        if let Ok(Sent::Dropped) = self.link.send(&sync::encode()) {
-            self.dropped += 1;
+        let _ = out.push(sync::encode());
+        // The RPDOs and the SYNC in one batch (one system call on a socket).
+        if let Ok(dropped) = self.link.send_all(&out) {
+            self.dropped += dropped as u64;
         }
         self.fault
     }
