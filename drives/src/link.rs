@@ -351,67 +351,68 @@ impl RawFrame {
     }
 }
 
+/// The headers of one `sendmmsg`/`recvmmsg` call, message i carrying one frame. Once aimed,
+/// each header points at its own iovec: built and used in place, never moved.
+struct Headers {
+    iov: [nix::libc::iovec; BATCH],
+    msgs: [nix::libc::mmsghdr; BATCH],
+}
+
+impl Headers {
+    #[allow(unsafe_code)]
+    fn new() -> Headers {
+        // SAFETY: all-zero is a valid iovec and mmsghdr (null pointers, zero lengths).
+        unsafe { std::mem::zeroed() }
+    }
+
+    /// Aim the first messages at the `len` frames from `base`; how many (at most BATCH).
+    fn aim(&mut self, base: *mut RawFrame, len: usize) -> usize {
+        let n = len.min(BATCH);
+        for i in 0..n {
+            self.iov[i].iov_base = base.wrapping_add(i).cast();
+            self.iov[i].iov_len = std::mem::size_of::<RawFrame>();
+            self.msgs[i].msg_hdr.msg_iov = &mut self.iov[i];
+            self.msgs[i].msg_hdr.msg_iovlen = 1;
+        }
+        n
+    }
+}
+
+/// A system call's count, or its errno.
+fn counted(r: nix::libc::c_int) -> Result<usize, i32> {
+    usize::try_from(r).map_err(|_| nix::errno::Errno::last_raw())
+}
+
 /// `sendmmsg(2)` of `frames`, non-blocking: how many the kernel took, or the errno.
 #[allow(unsafe_code)]
 fn sendmmsg(fd: RawFd, frames: &[RawFrame]) -> Result<usize, i32> {
     use nix::libc;
-    let mut iov = [libc::iovec {
-        iov_base: std::ptr::null_mut(),
-        iov_len: 0,
-    }; BATCH];
-    // SAFETY: all-zero is a valid mmsghdr (null pointers, zero lengths).
-    let mut msgs: [libc::mmsghdr; BATCH] = unsafe { std::mem::zeroed() };
-    let n = frames.len().min(BATCH);
-    for i in 0..n {
-        iov[i].iov_base = std::ptr::from_ref(&frames[i]).cast_mut().cast();
-        iov[i].iov_len = std::mem::size_of::<RawFrame>();
-        msgs[i].msg_hdr.msg_iov = &mut iov[i];
-        msgs[i].msg_hdr.msg_iovlen = 1;
-    }
-    // SAFETY: msgs[..n] point at n live iovecs, each at one live 16-byte frame that the
+    let mut h = Headers::new();
+    let n = h.aim(frames.as_ptr().cast_mut(), frames.len());
+    // SAFETY: h.msgs[..n] point at n live iovecs, each at one live 16-byte frame that the
     // kernel only reads; all of them outlive the call.
-    let r = unsafe { libc::sendmmsg(fd, msgs.as_mut_ptr(), n as _, libc::MSG_DONTWAIT as _) };
-    if r < 0 {
-        Err(nix::errno::Errno::last_raw())
-    } else {
-        Ok(r as usize)
-    }
+    counted(unsafe { libc::sendmmsg(fd, h.msgs.as_mut_ptr(), n as _, libc::MSG_DONTWAIT as _) })
 }
 
 /// `recvmmsg(2)` into `frames`, non-blocking: how many arrived, or the errno.
 #[allow(unsafe_code)]
 fn recvmmsg(fd: RawFd, frames: &mut [RawFrame]) -> Result<usize, i32> {
     use nix::libc;
-    let mut iov = [libc::iovec {
-        iov_base: std::ptr::null_mut(),
-        iov_len: 0,
-    }; BATCH];
-    // SAFETY: all-zero is a valid mmsghdr (null pointers, zero lengths).
-    let mut msgs: [libc::mmsghdr; BATCH] = unsafe { std::mem::zeroed() };
-    let n = frames.len().min(BATCH);
-    for i in 0..n {
-        iov[i].iov_base = std::ptr::from_mut(&mut frames[i]).cast();
-        iov[i].iov_len = std::mem::size_of::<RawFrame>();
-        msgs[i].msg_hdr.msg_iov = &mut iov[i];
-        msgs[i].msg_hdr.msg_iovlen = 1;
-    }
-    // SAFETY: msgs[..n] point at n live iovecs, each at one live, exclusively borrowed
+    let mut h = Headers::new();
+    let n = h.aim(frames.as_mut_ptr(), frames.len());
+    // SAFETY: h.msgs[..n] point at n live iovecs, each at one live, exclusively borrowed
     // 16-byte frame; the kernel writes at most iov_len bytes into each.
-    let r = unsafe {
+    let got = counted(unsafe {
         libc::recvmmsg(
             fd,
-            msgs.as_mut_ptr(),
+            h.msgs.as_mut_ptr(),
             n as _,
             libc::MSG_DONTWAIT as _,
             std::ptr::null_mut(),
         )
-    };
-    if r < 0 {
-        return Err(nix::errno::Errno::last_raw());
-    }
-    let got = r as usize;
+    })?;
     // A datagram shorter than a can_frame is not one: mark it for skipping.
-    for (f, m) in frames.iter_mut().zip(&msgs).take(got) {
+    for (f, m) in frames.iter_mut().zip(&h.msgs).take(got) {
         if (m.msg_len as usize) < std::mem::size_of::<RawFrame>() {
             f.can_id = CAN_FLAGS;
         }

@@ -35,12 +35,6 @@ enum MethodArg {
     Taylor2,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum DemoLinkArg {
-    Memory,
-    Socketpair,
-}
-
 #[derive(Subcommand)]
 enum Command {
     /// The main job on built-in defaults: the paper's example program on the paper's machine,
@@ -57,8 +51,8 @@ enum Command {
         /// The in-process bus between the master and the simulated drives: `memory` (lock-free
         /// queues, no system call per frame) or `socketpair` (a kernel socket carrying
         /// can_frame structs through the same socketcan calls as a CAN interface).
-        #[arg(long, value_enum, default_value_t = DemoLinkArg::Memory)]
-        link: DemoLinkArg,
+        #[arg(long, value_enum, default_value_t = DemoLink::Memory)]
+        link: DemoLink,
     },
     /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
     /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
@@ -428,7 +422,7 @@ fn finish_run(
     }
 }
 
-fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLinkArg) -> anyhow::Result<()> {
+fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLink) -> anyhow::Result<()> {
     let opts = dnurbs_tools::run::RunOptions {
         name: "paper-example.nc".into(),
         approach: true,
@@ -440,9 +434,9 @@ fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLinkArg) -> anyhow::Resu
         report: report.clone(),
         progress: true,
     };
-    let (link, bus) = match link {
-        DemoLinkArg::Memory => (DemoLink::Memory, "an in-memory CAN link"),
-        DemoLinkArg::Socketpair => (DemoLink::Socketpair, "a socketpair CAN link"),
+    let bus = match link {
+        DemoLink::Memory => "an in-memory CAN link",
+        DemoLink::Socketpair => "a socketpair CAN link",
     };
     eprintln!(
         "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \

@@ -381,13 +381,13 @@ pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-tabl
 /// The demo's program: the paper's example.
 pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
 
-/// The in-process bus of `dnurbs demo`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// The in-process bus of `dnurbs demo` (`--link`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum DemoLink {
     /// [`MemLink`]: lock-free queues in memory; the cycle makes no system call for the bus.
     Memory,
     /// [`SocketLink::pair`]: a kernel socketpair carrying `can_frame` structs through the
-    /// same socketcan read/write calls as a CAN interface, one system call per frame.
+    /// same system calls as a CAN interface (`sendmmsg`/`recvmmsg` per cycle).
     Socketpair,
 }
 
