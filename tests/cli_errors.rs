@@ -322,6 +322,35 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
 }
 
 #[test]
+fn idle_polling_needs_a_cpu_and_polls_it_during_the_run() {
+    for cmd in ["demo", "latency"] {
+        let out = dnurbs(&[cmd, "--idle-poll", "--no-rt"]);
+        assert_eq!(out.status.code(), Some(2), "{cmd}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("--cpu"),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let out = dnurbs(&[
+        "latency",
+        "--duration",
+        "200ms",
+        "--no-rt",
+        "--cpu",
+        "0",
+        "--idle-poll",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("real-time thread on CPU 0 (idle polled)"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("wakeup latency"));
+}
+
+#[test]
 fn angle_words_for_another_machine_are_refused() {
     // B/C angles on the paper's A/C machine: refused at the first B word, never read as A.
     check(

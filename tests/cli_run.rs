@@ -8,26 +8,33 @@ use common::{data, dnurbs, machine, temp};
 
 #[test]
 fn demo_runs_the_paper_example_to_its_end_and_writes_the_report() {
-    check_demo(None, "an in-memory CAN link");
+    check_demo(&[], "an in-memory CAN link");
 }
 
 #[test]
 fn demo_over_a_socketpair_runs_the_paper_example_to_its_end() {
-    check_demo(Some("socketpair"), "a socketpair CAN link");
+    check_demo(&["--link", "socketpair"], "a socketpair CAN link");
 }
 
-fn check_demo(link: Option<&str>, bus: &str) {
-    let dir = temp(&format!("demo-report-{}", link.unwrap_or("default")));
+#[test]
+fn demo_pinned_with_its_cpu_idle_polled_runs_the_paper_example_to_its_end() {
+    check_demo(
+        &["--cpu", "0", "--idle-poll"],
+        "real-time thread on CPU 0 (idle polled)",
+    );
+}
+
+/// Run the demo with `extra` arguments; its banner on stderr must contain `banner`.
+fn check_demo(extra: &[&str], banner: &str) {
+    let dir = temp(&format!("demo-report{}", extra.join("")));
     // --no-rt: the same loop without SCHED_FIFO, so the test needs no privileges.
     let mut args = vec!["demo", "--no-rt", "--report", dir.to_str().unwrap()];
-    if let Some(l) = link {
-        args.extend(["--link", l]);
-    }
+    args.extend(extra);
     let out = dnurbs(&args);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stdout}\n{stderr}");
-    assert!(stderr.contains(bus), "{stderr}");
+    assert!(stderr.contains(banner), "{stderr}");
     assert!(stdout.contains("program completed"), "{stdout}");
     assert!(stdout.contains("real-time: no (--no-rt)"), "{stdout}");
     // Every drive ends where the program ends, to the count, and follows its target.

@@ -212,6 +212,8 @@ pub struct Realtime {
     pub priority: i32,
     /// CPU the real-time thread is pinned to, if any.
     pub cpu: Option<usize>,
+    /// Keep `cpu` from halting between periods with a `SCHED_IDLE` polling thread.
+    pub idle_poll: bool,
     /// Segments the planner may keep queued ahead of the interpolator, 1..=1024.
     pub queue_depth: usize,
     /// A drive whose heartbeat is older than this is lost, s.
@@ -235,6 +237,7 @@ impl Default for Realtime {
         Realtime {
             priority: 80,
             cpu: None,
+            idle_poll: false,
             queue_depth: 64,
             heartbeat_timeout_s: 0.3,
             feedback_timeout_s: 0.02,

@@ -34,6 +34,8 @@ pub(crate) struct RawRealtime {
     pub priority: Option<i64>,
     /// CPU to pin the real-time thread to.
     pub cpu: Option<i64>,
+    /// Keep that CPU busy between periods with a SCHED_IDLE poller.
+    pub idle_poll: Option<bool>,
     /// Segments the planner may have queued ahead of the interpolator.
     pub queue_depth: Option<i64>,
     /// ms without a heartbeat before a drive counts as lost.

@@ -297,6 +297,16 @@ impl Check<'_, '_> {
             None => None,
             Some(c) => Some(int("cpu", Some(c), 0, 0, 4095, "CPU number")? as usize),
         };
+        let idle_poll = r.idle_poll.unwrap_or(false);
+        if idle_poll && cpu.is_none() {
+            return Err(self.invalid(
+                &path("idle_poll"),
+                Some("true".into()),
+                "needs `cpu`: the poller keeps the real-time thread's own CPU busy, so the \
+                 thread must be pinned"
+                    .into(),
+            ));
+        }
         let depth = int(
             "queue_depth",
             r.queue_depth,
@@ -319,6 +329,7 @@ impl Check<'_, '_> {
         Ok(Realtime {
             priority: priority as i32,
             cpu,
+            idle_poll,
             queue_depth: depth as usize,
             heartbeat_timeout_s: ms(
                 "heartbeat_timeout_ms",

@@ -445,6 +445,12 @@ fn realtime_settings_have_ranges_and_defaults() {
         (m.realtime.priority, m.realtime.cpu, m.realtime.queue_depth),
         (42, Some(1), 8)
     );
+    assert!(!m.realtime.idle_poll);
+    // Polling is for the real-time thread's own CPU: without one it is refused, not ignored.
+    assert!(with("idle_poll", "true").contains("needs `cpu`"));
+    let text = format!("{MINIMAL}\n[realtime]\ncpu = 1\nidle_poll = true\n");
+    let m = config::from_str(&text, std::path::Path::new(ORIGIN)).unwrap();
+    assert_eq!((m.realtime.cpu, m.realtime.idle_poll), (Some(1), true));
     let unknown = format!("{MINIMAL}\n[realtime]\nprio = 42\n");
     assert!(fail(&unknown).1.contains("prio"));
 }

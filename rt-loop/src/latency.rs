@@ -22,6 +22,21 @@ pub struct RtSettings {
     pub priority: Option<i32>,
     /// Pin the loop to this CPU.
     pub cpu: Option<usize>,
+    /// Keep `cpu` busy between periods with an [`os::IdlePoller`] (needs `cpu`).
+    pub idle_poll: bool,
+}
+
+impl RtSettings {
+    /// Start the idle poller these settings ask for, if any; it polls until dropped.
+    pub fn idle_poller(&self) -> Result<Option<os::IdlePoller>, RtError> {
+        match (self.idle_poll, self.cpu) {
+            (false, _) => Ok(None),
+            (true, Some(cpu)) => os::IdlePoller::start(cpu).map(Some),
+            (true, None) => Err(RtError::Thread(
+                "needs a CPU to poll on: idle polling is only for a pinned loop (set the CPU)",
+            )),
+        }
+    }
 }
 
 /// Stack the loop may use, touched before the first period.
@@ -58,6 +73,7 @@ pub fn run(
         })?),
         None => None,
     };
+    let _poller = rt.idle_poller()?;
     let t0 = os::now();
     std::thread::scope(|scope| -> Result<Stats, RunError> {
         let finished = &finished;
@@ -174,6 +190,7 @@ mod tests {
             RtSettings {
                 priority: None,
                 cpu: None,
+                idle_poll: false,
             },
             None,
         )
@@ -204,6 +221,7 @@ mod tests {
             RtSettings {
                 priority: None,
                 cpu: None,
+                idle_poll: false,
             },
             Some(&path),
         )

@@ -6,6 +6,8 @@
 //!   first period.
 //! * [`set_fifo`]: `SCHED_FIFO` at a priority (needs CAP_SYS_NICE or an rtprio limit).
 //! * [`pin_to_cpu`]: CPU affinity (pair it with `isolcpus=` on the kernel command line).
+//! * [`IdlePoller`]: a `SCHED_IDLE` thread that keeps the real-time CPU busy between
+//!   periods (user-space `idle=poll`), and [`avoid_cpu`] to keep other threads off it.
 //! * [`set_timer_slack`]: 1 ns, instead of the 50 us normal threads get.
 //! * [`now`], [`sleep_until`]: `CLOCK_MONOTONIC` and `clock_nanosleep(TIMER_ABSTIME)`, so
 //!   periods do not drift with the time spent computing.
@@ -43,6 +45,11 @@ pub enum RtError {
     },
     #[error("cannot pin the real-time thread to CPU {cpu} ({errno})")]
     Affinity {
+        cpu: usize,
+        errno: nix::errno::Errno,
+    },
+    #[error("cannot start the idle poller on CPU {cpu} ({errno})")]
+    IdlePoll {
         cpu: usize,
         errno: nix::errno::Errno,
     },
@@ -142,6 +149,91 @@ pub fn pin_to_cpu(cpu: usize) -> Result<(), RtError> {
         .map_err(|errno| RtError::Affinity { cpu, errno })
 }
 
+/// Take `cpu` out of the calling thread's affinity (threads it spawns later inherit it), so
+/// the non-real-time threads leave that CPU to the real-time thread. Nothing changes if
+/// `cpu` is the only CPU allowed.
+pub fn avoid_cpu(cpu: usize) -> Result<(), RtError> {
+    let me = nix::unistd::Pid::from_raw(0);
+    let err = |errno| RtError::Affinity { cpu, errno };
+    let mut set = nix::sched::sched_getaffinity(me).map_err(err)?;
+    let others =
+        (0..nix::sched::CpuSet::count()).any(|c| c != cpu && set.is_set(c).unwrap_or(false));
+    if !others {
+        return Ok(());
+    }
+    set.unset(cpu).map_err(err)?;
+    nix::sched::sched_setaffinity(me, &set).map_err(err)
+}
+
+/// A thread pinned to one CPU at `SCHED_IDLE` that spins until dropped: the CPU never
+/// halts between periods, as with the kernel's `idle=poll`, but for that CPU only and
+/// without a reboot. Any other thread preempts it at once, the real-time thread included.
+///
+/// Halting costs twice on a virtual machine (and on PCs whose idle states
+/// `/dev/cpu_dma_latency` cannot reach, e.g. no cpuidle driver): the wake-up goes through
+/// the hypervisor, and while the virtual CPU is halted the host runs other work on the
+/// physical core, so the real-time thread wakes to cold caches. Costs one CPU's worth of
+/// power: meant for a CPU set aside for the real-time thread (`isolcpus=`).
+pub struct IdlePoller {
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl IdlePoller {
+    /// Start polling on `cpu`; fails if the thread cannot be pinned there or set to
+    /// `SCHED_IDLE`.
+    pub fn start(cpu: usize) -> Result<Self, RtError> {
+        use std::sync::atomic::{AtomicBool, Ordering};
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        let flag = stop.clone();
+        let thread = std::thread::Builder::new()
+            .name("dnurbs-poll".into())
+            .spawn(move || {
+                let ready = pin_to_cpu(cpu).and_then(|()| set_idle_policy(cpu));
+                let ok = ready.is_ok();
+                let _ = tx.send(ready);
+                while ok && !flag.load(Ordering::Relaxed) {
+                    std::hint::spin_loop();
+                }
+            })
+            .map_err(|_| RtError::Thread("idle poller could not be started"))?;
+        let poller = IdlePoller {
+            stop,
+            thread: Some(thread),
+        };
+        match rx.recv() {
+            Ok(Ok(())) => Ok(poller),
+            Ok(Err(e)) => Err(e),
+            Err(_) => Err(RtError::Thread("idle poller ended before it started")),
+        }
+    }
+}
+
+impl Drop for IdlePoller {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Switch the calling thread to `SCHED_IDLE` (no privilege needed).
+fn set_idle_policy(cpu: usize) -> Result<(), RtError> {
+    let param = nix::libc::sched_param { sched_priority: 0 };
+    // SAFETY: sched_setscheduler reads `param` during the call only; pid 0 is this thread.
+    let rc = unsafe { nix::libc::sched_setscheduler(0, nix::libc::SCHED_IDLE, &param) };
+    if rc == 0 {
+        Ok(())
+    } else {
+        Err(RtError::IdlePoll {
+            cpu,
+            errno: nix::errno::Errno::last(),
+        })
+    }
+}
+
 /// Monotonic time in nanoseconds.
 pub fn now() -> u64 {
     // CLOCK_MONOTONIC cannot fail on Linux; 0 would only make one sample look late.
@@ -191,6 +283,61 @@ mod tests {
         );
         sleep_until(t0); // in the past: returns at once
         assert!(now() >= t1);
+    }
+
+    /// (policy, last CPU) of each thread of this process named `name`, from /proc.
+    fn threads_named(name: &str) -> Vec<(i32, usize)> {
+        let mut found = Vec::new();
+        for task in std::fs::read_dir("/proc/self/task").unwrap().flatten() {
+            let path = task.path();
+            let comm = std::fs::read_to_string(path.join("comm")).unwrap_or_default();
+            if comm.trim_end() != name {
+                continue;
+            }
+            let stat = std::fs::read_to_string(path.join("stat")).unwrap();
+            // Fields after "(comm)" start at field 3; processor is field 39, policy 41.
+            let rest: Vec<&str> = stat[stat.rfind(')').unwrap() + 1..]
+                .split_whitespace()
+                .collect();
+            found.push((rest[41 - 3].parse().unwrap(), rest[39 - 3].parse().unwrap()));
+        }
+        found
+    }
+
+    #[test]
+    fn the_idle_poller_runs_at_sched_idle_on_its_cpu_until_dropped() {
+        let poller = IdlePoller::start(0).unwrap();
+        assert_eq!(threads_named("dnurbs-poll"), [(nix::libc::SCHED_IDLE, 0)]);
+        drop(poller);
+        assert_eq!(threads_named("dnurbs-poll"), []);
+        // A CPU the machine does not have: an error naming it, and no thread left spinning.
+        let e = IdlePoller::start(4095).err().unwrap();
+        assert!(matches!(e, RtError::Affinity { cpu: 4095, .. }), "{e:?}");
+        assert_eq!(threads_named("dnurbs-poll"), []);
+    }
+
+    #[test]
+    fn avoid_cpu_leaves_that_cpu_to_the_real_time_thread() {
+        let me = nix::unistd::Pid::from_raw(0);
+        std::thread::spawn(move || {
+            let before = nix::sched::sched_getaffinity(me).unwrap();
+            let allowed =
+                |s: &nix::sched::CpuSet| (0..64).filter(|&c| s.is_set(c).unwrap_or(false)).count();
+            avoid_cpu(0).unwrap();
+            let after = nix::sched::sched_getaffinity(me).unwrap();
+            if allowed(&before) > 1 && before.is_set(0).unwrap() {
+                assert!(!after.is_set(0).unwrap());
+                assert_eq!(allowed(&after), allowed(&before) - 1);
+            } else {
+                assert_eq!(
+                    allowed(&after),
+                    allowed(&before),
+                    "the only CPU stays allowed"
+                );
+            }
+        })
+        .join()
+        .unwrap();
     }
 
     #[test]

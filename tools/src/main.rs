@@ -53,6 +53,15 @@ enum Command {
         /// can_frame structs through the same socketcan calls as a CAN interface).
         #[arg(long, value_enum, default_value_t = DemoLink::Memory)]
         link: DemoLink,
+        /// Pin the real-time thread to this CPU and keep the other threads (planner,
+        /// simulated drives, reporter) off it.
+        #[arg(long)]
+        cpu: Option<usize>,
+        /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
+        /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and
+        /// PCs without a cpuidle driver; costs that CPU's power. Needs --cpu.
+        #[arg(long, requires = "cpu")]
+        idle_poll: bool,
     },
     /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
     /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
@@ -152,6 +161,11 @@ enum Command {
         /// Pin the loop thread to this CPU (pair with isolcpus= on the kernel command line).
         #[arg(long)]
         cpu: Option<usize>,
+        /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
+        /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and
+        /// PCs without a cpuidle driver; costs that CPU's power. Needs --cpu.
+        #[arg(long, requires = "cpu")]
+        idle_poll: bool,
         /// Run the same loop without mlockall and SCHED_FIFO (development machines).
         #[arg(long)]
         no_rt: bool,
@@ -187,7 +201,17 @@ fn main() -> ExitCode {
             report,
             no_rt,
             link,
-        } => demo(report, no_rt, link),
+            cpu,
+            idle_poll,
+        } => demo(
+            report,
+            link,
+            rt_loop::latency::RtSettings {
+                priority: (!no_rt).then_some(80),
+                cpu,
+                idle_poll,
+            },
+        ),
         Command::Run {
             program,
             machine,
@@ -209,6 +233,7 @@ fn main() -> ExitCode {
             duration,
             priority,
             cpu,
+            idle_poll,
             no_rt,
             report,
         } => latency(
@@ -217,6 +242,7 @@ fn main() -> ExitCode {
             rt_loop::latency::RtSettings {
                 priority: (!no_rt).then_some(priority),
                 cpu,
+                idle_poll,
             },
             report,
         ),
@@ -422,14 +448,16 @@ fn finish_run(
     }
 }
 
-fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLink) -> anyhow::Result<()> {
+fn demo(
+    report: Option<PathBuf>,
+    link: DemoLink,
+    rt: rt_loop::latency::RtSettings,
+) -> anyhow::Result<()> {
+    keep_off_rt_cpu(rt)?;
     let opts = dnurbs_tools::run::RunOptions {
         name: "paper-example.nc".into(),
         approach: true,
-        rt: rt_loop::latency::RtSettings {
-            priority: (!no_rt).then_some(80),
-            cpu: None,
-        },
+        rt,
         rt_fallback: true,
         report: report.clone(),
         progress: true,
@@ -440,7 +468,8 @@ fn demo(report: Option<PathBuf>, no_rt: bool, link: DemoLink) -> anyhow::Result<
     };
     eprintln!(
         "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
-         CiA-402 drives on {bus}, 2 ms period"
+         CiA-402 drives on {bus}, 2 ms period{}",
+        cpu_text(rt)
     );
     let (r, records) = dnurbs_tools::run::demo(&opts, link)?;
     println!("simulated drives received {} targets", records.len());
@@ -483,17 +512,20 @@ fn run_cmd(
         rt: rt_loop::latency::RtSettings {
             priority: (!no_rt).then_some(m.realtime.priority),
             cpu: m.realtime.cpu,
+            idle_poll: m.realtime.idle_poll,
         },
         rt_fallback: false,
         report: report.clone(),
         progress: true,
     };
+    keep_off_rt_cpu(opts.rt)?;
     eprintln!(
-        "dnurbs run: {} on {} ({} drives, {} ms period)",
+        "dnurbs run: {} on {} ({} drives, {} ms period{})",
         program.display(),
         m.name,
         m.drives.len(),
-        m.period_s * 1000.0
+        m.period_s * 1000.0,
+        cpu_text(opts.rt)
     );
     if m.interpolation.method != config::Method::Arclength {
         eprintln!(
@@ -505,6 +537,23 @@ fn run_cmd(
     let r = dnurbs_tools::run::run(&src, &m, open_links, &opts)?;
     let title = format!("dnurbs run: {} on {}", program.display(), m.name);
     finish_run(&r, report, &title)
+}
+
+/// With a real-time CPU: this thread, and every thread it starts from now on, stays off it.
+fn keep_off_rt_cpu(rt: rt_loop::latency::RtSettings) -> anyhow::Result<()> {
+    if let Some(cpu) = rt.cpu {
+        rt_loop::os::avoid_cpu(cpu)?;
+    }
+    Ok(())
+}
+
+/// ", real-time thread on CPU n (idle polled)" or nothing.
+fn cpu_text(rt: rt_loop::latency::RtSettings) -> String {
+    match rt.cpu {
+        Some(c) if rt.idle_poll => format!(", real-time thread on CPU {c} (idle polled)"),
+        Some(c) => format!(", real-time thread on CPU {c}"),
+        None => String::new(),
+    }
 }
 
 fn latency(
@@ -519,15 +568,17 @@ fn latency(
         ))
         .into());
     }
+    keep_off_rt_cpu(rt)?;
     eprintln!(
-        "dnurbs latency: {} periods of {} us{}",
+        "dnurbs latency: {} periods of {} us{}{}",
         duration / period,
         period as f64 / 1000.0,
         if rt.priority.is_some() {
             ", SCHED_FIFO"
         } else {
             ", without real-time privileges (--no-rt)"
-        }
+        },
+        cpu_text(rt)
     );
     if let Some(dir) = &report {
         std::fs::create_dir_all(dir)

@@ -270,6 +270,7 @@ fn run_threads<L: CanLink + Send>(
     let t0 = os::now();
     let rt = opts.rt;
     let fallback = opts.rt_fallback;
+    let _poller = rt.idle_poller()?;
     std::thread::scope(|scope| -> anyhow::Result<RunResult> {
         let (progress, done) = (&progress, &done);
         let pl = &mut *pipeline;
@@ -384,9 +385,9 @@ pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc")
 /// The in-process bus of `dnurbs demo` (`--link`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum DemoLink {
-    /// [`MemLink`]: lock-free queues in memory; the cycle makes no system call for the bus.
+    /// Lock-free queues in memory (`MemLink`): the cycle makes no system call for the bus.
     Memory,
-    /// [`SocketLink::pair`]: a kernel socketpair carrying `can_frame` structs through the
+    /// A kernel socketpair (`SocketLink::pair`) carrying `can_frame` structs through the
     /// same system calls as a CAN interface (`sendmmsg`/`recvmmsg` per cycle).
     Socketpair,
 }
