@@ -53,15 +53,8 @@ enum Command {
         /// can_frame structs through the same socketcan calls as a CAN interface).
         #[arg(long, value_enum, default_value_t = DemoLink::Memory)]
         link: DemoLink,
-        /// Pin the real-time thread to this CPU and keep the other threads (planner,
-        /// simulated drives, reporter) off it.
-        #[arg(long)]
-        cpu: Option<usize>,
-        /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
-        /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and
-        /// PCs without a cpuidle driver; costs that CPU's power. Needs --cpu.
-        #[arg(long, requires = "cpu")]
-        idle_poll: bool,
+        #[command(flatten)]
+        cpu: CpuArgs,
     },
     /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
     /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
@@ -158,14 +151,8 @@ enum Command {
         /// SCHED_FIFO priority of the loop thread (1..=99).
         #[arg(long, default_value_t = 80, value_parser = clap::value_parser!(i32).range(1..=99))]
         priority: i32,
-        /// Pin the loop thread to this CPU (pair with isolcpus= on the kernel command line).
-        #[arg(long)]
-        cpu: Option<usize>,
-        /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
-        /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and
-        /// PCs without a cpuidle driver; costs that CPU's power. Needs --cpu.
-        #[arg(long, requires = "cpu")]
-        idle_poll: bool,
+        #[command(flatten)]
+        cpu: CpuArgs,
         /// Run the same loop without mlockall and SCHED_FIFO (development machines).
         #[arg(long)]
         no_rt: bool,
@@ -194,6 +181,30 @@ enum Command {
     },
 }
 
+/// `--cpu N [--idle-poll]` of `demo` and `latency`.
+#[derive(clap::Args)]
+struct CpuArgs {
+    /// Pin the real-time thread to this CPU (pair with isolcpus= on the kernel command
+    /// line) and keep dnurbs's other threads off it.
+    #[arg(long)]
+    cpu: Option<usize>,
+    /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
+    /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and PCs
+    /// without a cpuidle driver; costs that CPU's power. Needs --cpu.
+    #[arg(long, requires = "cpu")]
+    idle_poll: bool,
+}
+
+impl CpuArgs {
+    fn settings(&self, priority: Option<i32>) -> rt_loop::latency::RtSettings {
+        rt_loop::latency::RtSettings {
+            priority,
+            cpu: self.cpu,
+            idle_poll: self.idle_poll,
+        }
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
@@ -202,16 +213,7 @@ fn main() -> ExitCode {
             no_rt,
             link,
             cpu,
-            idle_poll,
-        } => demo(
-            report,
-            link,
-            rt_loop::latency::RtSettings {
-                priority: (!no_rt).then_some(80),
-                cpu,
-                idle_poll,
-            },
-        ),
+        } => demo(report, link, cpu.settings((!no_rt).then_some(80))),
         Command::Run {
             program,
             machine,
@@ -233,17 +235,12 @@ fn main() -> ExitCode {
             duration,
             priority,
             cpu,
-            idle_poll,
             no_rt,
             report,
         } => latency(
             period,
             duration,
-            rt_loop::latency::RtSettings {
-                priority: (!no_rt).then_some(priority),
-                cpu,
-                idle_poll,
-            },
+            cpu.settings((!no_rt).then_some(priority)),
             report,
         ),
         Command::SimDrives {
