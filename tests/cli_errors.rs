@@ -322,6 +322,19 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
 }
 
 #[test]
+fn a_demo_lead_over_half_the_period_is_refused() {
+    for bad in ["2ms", "-5us", "1.5ms", "60"] {
+        let out = dnurbs(&["demo", "--no-rt", &format!("--lead={bad}")]);
+        assert_eq!(out.status.code(), Some(2), "{bad}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("--lead"),
+            "{bad}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}
+
+#[test]
 fn idle_polling_needs_a_cpu_and_polls_it_during_the_run() {
     for cmd in ["demo", "latency"] {
         let out = dnurbs(&[cmd, "--idle-poll", "--no-rt"]);

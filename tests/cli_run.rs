@@ -8,7 +8,7 @@ use common::{data, dnurbs, machine, temp};
 
 #[test]
 fn demo_runs_the_paper_example_to_its_end_and_writes_the_report() {
-    check_demo(&[], "an in-memory CAN link");
+    check_demo(&[], "an in-memory CAN link, 2 ms period, 60 µs lead");
 }
 
 #[test]
@@ -19,8 +19,8 @@ fn demo_over_a_socketpair_runs_the_paper_example_to_its_end() {
 #[test]
 fn demo_pinned_with_its_cpu_idle_polled_runs_the_paper_example_to_its_end() {
     check_demo(
-        &["--cpu", "0", "--idle-poll"],
-        "real-time thread on CPU 0 (idle polled)",
+        &["--cpu", "0", "--idle-poll", "--lead", "0"],
+        "2 ms period, real-time thread on CPU 0 (idle polled)",
     );
 }
 

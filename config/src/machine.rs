@@ -214,6 +214,9 @@ pub struct Realtime {
     pub cpu: Option<usize>,
     /// Keep `cpu` from halting between periods with a `SCHED_IDLE` polling thread.
     pub idle_poll: bool,
+    /// Wake this long before each deadline, warm the caches, compute the step and send at
+    /// the deadline, s; 0 sleeps to the deadline.
+    pub lead_s: f64,
     /// Segments the planner may keep queued ahead of the interpolator, 1..=1024.
     pub queue_depth: usize,
     /// A drive whose heartbeat is older than this is lost, s.
@@ -238,6 +241,7 @@ impl Default for Realtime {
             priority: 80,
             cpu: None,
             idle_poll: false,
+            lead_s: 0.0,
             queue_depth: 64,
             heartbeat_timeout_s: 0.3,
             feedback_timeout_s: 0.02,

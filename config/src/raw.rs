@@ -36,6 +36,8 @@ pub(crate) struct RawRealtime {
     pub cpu: Option<i64>,
     /// Keep that CPU busy between periods with a SCHED_IDLE poller.
     pub idle_poll: Option<bool>,
+    /// µs before each deadline to wake, warm up and compute (0: sleep to the deadline).
+    pub lead_us: Option<f64>,
     /// Segments the planner may have queued ahead of the interpolator.
     pub queue_depth: Option<i64>,
     /// ms without a heartbeat before a drive counts as lost.

@@ -307,6 +307,16 @@ impl Check<'_, '_> {
                     .into(),
             ));
         }
+        // At most half the period: the rest is for the bus work and the other threads.
+        let lead_us = r.lead_us.unwrap_or(d.lead_s * 1e6);
+        let max_lead_us = (period_s * 1e6 / 2.0).min(10_000.0);
+        if !(lead_us.is_finite() && (0.0..=max_lead_us).contains(&lead_us)) {
+            return Err(self.invalid(
+                &path("lead_us"),
+                Some(lead_us.to_string()),
+                format!("must be in 0..={max_lead_us} (µs, at most half the period)"),
+            ));
+        }
         let depth = int(
             "queue_depth",
             r.queue_depth,
@@ -330,6 +340,7 @@ impl Check<'_, '_> {
             priority: priority as i32,
             cpu,
             idle_poll,
+            lead_s: lead_us * 1e-6,
             queue_depth: depth as usize,
             heartbeat_timeout_s: ms(
                 "heartbeat_timeout_ms",

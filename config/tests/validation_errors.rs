@@ -437,6 +437,12 @@ fn realtime_settings_have_ranges_and_defaults() {
     // Supervision shorter than two periods (2 ms here) would fault on the first late frame.
     assert!(with("heartbeat_timeout_ms", "3").contains("must be in 4..=600000 (ms)"));
     assert!(with("feedback_timeout_ms", "nan").contains("(ms)"));
+    // The lead is at most half the period (2 ms here), never negative.
+    assert!(with("lead_us", "1001").ends_with("must be in 0..=1000 (µs, at most half the period)"));
+    assert!(with("lead_us", "-1").contains("0..=1000"));
+    let text = format!("{MINIMAL}\n[realtime]\nlead_us = 60\n");
+    let m = config::from_str(&text, std::path::Path::new(ORIGIN)).unwrap();
+    assert!((m.realtime.lead_s - 60e-6).abs() < 1e-15);
     let m = config::from_str(MINIMAL, std::path::Path::new(ORIGIN)).unwrap();
     assert_eq!(m.realtime, config::Realtime::default());
     let text = format!("{MINIMAL}\n[realtime]\npriority = 42\ncpu = 1\nqueue_depth = 8\n");

@@ -520,6 +520,29 @@ impl<'q> Follower<'q> {
         }
     }
 
+    /// A dry run of [`Follower::evaluate`]'s work where the next period will likely be (one
+    /// period on at the present speed, in whichever chunk holds that): the same arc-length
+    /// inverse, basis functions, both curves and inverse kinematics, with nothing kept. The
+    /// real-time loop calls it before the deadline so that the step's code and data, the
+    /// next segment's at a hand-over, are in the caches when the timed step runs.
+    /// Allocation-free; bounded by [`LOOKAHEAD`].
+    pub fn rehearse(&self) -> Joints {
+        let s = self.motion.s + self.motion.v.max(0.0) * self.hold.period;
+        let chunk = self
+            .local
+            .iter()
+            .find(|c| s <= c.s1)
+            .or_else(|| self.local.back());
+        match chunk {
+            Some(c) => {
+                c.segment
+                    .pose(s.min(c.s1) - c.s0)
+                    .joints(&self.kin, &self.joints, &self.lim)
+            }
+            None => self.joints,
+        }
+    }
+
     fn pose_setpoint(&mut self, cycle: u64) -> Setpoint {
         if let Some(c) = self.local.front() {
             self.block = c.segment.block;
@@ -640,6 +663,38 @@ mod tests {
             }
             assert!(sps.last().unwrap().done && n > 100);
             assert_eq!(counters, StreamCounters::default());
+        }
+    }
+
+    #[test]
+    fn a_rehearsal_changes_nothing_and_lands_where_the_next_step_goes() {
+        for src in [None, Some(TWO), Some(G01)] {
+            let (plain, _, _) = stream(src, 16, 0, None);
+            let (path, profile, hold) = planned(src);
+            let (kin, cfg, _) = machine();
+            let (start, all) = chunks(path, &profile);
+            let mut source = all.into_iter();
+            let mut q = Queues::new();
+            let (mut feeder, inlet) = q.split(16);
+            let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+            feeder.feed(&mut source.by_ref().take(1));
+            // Summed over the run: how far the rehearsal, and the previous setpoint, are from
+            // the step that follows.
+            let (mut off, mut moved) = (0.0, 0.0);
+            let mut prev = start.joints;
+            for want in &plain {
+                feeder.feed(&mut source.by_ref());
+                let guess = f.rehearse();
+                let sp = f.step();
+                assert_eq!(sp, *want, "a rehearsal changed the setpoint");
+                for j in 0..5 {
+                    off += (guess[j] - sp.joints[j]).abs();
+                    moved += (prev[j] - sp.joints[j]).abs();
+                }
+                prev = sp.joints;
+            }
+            feeder.feed(&mut std::iter::empty());
+            assert!(off < 0.01 * moved, "rehearsed {off} away, moved {moved}");
         }
     }
 

@@ -260,6 +260,30 @@ pub fn sleep_until(deadline_ns: u64) {
     );
 }
 
+/// Wait on the clock, without sleeping, until the monotonic time `deadline_ns`; returns the
+/// time read then. For the last microseconds before a deadline (the loop's lead), where a
+/// sleep would add the wake-up latency again. When two clock reads are more than `gap_ns`
+/// apart something else ran on this CPU (an interrupt, the hypervisor) and may have evicted
+/// the caches: `on_gap(when)` is called then, with the time the pause began. Bounded: at
+/// most `max_ns` clock reads, which take far longer than `max_ns` nanoseconds, so a stuck
+/// clock cannot hold the thread.
+pub fn spin_until(deadline_ns: u64, max_ns: u64, gap_ns: u64, mut on_gap: impl FnMut(u64)) -> u64 {
+    let mut t = now();
+    for _ in 0..max_ns {
+        if t >= deadline_ns {
+            break;
+        }
+        core::hint::spin_loop();
+        let prev = t;
+        t = now();
+        if t.saturating_sub(prev) > gap_ns {
+            on_gap(prev);
+            t = now();
+        }
+    }
+    t
+}
+
 /// Minor page faults of the calling thread so far (getrusage RUSAGE_THREAD): the loop
 /// thread measures its own, not those of the planner or reporter threads.
 pub fn minor_faults() -> i64 {
@@ -270,6 +294,22 @@ pub fn minor_faults() -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn spin_until_waits_for_the_deadline_reports_pauses_and_is_bounded() {
+        let t0 = now();
+        let t = spin_until(t0 + 200_000, 10_000_000, u64::MAX, |_| panic!("no gap"));
+        assert!(t >= t0 + 200_000);
+        // Every two clock reads are more than 0 ns apart: each counts as a pause, and the
+        // time given is that of the read before it.
+        let mut seen = Vec::new();
+        let t1 = now();
+        spin_until(t1 + 20_000, 10_000_000, 0, |at| seen.push(at));
+        assert!(!seen.is_empty() && seen.iter().all(|&at| at >= t1 && at < t1 + 20_000));
+        // A deadline ten seconds away with a bound of 100 reads: back long before it.
+        let t = spin_until(now() + 10_000_000_000, 100, u64::MAX, |_| {});
+        assert!(t < t0 + 1_000_000_000);
+    }
 
     #[test]
     fn sleep_until_is_absolute_and_monotonic() {

@@ -176,6 +176,15 @@ pub struct CycleInfo {
     pub finished: bool,
 }
 
+/// The interpolation step of a period, done by [`Pipeline::prepare`] ahead of the bus work.
+#[derive(Clone, Copy, Debug)]
+struct Prepared {
+    compute_ns: u64,
+    /// The program's end, or the stop, is reached.
+    at_rest: bool,
+    overflow: Option<StopReason>,
+}
+
 /// Everything the real-time thread works with.
 pub struct Pipeline<'q, L: CanLink> {
     pub follower: Follower<'q>,
@@ -191,6 +200,7 @@ pub struct Pipeline<'q, L: CanLink> {
     rotary_deg: [bool; 5],
     cycles: u64,
     settle: u64,
+    prepared: Option<Prepared>,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
@@ -264,6 +274,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             rotary_deg,
             cycles: 0,
             settle: 0,
+            prepared: None,
         })
     }
 
@@ -317,6 +328,24 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         })
     }
 
+    /// Before the deadline, the cache warm-up: the interpolation step and the count conversion
+    /// run once at the current position ([`Follower::rehearse`]) and the result is dropped, so
+    /// the timed step after the deadline finds its code and data in the caches. Changes no
+    /// state and sends nothing; does nothing outside the program.
+    pub fn rehearse(&self) {
+        if !matches!(self.stage, Stage::Running | Stage::Stopping) {
+            return;
+        }
+        let axes = self.joints_to_axes(&self.follower.rehearse());
+        for b in &self.buses {
+            for d in &b.drives {
+                if let Some(&p) = axes.get(d.axis) {
+                    core::hint::black_box(d.counts(p));
+                }
+            }
+        }
+    }
+
     /// Every drive within one count of its target.
     fn settled(&self) -> bool {
         self.buses.iter().all(|b| {
@@ -332,6 +361,28 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         self.buses
             .iter()
             .all(|b| b.master.status().iter().all(|s| s.state.is_some_and(&f)))
+    }
+
+    /// The interpolation step of the coming period, while the program runs: feed, override
+    /// and chunk hand-off, then the timed span, the paper's: parameter update (u at the new
+    /// s), basis functions, both curves, tool axis, inverse kinematics, to the final axis
+    /// positions in counts. [`Pipeline::cycle`] sends what it computed; it calls this itself
+    /// unless the loop did so before the deadline. Once per period: a second call does
+    /// nothing.
+    pub fn prepare(&mut self) {
+        if self.prepared.is_some() || !matches!(self.stage, Stage::Running | Stage::Stopping) {
+            return;
+        }
+        self.follower.advance();
+        let t0 = os::now();
+        let sp = self.follower.evaluate();
+        let axes = self.joints_to_axes(&sp.joints);
+        let overflow = self.set_targets(&axes).err();
+        self.prepared = Some(Prepared {
+            compute_ns: os::now().saturating_sub(t0),
+            at_rest: sp.done || self.follower.is_stopped(),
+            overflow,
+        });
     }
 
     /// One period at monotonic time `now_ns`. `stop` is the stop request (signal flag).
@@ -378,27 +429,22 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 }
             }
             Stage::Running | Stage::Stopping => {
-                // Feed, override and chunk hand-off first; the timed span is the paper's:
-                // parameter update (u at the new s), basis functions, both curves, tool axis,
-                // inverse kinematics, to the final axis positions in counts.
-                self.follower.advance();
-                let t0 = os::now();
-                let sp = self.follower.evaluate();
-                let axes = self.joints_to_axes(&sp.joints);
-                let overflow = self.set_targets(&axes);
-                compute_ns = os::now().saturating_sub(t0);
-                if let Err(r) = overflow {
-                    self.stop(r);
-                }
-                if self.reason.is_some() && self.stage == Stage::Running {
-                    self.enter(Stage::Stopping);
-                }
-                // At rest: let the drives reach the last target (their own lag) before
-                // disabling, so they stop where the path ends; bounded by SETTLE_CYCLES.
-                if sp.done || self.follower.is_stopped() {
-                    self.settle += 1;
-                    if self.settled() || self.settle > SETTLE_CYCLES {
-                        self.enter(Stage::Disabling);
+                self.prepare();
+                if let Some(p) = self.prepared.take() {
+                    compute_ns = p.compute_ns;
+                    if let Some(r) = p.overflow {
+                        self.stop(r);
+                    }
+                    if self.reason.is_some() && self.stage == Stage::Running {
+                        self.enter(Stage::Stopping);
+                    }
+                    // At rest: let the drives reach the last target (their own lag) before
+                    // disabling, so they stop where the path ends; bounded by SETTLE_CYCLES.
+                    if p.at_rest {
+                        self.settle += 1;
+                        if self.settled() || self.settle > SETTLE_CYCLES {
+                            self.enter(Stage::Disabling);
+                        }
                     }
                 }
             }
@@ -469,6 +515,52 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     }
 }
 
+/// With a lead: a pause between two clock reads longer than this, ns, means something else
+/// ran on the CPU (an interrupt, the hypervisor) and may have evicted the caches.
+pub const GAP_NS: u64 = 2_000;
+/// With a lead: a disturbance this close to a compute slot, ns, makes the slot unquiet.
+const NEAR_NS: u64 = 15_000;
+/// With a lead: a slot is quiet again this long after its last disturbance, ns.
+const FORGET_NS: u64 = 1_000_000_000;
+
+/// Where in the lead the step is computed. Periodic interruptions (a hypervisor's timer
+/// tick, an SMI) come at a phase that drifts slowly against the loop's deadlines; the loop
+/// sees them while it waits on the clock, and computes in whichever of two slots, a quarter
+/// and three quarters of the lead before the deadline, has been quiet the longer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Slots {
+    /// Offset of each slot before the deadline, ns.
+    before: [u64; 2],
+    /// When a disturbance was last seen near each slot (monotonic ns; 0: never).
+    seen: [u64; 2],
+}
+
+impl Slots {
+    fn new(lead_ns: u64) -> Slots {
+        Slots {
+            before: [lead_ns / 4, lead_ns * 3 / 4],
+            seen: [0; 2],
+        }
+    }
+
+    /// The slot to compute in at time `now`: the one nearer the deadline unless it was
+    /// disturbed in the last [`FORGET_NS`] and the other was disturbed less recently.
+    fn choose(&self, now: u64) -> usize {
+        let recent = |k: usize| self.seen[k] != 0 && now.saturating_sub(self.seen[k]) < FORGET_NS;
+        usize::from(recent(0) && self.seen[1] < self.seen[0])
+    }
+
+    /// Something ran on the CPU at `at` in the period due at `deadline`.
+    fn disturbed(&mut self, at: u64, deadline: u64) {
+        let before = deadline as i64 - at as i64;
+        for k in 0..2 {
+            if before.abs_diff(self.before[k] as i64) <= NEAR_NS {
+                self.seen[k] = at;
+            }
+        }
+    }
+}
+
 /// What the real-time thread publishes for the progress line (lock-free).
 #[derive(Debug, Default)]
 pub struct Progress {
@@ -483,25 +575,53 @@ pub struct Progress {
 /// record wake-up latency, compute time and whole-cycle time, publish progress. Ends when
 /// the pipeline has finished, or after `max_cycles` (a bound for tests and a last resort).
 /// Allocation-free; overruns are counted and the missed deadlines skipped, never caught up.
+///
+/// With a `lead_ns` above zero the thread wakes that much before each deadline, rehearses
+/// the step ([`Pipeline::rehearse`]) to warm the caches, computes the period's targets
+/// ([`Pipeline::prepare`]) [`AHEAD_NS`] before the deadline, and waits on the clock for the
+/// deadline to send them ([`os::spin_until`]). The frames then leave on time even when the
+/// wake-up is late by less than the lead. The wake-up latency is measured against the early
+/// wake-up time, the whole cycle from the deadline (or the wake-up, if that was later) to the
+/// last frame written: the step is done by then.
 pub fn drive_loop<L: CanLink>(
     rec: &mut crate::interval::Recorder<'_>,
     pipeline: &mut Pipeline<'_, L>,
     period_ns: u64,
+    lead_ns: u64,
     stop: &std::sync::atomic::AtomicBool,
     progress: &Progress,
     max_cycles: u64,
 ) {
     use std::sync::atomic::Ordering::Relaxed;
     let period = period_ns.max(1);
+    let lead = lead_ns.min(period / 2);
+    let mut slots = Slots::new(lead);
     let mut next = os::now().saturating_add(period);
     let (mut underruns, mut total_overruns) = (0, 0);
     for _ in 0..max_cycles {
-        os::sleep_until(next);
+        let wake_at = next.saturating_sub(lead);
+        os::sleep_until(wake_at);
         let woke = os::now();
-        let info = pipeline.cycle(woke, stop.load(Relaxed));
+        let start = if lead > 0 {
+            pipeline.rehearse();
+            let slot = next.saturating_sub(slots.before[slots.choose(woke)]);
+            os::spin_until(slot, lead, GAP_NS, |at| {
+                slots.disturbed(at, next);
+                pipeline.rehearse();
+            });
+            let t0 = os::now();
+            pipeline.prepare();
+            if os::now().saturating_sub(t0) > GAP_NS {
+                slots.disturbed(t0, next);
+            }
+            os::spin_until(next, lead, GAP_NS, |at| slots.disturbed(at, next)).max(woke)
+        } else {
+            woke
+        };
+        let info = pipeline.cycle(start, stop.load(Relaxed));
         let done = os::now();
         let stats = rec.stats();
-        let (late, busy) = (woke.saturating_sub(next), done.saturating_sub(woke));
+        let (late, busy) = (woke.saturating_sub(wake_at), done.saturating_sub(start));
         if info.compute_ns > 0 {
             stats.record(late, info.compute_ns, busy);
         } else {
@@ -526,5 +646,39 @@ pub fn drive_loop<L: CanLink>(
         if info.finished {
             break;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MS: u64 = 1_000_000;
+
+    #[test]
+    fn the_step_moves_to_the_quieter_slot_and_back_when_the_disturbance_passes() {
+        let mut s = Slots::new(60_000);
+        assert_eq!(s.before, [15_000, 45_000]);
+        let deadline = 10_000 * MS;
+        // Nothing seen: the slot nearer the deadline.
+        assert_eq!(s.choose(deadline), 0);
+        // Far from both slots (50 µs after the deadline... 31 µs before it): no effect.
+        s.disturbed(deadline + 50_000, deadline);
+        s.disturbed(deadline - 31_000, deadline);
+        assert_eq!(s.choose(deadline), 0);
+        // Near the first slot: compute in the second.
+        s.disturbed(deadline - 2_000, deadline);
+        assert_eq!(s.seen[0], deadline - 2_000);
+        assert_eq!(s.choose(deadline), 1);
+        // Two periods later near the second slot too, the first one older: back to it.
+        let d2 = deadline + 4 * MS;
+        s.disturbed(d2 - 50_000, d2);
+        assert_eq!(s.choose(d2), 0);
+        // Both seen, the second longer ago: the second.
+        let d3 = d2 + 2 * MS;
+        s.disturbed(d3 - 12_000, d3);
+        assert_eq!(s.choose(d3), 1);
+        // A second after the last disturbance near the first slot it is quiet again.
+        assert_eq!(s.choose(d3 - 12_000 + FORGET_NS), 0);
     }
 }

@@ -55,6 +55,12 @@ enum Command {
         link: DemoLink,
         #[command(flatten)]
         cpu: CpuArgs,
+        /// Wake this long before each 2 ms deadline: rehearse the interpolation step (warm
+        /// caches), compute it in a quiet moment, wait on the clock and send the frames at the
+        /// deadline. Costs the lead in CPU time per period. 0 sleeps to the deadline and
+        /// computes after it. At most 1ms.
+        #[arg(long, default_value = "60us", value_parser = parse_lead_ns)]
+        lead: u64,
     },
     /// Run a program on the machine: set up the drives on the machine file's CAN interfaces
     /// (SDO, PDO mapping, NMT start), enable them (CiA-402), interpolate in the real-time
@@ -213,7 +219,8 @@ fn main() -> ExitCode {
             no_rt,
             link,
             cpu,
-        } => demo(report, link, cpu.settings((!no_rt).then_some(80))),
+            lead,
+        } => demo(report, link, cpu.settings((!no_rt).then_some(80)), lead),
         Command::Run {
             program,
             machine,
@@ -408,6 +415,15 @@ fn parse_duration_ns(s: &str) -> Result<u64, String> {
     Ok(ns.round() as u64)
 }
 
+/// `--lead` of the demo: a duration up to half its 2 ms period, or 0.
+fn parse_lead_ns(s: &str) -> Result<u64, String> {
+    let ns = if s == "0" { 0 } else { parse_duration_ns(s)? };
+    if ns > 1_000_000 {
+        return Err(format!("{s:?}: at most 1ms (half the period)"));
+    }
+    Ok(ns)
+}
+
 fn write_report(
     dir: &std::path::Path,
     stats: &rt_loop::stats::Stats,
@@ -449,12 +465,14 @@ fn demo(
     report: Option<PathBuf>,
     link: DemoLink,
     rt: rt_loop::latency::RtSettings,
+    lead_ns: u64,
 ) -> anyhow::Result<()> {
     keep_off_rt_cpu(rt)?;
     let opts = dnurbs_tools::run::RunOptions {
         name: "paper-example.nc".into(),
         approach: true,
         rt,
+        lead_ns,
         rt_fallback: true,
         report: report.clone(),
         progress: true,
@@ -465,7 +483,8 @@ fn demo(
     };
     eprintln!(
         "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
-         CiA-402 drives on {bus}, 2 ms period{}",
+         CiA-402 drives on {bus}, 2 ms period{}{}",
+        lead_text(lead_ns),
         cpu_text(rt)
     );
     let (r, records) = dnurbs_tools::run::demo(&opts, link)?;
@@ -511,17 +530,19 @@ fn run_cmd(
             cpu: m.realtime.cpu,
             idle_poll: m.realtime.idle_poll,
         },
+        lead_ns: (m.realtime.lead_s * 1e9).round() as u64,
         rt_fallback: false,
         report: report.clone(),
         progress: true,
     };
     keep_off_rt_cpu(opts.rt)?;
     eprintln!(
-        "dnurbs run: {} on {} ({} drives, {} ms period{})",
+        "dnurbs run: {} on {} ({} drives, {} ms period{}{})",
         program.display(),
         m.name,
         m.drives.len(),
         m.period_s * 1000.0,
+        lead_text(opts.lead_ns),
         cpu_text(opts.rt)
     );
     if m.interpolation.method != config::Method::Arclength {
@@ -542,6 +563,14 @@ fn keep_off_rt_cpu(rt: rt_loop::latency::RtSettings) -> anyhow::Result<()> {
         rt_loop::os::avoid_cpu(cpu)?;
     }
     Ok(())
+}
+
+/// ", 60 µs lead" or nothing.
+fn lead_text(lead_ns: u64) -> String {
+    if lead_ns == 0 {
+        return String::new();
+    }
+    format!(", {} µs lead", lead_ns as f64 / 1e3)
 }
 
 /// ", real-time thread on CPU n (idle polled)" or nothing.

@@ -38,6 +38,9 @@ pub struct RunOptions {
     pub approach: bool,
     /// Real-time settings; `priority: None` is --no-rt.
     pub rt: RtSettings,
+    /// Wake this long before each deadline to rehearse the step and wait on the clock
+    /// ([`drive_loop`]); 0 sleeps to the deadline.
+    pub lead_ns: u64,
     /// If the real-time privileges are missing, run without them (demo) instead of failing.
     pub rt_fallback: bool,
     pub report: Option<PathBuf>,
@@ -268,7 +271,7 @@ fn run_threads<L: CanLink + Send>(
     let progress = Progress::default();
     let done = AtomicBool::new(false);
     let t0 = os::now();
-    let rt = opts.rt;
+    let (rt, lead) = (opts.rt, opts.lead_ns);
     let fallback = opts.rt_fallback;
     let _poller = rt.idle_poller()?;
     std::thread::scope(|scope| -> anyhow::Result<RunResult> {
@@ -289,7 +292,7 @@ fn run_threads<L: CanLink + Send>(
                 os::prefault_stack(STACK_PREFAULT);
                 let mut rec = Recorder::new(first, full_p, free_c, INTERVAL_NS, os::now());
                 let faults = os::minor_faults();
-                drive_loop(&mut rec, pl, period_ns, stop, progress, u64::MAX);
+                drive_loop(&mut rec, pl, period_ns, lead, stop, progress, u64::MAX);
                 let faults = os::minor_faults() - faults;
                 done.store(true, Ordering::Release);
                 Ok((rec.finish(os::now()), faults, realtime))
