@@ -577,12 +577,15 @@ pub struct Progress {
 /// Allocation-free; overruns are counted and the missed deadlines skipped, never caught up.
 ///
 /// With a `lead_ns` above zero the thread wakes that much before each deadline, rehearses
-/// the step ([`Pipeline::rehearse`]) to warm the caches, computes the period's targets
-/// ([`Pipeline::prepare`]) [`AHEAD_NS`] before the deadline, and waits on the clock for the
-/// deadline to send them ([`os::spin_until`]). The frames then leave on time even when the
-/// wake-up is late by less than the lead. The wake-up latency is measured against the early
-/// wake-up time, the whole cycle from the deadline (or the wake-up, if that was later) to the
-/// last frame written: the step is done by then.
+/// the step ([`Pipeline::rehearse`]) to warm the caches, waits on the clock for the quieter
+/// of two compute slots (a quarter and three quarters of the lead before the deadline: the
+/// one longer free of pauses seen while waiting; it rehearses again after a pause), rehearses
+/// once more and computes the period's targets there ([`Pipeline::prepare`]), then waits on
+/// the clock for the deadline and sends them. The frames leave on time even when the wake-up
+/// is late by less than the lead. The wake-up latency is measured against the early wake-up
+/// time, the whole cycle from the deadline (or the wake-up, if that was later) to the last
+/// frame written: the step is done by then. The lead costs its length in CPU time per
+/// period.
 pub fn drive_loop<L: CanLink>(
     rec: &mut crate::interval::Recorder<'_>,
     pipeline: &mut Pipeline<'_, L>,
@@ -609,6 +612,7 @@ pub fn drive_loop<L: CanLink>(
                 slots.disturbed(at, next);
                 pipeline.rehearse();
             });
+            pipeline.rehearse();
             let t0 = os::now();
             pipeline.prepare();
             if os::now().saturating_sub(t0) > GAP_NS {
