@@ -615,22 +615,12 @@ fn latency(
     let summary = stats.summary();
     print!("{}", summary.text());
     if let Some(dir) = report {
-        let write = |name: &str, body: String| {
-            let path = dir.join(name);
-            std::fs::write(&path, body)
-                .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
-        };
-        write("summary.txt", summary.text())?;
-        write("summary.json", serde_json::to_string_pretty(&summary)?)?;
         let title = format!(
             "dnurbs latency: {} periods of {} us",
             summary.cycles,
             period as f64 / 1000.0
         );
-        let svg = dir.join("latency.svg");
-        rt_loop::report::write_svg(&svg, &stats, &title)
-            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", svg.display()))?;
-        eprintln!("report: {}", dir.display());
+        write_report(&dir, &stats, &title)?;
     }
     Ok(())
 }
