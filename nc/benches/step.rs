@@ -33,7 +33,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("step");
     for (kname, kin) in machines {
         let path = build(&program, &kin, &limits).expect("paper example builds");
-        let profile = plan(&path, &kin, &cfg);
+        let profile = plan(&path, &kin, &cfg).unwrap();
         for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
             group.bench_function(format!("{kname}/{}", method.name()), |b| {
                 b.iter_custom(|iters| {

@@ -47,6 +47,7 @@ pub fn small_mill(period: f64) -> (PlanConfig, BuildLimits) {
         path_jerk: 20000.0,
         axes: [lin, lin, lin, rot, rot],
         rotary: RotaryLimits::UNLIMITED,
+        travel: [(f64::NEG_INFINITY, f64::INFINITY); 5],
     };
     let build = BuildLimits {
         rapid_mm_s: 250.0,

@@ -145,6 +145,11 @@ impl<'a> Interpolator<'a> {
         self.done
     }
 
+    /// Index of the segment the last setpoint lies on.
+    pub fn segment(&self) -> usize {
+        self.seg
+    }
+
     /// Compute the next period's setpoint. After the last one (`done`), further calls repeat
     /// the end point.
     pub fn step(&mut self) -> Setpoint {
@@ -313,7 +318,7 @@ pub(crate) mod tests {
     fn run(method: Method) -> (Path, FeedProfile, Vec<Setpoint>) {
         let (kin, cfg, bl) = machine();
         let path = build(&paper_program(), &kin, &bl).unwrap();
-        let profile = plan(&path, &kin, &cfg);
+        let profile = plan(&path, &kin, &cfg).unwrap();
         let mut out = Vec::new();
         {
             let mut ip = Interpolator::new(
@@ -432,7 +437,7 @@ pub(crate) mod tests {
     fn profile_respects_path_limits_and_is_continuous() {
         let (kin, cfg, bl) = machine();
         let path = build(&paper_program(), &kin, &bl).unwrap();
-        let p = plan(&path, &kin, &cfg);
+        let p = plan(&path, &kin, &cfg).unwrap();
         for w in p.phases.windows(2) {
             let e = w[0].end();
             assert!(

@@ -26,3 +26,4 @@ pub mod program;
 pub mod scurve;
 pub mod segment;
 pub mod stream;
+pub mod verify;

@@ -24,9 +24,12 @@
 //! The result is a [`FeedProfile`]: constant-jerk phases over the whole path, evaluated per
 //! period without allocation.
 
+use crate::kinematics::Tilt;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
+use crate::program::SrcPos;
 use crate::scurve::{push_section, reachable, Motion, Phase};
 use crate::segment::{Geometry, Path, Segment};
+use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
 
 /// Limits of one machine axis, in mm or radians and seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -48,6 +51,9 @@ pub struct PlanConfig {
     /// X, Y, Z, tilt, C.
     pub axes: [AxisLimit; 5],
     pub rotary: RotaryLimits,
+    /// Travel of each axis (mm, radians): every setpoint stays within it, or the program
+    /// is refused. Infinite for a continuous C table.
+    pub travel: [(f64, f64); 5],
 }
 
 /// Slowest speed the planner schedules where a ceiling would be lower (path units/s), so
@@ -76,6 +82,9 @@ pub struct FeedProfile {
     pub seg_start: Vec<f64>,
     pub length: f64,
     pub duration: f64,
+    /// The largest axis velocity, acceleration, jerk and chord error the setpoints reach,
+    /// as fractions of their limits (all <= 1 for a plan that [`plan`] returned).
+    pub margins: Margins,
 }
 
 impl FeedProfile {
@@ -250,8 +259,174 @@ fn speed_at(phases: &[Phase], s: f64) -> f64 {
     p.at(0.5 * (lo + hi)).v
 }
 
-/// Plan the feed over the whole path.
-pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfile {
+/// Planning rounds with the setpoint check before the program is refused.
+const VERIFY_ROUNDS: usize = 40;
+/// A lowered ceiling aims this far below what the measured violation needs.
+const CAP_MARGIN: f64 = 0.97;
+
+/// A program the planner cannot run within the machine's limits.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{pos}: {kind}")]
+pub struct PlanError {
+    pub pos: SrcPos,
+    pub kind: PlanErrorKind,
+}
+
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PlanErrorKind {
+    #[error("the program would take {hours:.1} h at the feeds the limits allow, more than the {max_cycles} periods dnurbs plans ({max_hours:.1} h at this period)")]
+    TooLong {
+        hours: f64,
+        max_cycles: u64,
+        max_hours: f64,
+    },
+    #[error("the {axis} axis would leave its travel: {value:.4} {unit} at t = {t:.3} s (travel {min} .. {max} {unit})")]
+    Travel {
+        axis: char,
+        unit: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+        t: f64,
+    },
+    #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x its limit of {limit:.4e} {unit}, even at the slowest feed the planner schedules there ({v:.3e} {path_unit}/s){hint}", subject(*.axis), .quantity.name(), .value / .limit)]
+    Limit {
+        /// The axis, or `None` for the chord error of the cutter path.
+        axis: Option<char>,
+        quantity: Quantity,
+        unit: &'static str,
+        value: f64,
+        limit: f64,
+        t: f64,
+        v: f64,
+        path_unit: &'static str,
+        hint: &'static str,
+    },
+}
+
+fn subject(axis: Option<char>) -> String {
+    axis.map_or_else(|| "cutter path".to_string(), |c| format!("{c} axis"))
+}
+
+fn axis_name(kin: &MachineKinematics, j: usize) -> char {
+    match (j, kin.tilt_kind()) {
+        (0, _) => 'X',
+        (1, _) => 'Y',
+        (2, _) => 'Z',
+        (3, Tilt::A) => 'A',
+        (3, Tilt::B) => 'B',
+        _ => 'C',
+    }
+}
+
+fn refuse(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig, v: &Violation) -> PlanError {
+    let pos = if v.cycle == 0 {
+        path.start_src
+    } else {
+        path.segments
+            .get(v.segment)
+            .map_or(path.start_src, |s| s.src)
+    };
+    let rotary = (3..5).contains(&v.axis);
+    let conv = |x: f64| if rotary { x.to_degrees() } else { x };
+    let base = if v.axis == 5 {
+        "mm"
+    } else if rotary {
+        "deg"
+    } else {
+        "mm"
+    };
+    let kind = match v.quantity {
+        Quantity::Travel => PlanErrorKind::Travel {
+            axis: axis_name(kin, v.axis),
+            unit: base,
+            value: conv(v.value),
+            min: conv(cfg.travel[v.axis].0),
+            max: conv(cfg.travel[v.axis].1),
+            t: v.t,
+        },
+        q => {
+            let unit = match (q, rotary) {
+                (Quantity::Velocity, true) => "deg/s",
+                (Quantity::Velocity, false) => "mm/s",
+                (Quantity::Acceleration, true) => "deg/s^2",
+                (Quantity::Acceleration, false) => "mm/s^2",
+                (Quantity::Jerk, true) => "deg/s^3",
+                (Quantity::Jerk, false) => "mm/s^3",
+                _ => base,
+            };
+            let rotary_only = path.segments.get(v.segment).is_some_and(|s| s.rotary_only);
+            PlanErrorKind::Limit {
+                axis: (v.axis < 5).then(|| axis_name(kin, v.axis)),
+                quantity: q,
+                unit,
+                value: conv(v.value),
+                limit: conv(v.limit),
+                t: v.t,
+                v: v.v,
+                path_unit: if rotary_only { "deg" } else { "mm" },
+                hint: if v.v <= 0.0 {
+                    ": the axis steps while the path stands still (a jump of the rotary solution between blocks)"
+                } else if rotary {
+                    ": the tool axis passes too close to the vertical, where C turns by up to 180 degrees"
+                } else {
+                    ""
+                },
+            }
+        }
+    };
+    PlanError { pos, kind }
+}
+
+fn too_long(path: &Path, seg_start: &[f64], phases: &[Phase], duration: f64, ts: f64) -> PlanError {
+    // Name the block the plan is in when the limit runs out.
+    let t_max = MAX_CYCLES as f64 * ts;
+    let i = phases.partition_point(|p| p.t0 <= t_max).saturating_sub(1);
+    let s = phases.get(i).map_or(0.0, |p| p.at(t_max - p.t0).s);
+    let k = seg_start.partition_point(|&x| x <= s).saturating_sub(1);
+    PlanError {
+        pos: path.segments.get(k).map_or(path.start_src, |seg| seg.src),
+        kind: PlanErrorKind::TooLong {
+            hours: duration / 3600.0,
+            max_cycles: MAX_CYCLES,
+            max_hours: t_max / 3600.0,
+        },
+    }
+}
+
+/// Why a parsed program cannot run on a machine: its geometry, or its plan.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ProgramError {
+    #[error(transparent)]
+    Build(#[from] crate::segment::BuildError),
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
+
+/// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.
+fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64) {
+    let a = st.partition_point(|x| x.s < s0);
+    let b = st.partition_point(|x| x.s <= s1);
+    let (a, b) = if a < b {
+        (a, b)
+    } else {
+        (a.saturating_sub(1), (b + 1).min(st.len()))
+    };
+    for x in &mut st[a..b] {
+        x.vlim = x.vlim.min(cap).max(V_FLOOR);
+    }
+}
+
+/// Plan the feed over the whole path: stations, ceilings and S-curves, then the check of the
+/// setpoints at the period ([`crate::verify::check`]). Where a limit is broken the ceiling
+/// there drops by the factor the measurement asks for and the plan is made again; a limit
+/// that slowing cannot bring within its bound (travel, a step at rest, a violation at the
+/// slowest feed) refuses the program with the position of its block.
+pub fn plan(
+    path: &Path,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+) -> Result<FeedProfile, PlanError> {
     let mut seg_start = Vec::with_capacity(path.segments.len() + 1);
     let mut total = 0.0;
     for seg in &path.segments {
@@ -259,15 +434,66 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
         total += seg.length;
     }
     seg_start.push(total);
-    if path.segments.is_empty() {
-        return FeedProfile {
-            phases: Vec::new(),
-            seg_start,
-            length: 0.0,
-            duration: 0.0,
+    let smooth = crate::verify::smooth_junctions(path, kin, cfg);
+    let (mut st, starts) = if path.segments.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        stations(path, kin, cfg)
+    };
+    let mut round = 0;
+    loop {
+        let phases = if st.is_empty() {
+            Vec::new()
+        } else {
+            schedule(&st, &starts, cfg)
         };
+        let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
+        if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
+            return Err(too_long(path, &seg_start, &phases, duration, cfg.period));
+        }
+        let mut profile = FeedProfile {
+            phases,
+            seg_start: seg_start.clone(),
+            length: total,
+            duration,
+            margins: Margins::default(),
+        };
+        let checked = crate::verify::check(path, &profile, kin, cfg, &smooth);
+        if checked.violations.is_empty() {
+            profile.margins = checked.margins;
+            return Ok(profile);
+        }
+        // Travel: slowing cannot help. Report the farthest excursion of the first block
+        // that leaves the travel.
+        let travel = checked
+            .violations
+            .iter()
+            .filter(|v| v.quantity == Quantity::Travel);
+        if let Some(first) = travel.clone().next() {
+            let worst = travel
+                .filter(|v| v.segment == first.segment)
+                .fold(first, |w, v| {
+                    if (v.value - v.limit).abs() > (w.value - w.limit).abs() {
+                        v
+                    } else {
+                        w
+                    }
+                });
+            return Err(refuse(path, kin, cfg, worst));
+        }
+        for v in &checked.violations {
+            let factor = match v.speed_factor() {
+                Some(f) if v.v > V_FLOOR * 1.01 && round + 1 < VERIFY_ROUNDS && f.is_finite() => f,
+                _ => return Err(refuse(path, kin, cfg, v)),
+            };
+            cap_stations(&mut st, v.s, v.v * factor * CAP_MARGIN);
+        }
+        round += 1;
     }
-    let (st, starts) = stations(path, kin, cfg);
+}
+
+/// The S-curve phases through the stations' ceilings.
+fn schedule(st: &[Station], starts: &[usize], cfg: &PlanConfig) -> Vec<Phase> {
     let last = st.len() - 1;
     // Critical points: (station index, speed).
     let mut crit: Vec<(usize, f64)> = vec![(0, 0.0)];
@@ -284,7 +510,7 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
     for round in 0..ROUNDS_MAX {
         let limits: Vec<(f64, f64)> = crit
             .windows(2)
-            .map(|w| section_limits(&st, w[0].0, w[1].0, cfg))
+            .map(|w| section_limits(st, w[0].0, w[1].0, cfg))
             .collect();
         // Backward then forward: every point's speed reachable within its sections.
         for k in (0..crit.len() - 1).rev() {
@@ -339,11 +565,5 @@ pub fn plan(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> FeedProfi
             crit.insert(pos, (i, st[i].vlim));
         }
     }
-    let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
-    FeedProfile {
-        phases,
-        seg_start,
-        length: total,
-        duration,
-    }
+    phases
 }

@@ -206,6 +206,8 @@ pub struct BuildLimits {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Path {
     pub start: Pose,
+    /// Where the start pose was programmed.
+    pub start_src: SrcPos,
     pub start_joints: Joints,
     pub segments: Vec<Segment>,
 }
@@ -239,28 +241,76 @@ pub fn build(
     };
     let mut joints = pose.joints(kin, &[0.0; 5], lim);
     let start = pose;
-    let start_joints = joints;
-    let mut segments = Vec::with_capacity(program.blocks.len());
+    let mut start_joints = joints;
+    let mut segments: Vec<Segment> = Vec::with_capacity(program.blocks.len());
     for (i, block) in program.blocks.iter().enumerate().skip(1) {
         let index = (i + 1) as u32;
         let seg = match block {
             Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?,
             Block::Nurbs(b) => Some(nurbs(index, b, &pose, kin, limits)?),
         };
-        if let Some(seg) = seg {
-            let end = seg.pose(seg.length);
-            joints = end.joints(kin, &joints, lim);
-            pose = end;
-            segments.push(seg);
+        let Some(seg) = seg else { continue };
+        // With a vertical tool C is free: choose it where the path leaves the vertical.
+        if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
+            if segments.is_empty() {
+                start_joints[4] = c;
+                joints[4] = c;
+            } else if (c - joints[4]).abs() > 1e-9 {
+                segments.push(turn_c(&seg, &joints, c));
+                joints[4] = c;
+            }
         }
+        // The joints at the end are those the interpolator arrives with: follow the
+        // segment, so the next block starts from the rotary branch the path really took.
+        joints = follow(&seg, kin, &joints, lim);
+        pose = seg.pose(seg.length);
+        segments.push(seg);
     }
-    let mut path = Path {
+    Ok(Path {
         start,
+        start_src: first.pos,
         start_joints,
         segments,
+    })
+}
+
+/// Joints at the end of `seg`, reached from `prev` at its start by following the tool
+/// through the segment finely enough (at most 0.25 degree of tool rotation a step) that the
+/// rotary branch is the one the interpolator, stepping along the same path, ends on.
+pub fn follow(seg: &Segment, kin: &MachineKinematics, prev: &Joints, lim: &RotaryLimits) -> Joints {
+    let steps = match &seg.tooling {
+        Tooling::Fixed(_) | Tooling::Angles { .. } => 1,
+        Tooling::Slerp { angle, .. } => {
+            ((angle.to_degrees() * 4.0).ceil() as usize).clamp(16, 4096)
+        }
+        Tooling::Curve => 1024,
     };
-    orient_c_at_vertical(&mut path, kin, lim);
-    Ok(path)
+    let mut q = *prev;
+    for i in 1..=steps {
+        q = seg
+            .pose(seg.length * i as f64 / steps as f64)
+            .joints(kin, &q, lim);
+    }
+    q
+}
+
+/// A rotary-only move that turns C from `joints` to `c` at the start of `seg`, at rest,
+/// with the tool vertical: planned like any other move under the C axis limits.
+fn turn_c(seg: &Segment, joints: &Joints, c: f64) -> Segment {
+    let p = seg.pose(0.0).p;
+    Segment {
+        block: seg.block,
+        src: seg.src,
+        length: (c - joints[4]).abs().to_degrees(),
+        feed: f64::INFINITY, // limited by the C axis alone
+        rapid: false,
+        rotary_only: true,
+        geometry: Geometry::Line { from: p, to: p },
+        tooling: Tooling::Angles {
+            from: (joints[3], joints[4]),
+            to: (joints[3], c),
+        },
+    }
 }
 
 /// True when the tool axis is (numerically) vertical, so that C is undefined.
@@ -293,51 +343,6 @@ fn c_leaving_vertical(
         s *= 10.0;
     }
     None
-}
-
-/// With a vertical tool, C is free: choose it where the path leaves the vertical, instead
-/// of holding the last one and turning C through up to 180 degrees in one period.
-/// At the program start the start pose takes that C (the machine is positioned there
-/// before the program runs); later, a rotary-only move turns C at rest while the tool stays
-/// vertical, planned like any other move under the C axis limits.
-fn orient_c_at_vertical(path: &mut Path, kin: &MachineKinematics, lim: &RotaryLimits) {
-    let mut joints = path.start_joints;
-    let mut k = 0;
-    while k < path.segments.len() {
-        let seg = &path.segments[k];
-        if let Some(c) = c_leaving_vertical(seg, kin, &joints, lim) {
-            if k == 0 {
-                path.start_joints[4] = c;
-                joints[4] = c;
-            } else if (c - joints[4]).abs() > 1e-9 {
-                let p = seg.pose(0.0).p;
-                let turn = Segment {
-                    block: seg.block,
-                    src: seg.src,
-                    length: (c - joints[4]).abs().to_degrees(),
-                    feed: f64::INFINITY, // limited by the C axis alone
-                    rapid: false,
-                    rotary_only: true,
-                    geometry: Geometry::Line { from: p, to: p },
-                    tooling: Tooling::Angles {
-                        from: (joints[3], joints[4]),
-                        to: (joints[3], c),
-                    },
-                };
-                path.segments.insert(k, turn);
-            }
-        }
-        let seg = &path.segments[k];
-        let mut prev = joints;
-        // Follow the segment so the rotary branch at its end is the one the path takes.
-        for i in 1..=16 {
-            prev = seg
-                .pose(seg.length * i as f64 / 16.0)
-                .joints(kin, &prev, lim);
-        }
-        joints = prev;
-        k += 1;
-    }
 }
 
 fn linear_tool(m: &LinearMove) -> Tool {

@@ -586,7 +586,7 @@ mod tests {
             None => paper_program(),
         };
         let path = build(&program, &kin, &bl).unwrap();
-        let profile = plan(&path, &kin, &cfg);
+        let profile = plan(&path, &kin, &cfg).unwrap();
         (path, profile, HoldConfig::from_plan(&cfg))
     }
 

@@ -65,7 +65,7 @@ fn step_never_allocates() {
         let program = nc::parse::parse(src).expect("test program parses");
         for kin in kins {
             let path = build(&program, &kin, &limits).expect("test program builds");
-            let profile = plan(&path, &kin, &cfg);
+            let profile = plan(&path, &kin, &cfg).unwrap();
             for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
                 let mut ip =
                     Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);

@@ -87,7 +87,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(mut link: L, drive_end:
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let program = nc::parse::parse(PAPER).unwrap();
     let path = nc::segment::build(&program, &kin, &bl).unwrap();
-    let profile = nc::plan::plan(&path, &kin, &cfg);
+    let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
     let (start, list) = chunks(path, &profile);
     let mut source = list.into_iter();
 

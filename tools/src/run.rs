@@ -74,7 +74,8 @@ fn plan_program(
     let program = nc::parse::parse(src).map_err(|e| InputError(format!("{name}:{e}")))?;
     let path =
         build(&program, &setup.kin, &setup.build).map_err(|e| InputError(format!("{name}:{e}")))?;
-    let profile = plan(&path, &setup.kin, &setup.plan);
+    let profile =
+        plan(&path, &setup.kin, &setup.plan).map_err(|e| InputError(format!("{name}:{e}")))?;
     // The program's end, for the closing check of the drive positions.
     let end = match path.segments.last() {
         Some(seg) => {

@@ -71,6 +71,10 @@ impl MachineSetup {
             tilt: (limits[3].min.to_radians(), limits[3].max.to_radians()),
             c: (limits[4].min.to_radians(), limits[4].max.to_radians()),
         };
+        let travel: [(f64, f64); 5] = core::array::from_fn(|j| {
+            let k = if j >= 3 { 1f64.to_radians() } else { 1.0 };
+            (limits[j].min * k, limits[j].max * k)
+        });
         let ip = &m.interpolation;
         MachineSetup {
             name: m.name.clone(),
@@ -83,6 +87,7 @@ impl MachineSetup {
                 path_jerk: ip.path_jerk,
                 axes,
                 rotary,
+                travel,
             },
             build: BuildLimits {
                 rapid_mm_s: ip.rapid_feed_mm_min / 60.0,

@@ -12,9 +12,10 @@ use nc::arclen::GL8;
 use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::Kinematics;
 use nc::nurbs::DoubleNurbs;
-use nc::plan::{plan, FeedProfile};
+use nc::plan::{plan, FeedProfile, ProgramError};
 use nc::program::Program;
-use nc::segment::{build, BuildError, Path, Tooling};
+use nc::segment::{build, Path, Tooling};
+pub use nc::verify::MAX_CYCLES;
 use serde::Serialize;
 
 /// A finished offline run.
@@ -25,13 +26,10 @@ pub struct Run {
     pub method: Method,
 }
 
-/// Upper bound on simulated periods, so a degenerate plan cannot run forever (24 h at 1 ms).
-pub const MAX_CYCLES: u64 = 86_400_000;
-
 /// Plan and interpolate a whole program.
-pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Run, BuildError> {
+pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Run, ProgramError> {
     let path = build(program, &setup.kin, &setup.build)?;
-    let profile = plan(&path, &setup.kin, &setup.plan);
+    let profile = plan(&path, &setup.kin, &setup.plan)?;
     let creep = setup.plan.path_acc * setup.period;
     let mut setpoints = Vec::with_capacity((profile.duration / setup.period) as usize + 2);
     {

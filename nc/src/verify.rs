@@ -1,0 +1,381 @@
+//! The limits checked on the setpoints themselves, as the drives will receive them.
+//!
+//! The planner's ceilings (`crate::plan`) come from stations along the path; a peak of
+//! curvature, of an axis derivative or of the C rate near the vertical tool can fall between
+//! two stations. So the plan is not trusted: [`check`] runs the interpolator over the whole
+//! plan at the machine period, exactly as `dnurbs simulate` and the real-time thread do, and
+//! measures every axis on the setpoints it produces, by finite differences at the period:
+//!
+//! * velocity `(q[k] - q[k-1]) / Ts`, acceleration `(q[k] - 2 q[k-1] + q[k-2]) / Ts^2` and
+//!   jerk `(q[k] - 3 q[k-1] + 3 q[k-2] - q[k-3]) / Ts^3` of every axis against its limit. The
+//!   drives hold the start before the first setpoint and the end after the last, so the
+//!   sequence is padded with copies of both; a step at the start or end counts.
+//!   Jerk is not limited over a junction whose joint path is not G2-continuous (a corner
+//!   or a change of curvature between blocks): there the velocity or the acceleration
+//!   changes direction within one period by design (the corner policy in `crate::plan`).
+//! * chord error: the largest distance of the cutter path between two setpoints from the
+//!   straight chord between them (the drives interpolate linearly), measured at the quarter
+//!   points of a curve's parameter interval and at every segment junction the chord spans.
+//! * travel: every setpoint of every axis within the machine's travel.
+//!
+//! What it finds drives the planner (`crate::plan::plan` lowers the speed where a limit is
+//! broken and plans again) and, where slowing cannot help, the refusal of the program.
+
+use crate::interp::{Interpolator, Method, Setpoint};
+use crate::kinematics::{Joints, MachineKinematics};
+use crate::plan::{FeedProfile, PlanConfig};
+use crate::segment::{Geometry, Path, Segment};
+use nalgebra::Vector3;
+
+/// What a limit bounds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Quantity {
+    Velocity,
+    Acceleration,
+    Jerk,
+    Chord,
+    Travel,
+}
+
+impl Quantity {
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::Velocity => "velocity",
+            Quantity::Acceleration => "acceleration",
+            Quantity::Jerk => "jerk",
+            Quantity::Chord => "chord error",
+            Quantity::Travel => "travel",
+        }
+    }
+
+    /// How the quantity scales with the path speed: v^n (travel does not).
+    pub fn speed_power(self) -> Option<i32> {
+        match self {
+            Quantity::Velocity => Some(1),
+            Quantity::Acceleration | Quantity::Chord => Some(2),
+            Quantity::Jerk => Some(3),
+            Quantity::Travel => None,
+        }
+    }
+}
+
+/// One broken limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Violation {
+    pub quantity: Quantity,
+    /// Joint index (X Y Z tilt C); 5 for the chord error of the cutter path.
+    pub axis: usize,
+    /// Cycle of the newest setpoint in the stencil, and its time (s).
+    pub cycle: u64,
+    pub t: f64,
+    /// Segment of the newest setpoint.
+    pub segment: usize,
+    /// Path positions the stencil spans.
+    pub s: (f64, f64),
+    /// Highest planned path speed over the stencil.
+    pub v: f64,
+    /// The measured value and its limit (absolute; radians for rotary axes).
+    pub value: f64,
+    pub limit: f64,
+}
+
+impl Violation {
+    /// Factor by which the path speed must drop for this limit to hold, if slowing helps.
+    pub fn speed_factor(&self) -> Option<f64> {
+        let n = self.quantity.speed_power()?;
+        Some((self.limit / self.value).powf(1.0 / f64::from(n)))
+    }
+}
+
+/// The largest value of each quantity as a fraction of its limit.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Margins {
+    pub velocity: [f64; 5],
+    pub acceleration: [f64; 5],
+    pub jerk: [f64; 5],
+    pub chord: f64,
+    /// Setpoints checked (cycles of the plan).
+    pub cycles: u64,
+}
+
+/// The result of [`check`]: the margins, and at most one violation per cycle (the worst).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Checked {
+    pub margins: Margins,
+    pub violations: Vec<Violation>,
+}
+
+/// Relative slack for rounding: a value within it of the limit holds.
+const SLACK: f64 = 1e-9;
+/// Most periods a plan may take (24 h at 1 ms): a longer plan is refused, so neither the
+/// check nor `dnurbs simulate` ever stops short of the program's end.
+pub const MAX_CYCLES: u64 = 86_400_000;
+
+/// A setpoint with what the check needs beside it.
+#[derive(Clone, Copy)]
+struct Sample {
+    q: Joints,
+    p: Vector3<f64>,
+    u: Option<f64>,
+    seg: usize,
+    s: f64,
+    v: f64,
+    cycle: u64,
+    t: f64,
+}
+
+/// Run the interpolator over `profile` at the period and measure every limit on its
+/// setpoints. `smooth[k]` tells whether the junction at the start of segment k is
+/// G2-continuous in the joints (from [`smooth_junctions`]).
+pub fn check(
+    path: &Path,
+    profile: &FeedProfile,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+    smooth: &[bool],
+) -> Checked {
+    let mut out = Checked::default();
+    let ts = cfg.period;
+    let mut ip = Interpolator::new(path, profile, *kin, cfg.rotary, Method::ArcLength, ts, 0.0);
+    let mut cursor = 0;
+    // The last four samples, newest last; padded with the start pose (the drives are there).
+    let first = sample(&ip.step(), 0, profile, &mut cursor);
+    let mut win = [first; 4];
+    // Padding past the end: three more copies of the last setpoint.
+    let mut tail = 0;
+    let mut done = first.cycle == 0 && path.segments.is_empty();
+    out.margins.cycles = 1;
+    check_travel(&first, cfg, &mut out);
+    while tail < 3 {
+        let next = if done {
+            tail += 1;
+            Sample {
+                cycle: win[3].cycle + 1,
+                t: win[3].t + ts,
+                v: 0.0,
+                ..win[3]
+            }
+        } else {
+            let sp = ip.step();
+            done = sp.done || sp.cycle >= MAX_CYCLES;
+            out.margins.cycles += 1;
+            sample(&sp, ip.segment(), profile, &mut cursor)
+        };
+        win = [win[1], win[2], win[3], next];
+        check_travel(&next, cfg, &mut out);
+        check_window(&win, path, cfg, smooth, &mut out);
+    }
+    out
+}
+
+fn sample(sp: &Setpoint, seg: usize, profile: &FeedProfile, cursor: &mut usize) -> Sample {
+    let m = profile.at(sp.t, cursor);
+    Sample {
+        q: sp.joints,
+        p: sp.p,
+        u: sp.u,
+        seg,
+        s: m.s,
+        v: m.v,
+        cycle: sp.cycle,
+        t: sp.t,
+    }
+}
+
+fn violation(q: Quantity, axis: usize, w: &[Sample], value: f64, limit: f64) -> Violation {
+    let last = &w[w.len() - 1];
+    Violation {
+        quantity: q,
+        axis,
+        cycle: last.cycle,
+        t: last.t,
+        segment: last.seg,
+        s: (w[0].s, last.s),
+        v: w.iter().map(|x| x.v).fold(0.0, f64::max),
+        value,
+        limit,
+    }
+}
+
+/// Keep the worst violation of a cycle: the one that needs the largest slow-down.
+fn record(out: &mut Checked, v: Violation) {
+    if let Some(last) = out.violations.last_mut() {
+        if last.cycle == v.cycle {
+            let worse = match (v.speed_factor(), last.speed_factor()) {
+                (None, _) => true,
+                (Some(_), None) => false,
+                (Some(a), Some(b)) => a < b,
+            };
+            if worse {
+                *last = v;
+            }
+            return;
+        }
+    }
+    out.violations.push(v);
+}
+
+fn check_travel(x: &Sample, cfg: &PlanConfig, out: &mut Checked) {
+    for j in 0..5 {
+        let (lo, hi) = cfg.travel[j];
+        let q = x.q[j];
+        if !(q >= lo - SLACK * lo.abs().max(1.0) && q <= hi + SLACK * hi.abs().max(1.0)) {
+            let limit = if q < lo { lo } else { hi };
+            record(out, violation(Quantity::Travel, j, &[*x], q, limit));
+        }
+    }
+}
+
+/// Does the stencil `w` cross a junction that is not G2-continuous?
+fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
+    let (a, b) = (w[0].seg, w[w.len() - 1].seg);
+    (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
+}
+
+fn check_window(
+    w: &[Sample; 4],
+    path: &Path,
+    cfg: &PlanConfig,
+    smooth: &[bool],
+    out: &mut Checked,
+) {
+    let (ts, m) = (cfg.period, &mut out.margins);
+    let mut found: Option<Violation> = None;
+    let keep = |v: Violation, found: &mut Option<Violation>| {
+        let worse = match (
+            found.as_ref().and_then(Violation::speed_factor),
+            v.speed_factor(),
+        ) {
+            (_, None) => true,
+            (None, Some(_)) => found.is_none(),
+            (Some(a), Some(b)) => b < a,
+        };
+        if worse {
+            *found = Some(v);
+        }
+    };
+    let jerk_ok = !crosses_corner(w, smooth);
+    for (j, ax) in cfg.axes.iter().enumerate() {
+        let (q0, q1, q2, q3) = (w[0].q[j], w[1].q[j], w[2].q[j], w[3].q[j]);
+        let vel = ((q3 - q2) / ts).abs();
+        let acc = ((q3 - 2.0 * q2 + q1) / (ts * ts)).abs();
+        let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / (ts * ts * ts)).abs();
+        m.velocity[j] = m.velocity[j].max(vel / ax.velocity);
+        m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
+        if vel > ax.velocity * (1.0 + SLACK) || vel.is_nan() {
+            keep(
+                violation(Quantity::Velocity, j, &w[2..], vel, ax.velocity),
+                &mut found,
+            );
+        }
+        if acc > ax.acceleration * (1.0 + SLACK) || acc.is_nan() {
+            keep(
+                violation(Quantity::Acceleration, j, &w[1..], acc, ax.acceleration),
+                &mut found,
+            );
+        }
+        if jerk_ok {
+            m.jerk[j] = m.jerk[j].max(jerk / ax.jerk);
+            if jerk > ax.jerk * (1.0 + SLACK) || jerk.is_nan() {
+                keep(violation(Quantity::Jerk, j, w, jerk, ax.jerk), &mut found);
+            }
+        }
+    }
+    let chord = chord_error(&w[2], &w[3], path);
+    m.chord = m.chord.max(chord / cfg.chord_tol);
+    if chord > cfg.chord_tol * (1.0 + SLACK) || chord.is_nan() {
+        keep(
+            violation(Quantity::Chord, 5, &w[2..], chord, cfg.chord_tol),
+            &mut found,
+        );
+    }
+    if let Some(v) = found {
+        record(out, v);
+    }
+}
+
+fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    let ab = b - a;
+    let l2 = ab.norm_squared();
+    let f = if l2 > 0.0 {
+        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * f)).norm()
+}
+
+/// Largest distance of the cutter path between setpoints `a` and `b` from their chord.
+fn chord_error(a: &Sample, b: &Sample, path: &Path) -> f64 {
+    let mut e = 0.0f64;
+    if a.seg == b.seg {
+        let Some(seg) = path.segments.get(a.seg) else {
+            return e;
+        };
+        if let (Geometry::Nurbs { curve, .. }, Some(ua), Some(ub)) = (&seg.geometry, a.u, b.u) {
+            for f in [0.25, 0.5, 0.75] {
+                let p = curve.cutter(ua + (ub - ua) * f, 0).p;
+                e = e.max(dist_to_chord(&p, &a.p, &b.p));
+            }
+        }
+        return e;
+    }
+    // The chord spans junctions: every segment end between them is a point of the path.
+    for seg in path.segments.get(a.seg..b.seg).unwrap_or(&[]) {
+        if !seg.rotary_only {
+            e = e.max(dist_to_chord(&seg.pose(seg.length).p, &a.p, &b.p));
+        }
+    }
+    e
+}
+
+/// One-sided step used to compare the joint derivatives on both sides of a junction, mm.
+const JUNCTION_STEP: f64 = 1e-4;
+
+/// For every segment, whether the junction at its start is G2-continuous in the machine
+/// joints: equal first and second derivatives dq/ds, d2q/ds2 from both sides (one-sided
+/// finite differences), and no change between mm and degrees of path. Segment 0 (the
+/// program start, from rest) counts as smooth.
+pub fn smooth_junctions(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> Vec<bool> {
+    let mut out = Vec::with_capacity(path.segments.len());
+    out.push(true);
+    for w in path.segments.windows(2) {
+        out.push(g2(&w[0], &w[1], kin, cfg));
+    }
+    out
+}
+
+fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bool {
+    if a.rotary_only || b.rotary_only {
+        return false;
+    }
+    let h = JUNCTION_STEP.min(a.length / 4.0).min(b.length / 4.0);
+    if h <= 0.0 {
+        return false;
+    }
+    let lim = &cfg.rotary;
+    // Joints along a, then on into b, following one rotary branch.
+    let mut prev = a.pose(a.length - 3.0 * h).joints(kin, &[0.0; 5], lim);
+    let mut qa = [[0.0; 5]; 3];
+    for (i, q) in qa.iter_mut().enumerate() {
+        prev = a
+            .pose(a.length - (2 - i) as f64 * h)
+            .joints(kin, &prev, lim);
+        *q = prev;
+    }
+    let mut qb = [[0.0; 5]; 3];
+    for (i, q) in qb.iter_mut().enumerate() {
+        prev = b.pose(i as f64 * h).joints(kin, &prev, lim);
+        *q = prev;
+    }
+    (0..5).all(|j| {
+        let d1a = (qa[2][j] - qa[1][j]) / h;
+        let d1b = (qb[1][j] - qb[0][j]) / h;
+        let d2a = (qa[2][j] - 2.0 * qa[1][j] + qa[0][j]) / (h * h);
+        let d2b = (qb[2][j] - 2.0 * qb[1][j] + qb[0][j]) / (h * h);
+        let scale = d2a.abs().max(d2b.abs()).max(1.0);
+        (qa[2][j] - qb[0][j]).abs() < 1e-9
+            && (d1a - d1b).abs() < 1e-3 * d1a.abs().max(d1b.abs()).max(1.0) + 4.0 * h * scale
+            && (d2a - d2b).abs() < 1e-2 * scale
+    })
+}
