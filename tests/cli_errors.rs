@@ -110,7 +110,7 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
         "weight-negative",
         &format!("{START}{}", block("3", "-2", GOOD_K)),
         "4",
-        "greater than 0",
+        "must be from 1e-6 to 1e6",
     );
     check(
         "degree-6",

@@ -167,3 +167,39 @@ fn refusing_a_program_in_run_happens_before_the_bus_is_opened() {
     );
     assert!(!err.contains("CAN interface"), "{err}");
 }
+
+#[test]
+fn invalid_utf8_is_reported_at_its_line_and_column_and_a_bom_is_accepted() {
+    let m = machine("paper-ac-table.toml");
+    let latin1 = temp("latin1.nc");
+    std::fs::write(&latin1, b"G01 X0 Y0 Z0 F1000\nG01 X10 (caf\xe9)\nM30\n").unwrap();
+    let out = dnurbs(&[
+        "simulate",
+        latin1.to_str().unwrap(),
+        "--machine",
+        m.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!(
+            "{}:2:13: byte 0xe9 is not UTF-8",
+            latin1.display()
+        )),
+        "{err}"
+    );
+    let bom = temp("bom.nc");
+    std::fs::write(&bom, b"\xef\xbb\xbfG01 X0 Y0 Z0 F1000\nG01 X10\nM30\n").unwrap();
+    let out = dnurbs(&[
+        "simulate",
+        bom.to_str().unwrap(),
+        "--machine",
+        m.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let _ = (std::fs::remove_file(&latin1), std::fs::remove_file(&bom));
+}

@@ -51,7 +51,7 @@ pub struct Drive {
     pub bus: usize,
     /// CANopen node id, 1..=127, unique on its bus.
     pub node: u8,
-    /// Drive counts per mm or per degree, finite and > 0.
+    /// Drive counts per mm or per degree, 1e-6..=1e9.
     pub counts_per_unit: f64,
     /// +1 or -1: the drive's positive direction against the axis's.
     pub sign: i8,

@@ -6,7 +6,7 @@
 //! machines/foo.toml: cannot read: No such file or directory (os error 2)
 //! machines/foo.toml:3:11: TOML syntax error: ...
 //! machines/foo.toml:14:12: axes.x.velocity: invalid type: string "fast", expected f64
-//! machines/foo.toml:14:12: axes.x.velocity = -3: must be finite and > 0 (mm/s)
+//! machines/foo.toml:14:12: axes.x.velocity = -3: must be in 1e-6..=1e9 (mm/s)
 //! ```
 
 use std::fmt;

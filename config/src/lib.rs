@@ -15,7 +15,7 @@
 //! line:col, the dotted key path, the value as written and the allowed range with its unit:
 //!
 //! ```text
-//! machines/foo.toml:14:12: axes.x.velocity = -3: must be finite and > 0 (mm/s)
+//! machines/foo.toml:14:12: axes.x.velocity = -3: must be in 1e-6..=1e9 (mm/s)
 //! ```
 //!
 //! # Units

@@ -14,6 +14,13 @@ use crate::raw::{
 };
 use crate::source::Source;
 
+/// Smallest and largest value of any rate, limit or scale (velocity, acceleration, jerk,
+/// feed, counts per unit): outside them the planner's arithmetic under- or overflows.
+pub const MIN_POSITIVE: f64 = 1e-6;
+pub const MAX_POSITIVE: f64 = 1e9;
+/// Largest magnitude of a position (travel, pivot point): mm or degrees.
+pub const MAX_POSITION: f64 = 1e6;
+
 /// Converts the raw file into a validated [`Machine`].
 pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigError> {
     let check = Check { src };
@@ -61,21 +68,22 @@ impl Check<'_, '_> {
         }
     }
 
-    /// `v` finite and `> 0`.
+    /// `v` in `MIN_POSITIVE..=MAX_POSITIVE`: a rate, a limit or a scale.
     fn positive(&self, path: &[&str], v: f64, unit: &str) -> Result<f64, ConfigError> {
-        if v.is_finite() && v > 0.0 {
+        if (MIN_POSITIVE..=MAX_POSITIVE).contains(&v) {
             Ok(v)
         } else {
-            let rule = format!("must be finite and > 0 ({unit})");
+            let rule = format!("must be in {MIN_POSITIVE:e}..={MAX_POSITIVE:e} ({unit})");
             Err(self.invalid(path, Some(v.to_string()), rule))
         }
     }
 
+    /// `|v| <= MAX_POSITION`: a position (travel, pivot point).
     fn finite(&self, path: &[&str], v: f64, unit: &str) -> Result<f64, ConfigError> {
-        if v.is_finite() {
+        if v.abs() <= MAX_POSITION {
             Ok(v)
         } else {
-            let rule = format!("must be finite ({unit})");
+            let rule = format!("must be in -{MAX_POSITION:e}..={MAX_POSITION:e} ({unit})");
             Err(self.invalid(path, Some(v.to_string()), rule))
         }
     }
@@ -127,11 +135,11 @@ impl Check<'_, '_> {
                         k.kind
                     ),
                 )),
-                Some(p) if p.iter().all(|c| c.is_finite()) => Ok(p),
+                Some(p) if p.iter().all(|c| c.abs() <= MAX_POSITION) => Ok(p),
                 Some(p) => Err(self.invalid(
                     &path,
                     Some(fmt_point(p)),
-                    "must be [x, y, z] with finite coordinates (mm, machine frame)".to_owned(),
+                    format!("must be [x, y, z] with coordinates in -{MAX_POSITION:e}..={MAX_POSITION:e} (mm, machine frame)"),
                 )),
             }
         };
@@ -365,6 +373,22 @@ impl Check<'_, '_> {
     }
 
     fn buses(&self, raw: &[RawBus]) -> Result<Vec<Bus>, ConfigError> {
+        // Two tables on one interface would pass the load check separately while their
+        // frames share one wire.
+        for (i, b) in raw.iter().enumerate() {
+            if let Some(first) = raw[..i].iter().position(|o| o.interface == b.interface) {
+                let idx = i.to_string();
+                let rule = format!(
+                    "must differ from every other [[bus]] interface: bus {first} ({:?}) is already on it; put all drives of one wire in one [[bus]]",
+                    raw[first].name
+                );
+                return Err(self.invalid(
+                    &["bus", idx.as_str(), "interface"],
+                    Some(format!("{:?}", b.interface)),
+                    rule,
+                ));
+            }
+        }
         let mut out: Vec<Bus> = Vec::with_capacity(raw.len());
         for (i, b) in raw.iter().enumerate() {
             let idx = i.to_string();

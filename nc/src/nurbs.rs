@@ -45,7 +45,19 @@ pub enum CurveError {
     NonFinite,
     #[error("the orientation net has {tool} points, the cutter net {ctrl}")]
     ToolCount { ctrl: usize, tool: usize },
+    #[error("the weights span a ratio of {ratio:.3e} (largest / smallest): at most {MAX_WEIGHT_RATIO:e} within one block")]
+    WeightRatio { ratio: f64 },
+    #[error("knot {knot} is repeated {mult} times, more than the degree {degree}: the curve is discontinuous there")]
+    Discontinuous {
+        knot: f64,
+        mult: usize,
+        degree: usize,
+    },
 }
+
+/// Largest ratio of the weights within one block: beyond it the curve's parametric speed
+/// varies over more orders of magnitude than its arc-length table can follow to 1e-9 mm.
+pub const MAX_WEIGHT_RATIO: f64 = 1e6;
 
 /// A pair of rational curves with shared degree, knots and weights. For a 3-axis block
 /// (`G06.2`) the orientation net is empty and only C(u) is defined.
@@ -101,9 +113,31 @@ impl DoubleNurbs {
             && knots.windows(2).all(|w| w[0] <= w[1])
             && knots[..=degree].iter().all(|&k| k == knots[0])
             && knots[n..].iter().all(|&k| k == knots[n + degree])
-            && knots[n + degree] > knots[0];
+            // The range must be resolvable: u steps of 1e-12 of it stay distinct.
+            && knots[n + degree] - knots[0] > 1e-9 * knots[0].abs().max(knots[n + degree].abs());
         if !ok {
             return Err(CurveError::Knots);
+        }
+        // An interior knot repeated more than the degree breaks the curve in two.
+        let mut i = degree + 1;
+        while i < n {
+            let mult = knots[i..n].iter().take_while(|&&k| k == knots[i]).count();
+            if mult > degree {
+                return Err(CurveError::Discontinuous {
+                    knot: knots[i],
+                    mult,
+                    degree,
+                });
+            }
+            i += mult;
+        }
+        let (wmin, wmax) = weights
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &w| {
+                (lo.min(w), hi.max(w))
+            });
+        if wmax / wmin > MAX_WEIGHT_RATIO {
+            return Err(CurveError::WeightRatio { ratio: wmax / wmin });
         }
         let mut out = DoubleNurbs {
             degree,
@@ -337,6 +371,43 @@ pub(crate) mod tests {
     }
 
     /// The paper's block (design.md section 1).
+    #[test]
+    fn a_knot_repeated_more_than_the_degree_is_a_discontinuity() {
+        // Measured: an interior knot repeated degree + 1 times stepped Y by 5 mm in a period.
+        let c = [
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 5.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [5.0, 0.0, 0.0],
+        ];
+        let k = [0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0];
+        assert_eq!(
+            DoubleNurbs::new(2, &c, &[], &[1.0; 6], &k),
+            Err(CurveError::Discontinuous {
+                knot: 0.5,
+                mult: 3,
+                degree: 2
+            })
+        );
+        // Repeated degree times: continuous (a corner), accepted.
+        let k = [0.0, 0.0, 0.0, 0.3, 0.5, 0.5, 1.0, 1.0, 1.0];
+        assert!(DoubleNurbs::new(2, &c, &[], &[1.0; 6], &k).is_ok());
+    }
+
+    #[test]
+    fn weights_spanning_more_than_the_ratio_are_refused() {
+        use crate::fixtures::*;
+        let w = [1.0, 1e-3, 1.0, 1e3, 1.0];
+        assert!(DoubleNurbs::new(PAPER_DEGREE, &PAPER_C, &PAPER_T, &w, &PAPER_K).is_ok());
+        let w = [1.0, 1e-4, 1.0, 1e3, 1.0];
+        assert!(matches!(
+            DoubleNurbs::new(PAPER_DEGREE, &PAPER_C, &PAPER_T, &w, &PAPER_K),
+            Err(CurveError::WeightRatio { .. })
+        ));
+    }
+
     pub(crate) fn paper() -> DoubleNurbs {
         use crate::fixtures::*;
         DoubleNurbs::new(PAPER_DEGREE, &PAPER_C, &PAPER_T, &[1.0; 5], &PAPER_K).unwrap()

@@ -401,6 +401,10 @@ pub enum ProgramError {
     Build(#[from] crate::segment::BuildError),
     #[error(transparent)]
     Plan(#[from] PlanError),
+    /// The interpolation did not reach the program's end within [`MAX_CYCLES`] periods
+    /// (a Taylor method creeping to the end): an error, never a silently short run.
+    #[error("the interpolation did not reach the program's end within {0} periods")]
+    Unfinished(u64),
 }
 
 /// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.

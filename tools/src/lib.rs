@@ -24,9 +24,27 @@ impl std::error::Error for InputError {}
 
 /// Read and parse an NC program; errors name the file, line and column.
 pub fn load_program(path: &Path) -> Result<nc::program::Program, InputError> {
-    let text = std::fs::read_to_string(path)
+    let bytes = std::fs::read(path)
         .map_err(|e| InputError(format!("{}: cannot read the program: {e}", path.display())))?;
-    nc::parse::parse(&text).map_err(|e| InputError(format!("{}:{e}", path.display())))
+    let text = program_text(&bytes).map_err(|e| InputError(format!("{}:{e}", path.display())))?;
+    nc::parse::parse(text).map_err(|e| InputError(format!("{}:{e}", path.display())))
+}
+
+/// The program's text: UTF-8, with a leading byte-order mark dropped. Invalid UTF-8 is an
+/// error at its line and column (columns in characters, as the parser counts them).
+pub fn program_text(bytes: &[u8]) -> Result<&str, String> {
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes);
+    std::str::from_utf8(bytes).map_err(|e| {
+        let good = &bytes[..e.valid_up_to()];
+        let line = good.iter().filter(|&&b| b == b'\n').count() + 1;
+        let start = good.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        // The prefix is valid UTF-8 by construction.
+        let col = std::str::from_utf8(&good[start..]).map_or(0, |s| s.chars().count()) + 1;
+        format!(
+            "{line}:{col}: byte 0x{:02x} is not UTF-8: save the program as UTF-8 (or ASCII)",
+            bytes[e.valid_up_to()]
+        )
+    })
 }
 
 /// Read and validate a machine file.

@@ -45,8 +45,11 @@ pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Ru
         loop {
             let sp = ip.step();
             setpoints.push(sp);
-            if sp.done || sp.cycle >= MAX_CYCLES || path.segments.is_empty() {
+            if sp.done || path.segments.is_empty() {
                 break;
+            }
+            if sp.cycle >= MAX_CYCLES {
+                return Err(ProgramError::Unfinished(MAX_CYCLES));
             }
         }
     }

@@ -8,7 +8,7 @@
 use core::fmt;
 
 use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
-use super::parser::MIN_VECTOR_LENGTH;
+use super::parser::{MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH, MIN_WEIGHT};
 use crate::program::{SrcPos, MAX_CTRL};
 
 /// A parse failure: where it happened and which rule was broken.
@@ -75,6 +75,8 @@ pub enum ParseErrorKind {
     MissingNumber { letter: char },
     #[error("the number after {letter} ({len} characters) is too large for a finite value")]
     NumberOutOfRange { letter: char, len: usize },
+    #[error("{letter}{value:e} is outside the range dnurbs accepts for {letter}: at most {max:e} in magnitude (README, NC language)")]
+    OutsideDomain { letter: char, value: f64, max: f64 },
     #[error("comment `(` is not closed: a comment must end with `)` on the same line")]
     UnterminatedComment,
     #[error("`\\` continues a line only as its last character (spaces may follow, nothing else)")]
@@ -113,7 +115,7 @@ pub enum ParseErrorKind {
     MissingWord { letter: char, context: Context },
 
     // ---- modal state -------------------------------------------------------------------
-    #[error("feed F{value} must be greater than 0 mm/min")]
+    #[error("feed F{value} must be from {MIN_FEED_MM_MIN} to 1000000 mm/min")]
     BadFeed { value: f64 },
     #[error(
         "{motion} needs a feed but none is in effect: program F<mm/min> on this or an earlier line"
@@ -149,7 +151,7 @@ pub enum ParseErrorKind {
     MissingDegree,
     #[error("{motion} P{value}: {}", if *.motion == Motion::G062 { "the rank (degree + 1) must be an integer from 2 to 6" } else { "the degree must be an integer from 1 to 5" })]
     BadDegree { motion: Motion, value: f64 },
-    #[error("weight R{value} must be greater than 0")]
+    #[error("weight R{value} must be from {MIN_WEIGHT:e} to 1e6")]
     BadWeight { value: f64 },
     #[error("too few control points ({count}): a degree-{} block needs at least {min} (degree + 1)", .min - 1)]
     TooFewControlPoints { count: usize, min: usize },

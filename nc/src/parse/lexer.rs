@@ -134,6 +134,10 @@ fn scan_line(line: u32, text: &str, words: &mut Vec<Word>) -> Result<Option<SrcP
                         return Err(kind.at(pos));
                     }
                 };
+                let max = word_limit(letter);
+                if value.abs() > max {
+                    return Err(ParseErrorKind::OutsideDomain { letter, value, max }.at(pos));
+                }
                 let uint = number
                     .bytes()
                     .all(|b| b.is_ascii_digit())
@@ -150,6 +154,19 @@ fn scan_line(line: u32, text: &str, words: &mut Vec<Word>) -> Result<Option<SrcP
         }
     }
     Ok(None)
+}
+
+/// Largest magnitude a word's number may have. Coordinates up to 100 m and angles up to
+/// 10^6 degrees cover every machine; beyond them the arithmetic of the planner loses the
+/// micrometre (and far beyond, overflows), so such a number is refused where it is written.
+/// The other words have checks of their own: I J K are normalised as a direction (or are
+/// knots, checked by the curve), N is a `u32`, G M P are codes.
+pub const fn word_limit(letter: char) -> f64 {
+    match letter {
+        'X' | 'Y' | 'Z' | 'U' | 'V' | 'W' => 1e5,
+        'A' | 'B' | 'C' | 'F' | 'R' => 1e6,
+        _ => f64::MAX,
+    }
 }
 
 /// Line and column numbers saturate instead of overflowing on absurdly large inputs.

@@ -81,6 +81,8 @@ mod parser;
 mod tests;
 
 pub use error::{Context, Motion, ParseError, ParseErrorKind};
+pub use lexer::word_limit;
+pub use parser::{MIN_FEED_MM_MIN, MIN_WEIGHT};
 
 use crate::program::Program;
 

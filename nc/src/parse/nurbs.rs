@@ -128,7 +128,7 @@ impl OpenNurbs {
         };
         let knot = need('K')?;
         let weight = match line.get('R') {
-            Some(r) if r.value <= 0.0 => {
+            Some(r) if r.value < super::parser::MIN_WEIGHT => {
                 return Err(ParseErrorKind::BadWeight { value: r.value }.at(r.pos));
             }
             Some(r) => r.value,

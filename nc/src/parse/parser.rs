@@ -7,6 +7,11 @@ use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Prog
 
 /// Tool-vector length below which `I J K` is rejected (it has no direction).
 pub(super) const MIN_VECTOR_LENGTH: f64 = 1e-9;
+/// Slowest programmable feed, mm/min (0.06 mm/min was measured to run a 27 mm move for
+/// hours; the planner refuses any plan over 24 h at 1 ms in any case).
+pub const MIN_FEED_MM_MIN: f64 = 0.001;
+/// Smallest NURBS weight (the largest is the `R` word's bound, 1e6).
+pub const MIN_WEIGHT: f64 = 1e-6;
 /// The tool orientation until a program gives one: vertical.
 const VERTICAL: Orientation = Orientation::Vector([0.0, 0.0, 1.0]);
 
@@ -77,7 +82,7 @@ impl Parser {
         }
         self.just_closed = None;
         if let Some(f) = line.get('F') {
-            if f.value <= 0.0 {
+            if f.value < MIN_FEED_MM_MIN {
                 return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
             }
             self.feed = Some(f.value);

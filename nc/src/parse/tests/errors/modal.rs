@@ -10,6 +10,33 @@ use crate::parse::{Motion, ParseErrorKind as E};
 fn feed_must_be_positive() {
     assert_eq!(fails("G01 X0 Y0 Z0 F0", 1, 14), E::BadFeed { value: 0.0 });
     assert_eq!(fails("F-5", 1, 1), E::BadFeed { value: -5.0 });
+    // Measured: F0.01 over 27 mm ran simulate into its cycle limit at 11.5 GB.
+    assert_eq!(
+        fails("G01 X0 Y0 Z0 F0.0009", 1, 14),
+        E::BadFeed { value: 0.0009 }
+    );
+}
+
+#[test]
+fn numbers_outside_the_documented_domain_are_refused_where_written() {
+    // Measured: X1 followed by 200 zeros panicked in the segment builder; Z1e11 aborted
+    // allocating 408 TB.
+    let big = format!("G01 X0 Y0 Z0 F100\nG01 X1{}", "0".repeat(200));
+    assert!(matches!(fails(&big, 2, 5), E::OutsideDomain { letter: 'X', max, .. } if max == 1e5));
+    assert!(matches!(
+        fails("G01 X0 Y0 Z100000000000 F100", 1, 11),
+        E::OutsideDomain { letter: 'Z', .. }
+    ));
+    assert!(matches!(
+        fails("G01 X0 Y0 Z0 A1000001 C0 F100", 1, 14),
+        E::OutsideDomain { letter: 'A', .. }
+    ));
+    assert!(matches!(
+        fails("G01 X0 Y0 Z0 F1000001", 1, 14),
+        E::OutsideDomain { letter: 'F', .. }
+    ));
+    // The bounds themselves are accepted.
+    crate::parse::parse("G01 X100000 Y-100000 Z0 F1000000\n").unwrap();
 }
 
 #[test]
