@@ -1,0 +1,489 @@
+//! The guarantee of the issue "Limits guaranteed", on programs nobody wrote: proptest
+//! generates adversarial NC programs (degrees 1..=5, weights 1e-3..1e3 within a block,
+//! clustered and repeated knots, cusps, sharp turns at high feed, tool axes within 1e-6 of
+//! the vertical, I J K and A C blocks mixed, 180-degree tool turns, moves to and beyond the
+//! travel, coordinates up to 1e300). Each program is either refused with a positioned error
+//! (parse, build or plan), or its setpoints, produced by the same interpolator as the
+//! real-time thread's, hold every limit. The check below is written from the setpoints alone
+//! (finite differences at the period, the curve sampled between setpoints), independently
+//! of `nc::verify`.
+//!
+//! Cases: `PROPTEST_CASES` (default 300, seed `ADV_SEED`, default 0). Not yet 10 000: in
+//! longer runs some generated programs (tool axes grazing the vertical) make the planner
+//! slow the path to its floor speed over long stretches, and planning and checking those
+//! takes minutes before it refuses them; that is open work, not hidden here.
+
+use nalgebra::Vector3;
+use nc::interp::{Interpolator, Method, Setpoint};
+use nc::kinematics::{Kinematics, MachineKinematics, RotaryLimits};
+use nc::plan::{plan, PlanConfig};
+use nc::segment::{build, BuildLimits, Geometry, Path};
+use proptest::prelude::*;
+use std::fmt::Write;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+const PERIOD: f64 = 0.002;
+/// Above this many periods a case is not interpolated here (the planner's own 24 h bound
+/// still applies); counted and reported, and it must stay rare.
+const MAX_TEST_CYCLES: f64 = 400_000.0;
+
+fn machine() -> (PlanConfig, BuildLimits, MachineKinematics) {
+    let (mut cfg, mut bl) = nc::fixtures::small_mill(PERIOD);
+    let rotary = RotaryLimits {
+        tilt: ((-95f64).to_radians(), 95f64.to_radians()),
+        c: (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    cfg.rotary = rotary;
+    bl.rotary = rotary;
+    cfg.travel = [
+        (-300.0, 300.0),
+        (-250.0, 250.0),
+        (-200.0, 200.0),
+        rotary.tilt,
+        rotary.c,
+    ];
+    (cfg, bl, MachineKinematics::Paper)
+}
+
+/// A number as a post-processor would print it; sometimes absurdly large.
+fn num(x: f64) -> String {
+    format!("{x:.4}")
+}
+
+#[derive(Clone, Debug)]
+enum Tool {
+    Keep,
+    /// I J K as given (not normalised).
+    Ijk([f64; 3]),
+    Angles(f64, f64),
+}
+
+#[derive(Clone, Debug)]
+enum Move {
+    Line {
+        to: [f64; 3],
+        tool: Tool,
+        feed: f64,
+        rapid: bool,
+    },
+    Nurbs {
+        degree: usize,
+        g065: bool,
+        /// Offsets of the control points after the first (which is the current position).
+        pts: Vec<[f64; 3]>,
+        weights: Vec<f64>,
+        /// Interior knots (before sorting), and how often the first one is repeated.
+        interior: Vec<f64>,
+        repeat: usize,
+        /// Orientation offsets (added to the current tool axis, then scaled by `len`).
+        tilt: Vec<[f64; 3]>,
+        len: f64,
+        feed: f64,
+    },
+    /// A coordinate far outside every travel (up to 1e300).
+    Huge { exp: i32 },
+}
+
+fn tool_strategy() -> impl Strategy<Value = Tool> {
+    prop_oneof![
+        2 => Just(Tool::Keep),
+        3 => (-1.0..1.0f64, -1.0..1.0f64, 0.05..1.0f64).prop_map(|(i, j, k)| Tool::Ijk([i, j, k])),
+        // Within 1e-6 .. 1e-3 of the vertical.
+        2 => (-1e-3..1e-3f64, -1e-3..1e-3f64, 0usize..4).prop_map(|(i, j, e)| {
+            let s = [1.0, 1e-1, 1e-2, 1e-3][e];
+            Tool::Ijk([i * s, j * s, 1.0])
+        }),
+        2 => (-95.0..95.0f64, -400.0..400.0f64).prop_map(|(a, c)| Tool::Angles(a, c)),
+        1 => (-1.0..1.0f64, -1.0..1.0f64).prop_map(|(i, j)| Tool::Ijk([i, j, -0.2])),
+    ]
+}
+
+fn move_strategy() -> impl Strategy<Value = Move> {
+    let coord = prop_oneof![
+        12 => -60.0..60.0f64,
+        1 => -400.0..400.0f64,
+        1 => -0.01..0.01f64,
+    ];
+    let point = [coord.clone(), coord.clone(), coord];
+    let feed = prop_oneof![
+        2 => 100.0..3000.0f64,
+        2 => 3000.0..20000.0f64,
+    ];
+    let line = (
+        point,
+        tool_strategy(),
+        feed.clone(),
+        prop::bool::weighted(0.15),
+    )
+        .prop_map(|(to, tool, feed, rapid)| Move::Line {
+            to,
+            tool,
+            feed,
+            rapid,
+        });
+    let nurbs = (1usize..=5, any::<bool>(), 0usize..6, feed, 0.5..20.0f64)
+        .prop_flat_map(|(degree, g065, extra, feed, len)| {
+            let n = degree + 1 + extra;
+            let off = prop_oneof![
+                4 => [-20.0..20.0f64, -20.0..20.0f64, -10.0..10.0f64],
+                1 => [-0.001..0.001f64, -0.001..0.001f64, -0.001..0.001f64],
+            ];
+            (
+                Just((degree, g065, feed, len)),
+                prop::collection::vec(off, n - 1),
+                prop::collection::vec(-3.0..3.0f64, n), // log10 weights
+                prop::collection::vec(0.0..1.0f64, n - degree - 1),
+                0usize..=degree + 1,
+                prop::collection::vec([-0.6..0.6f64, -0.6..0.6f64, -0.3..0.3f64], n - 1),
+            )
+        })
+        .prop_map(
+            |((degree, g065, feed, len), pts, lw, interior, repeat, tilt)| Move::Nurbs {
+                degree,
+                g065,
+                pts,
+                weights: lw.iter().map(|l| 10f64.powf(*l)).collect(),
+                interior,
+                repeat,
+                tilt,
+                len,
+                feed,
+            },
+        );
+    prop_oneof![
+        10 => line,
+        9 => nurbs,
+        1 => (3i32..300).prop_map(|exp| Move::Huge { exp }),
+    ]
+}
+
+/// Write the program the way a post-processor would, tracking the position and tool axis
+/// so NURBS blocks start where the tool is (otherwise nearly all would be refused).
+fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
+    let kin = MachineKinematics::Paper;
+    let mut s = String::from("%\nG90 G21\n");
+    let mut here = start.0;
+    let mut axis = Vector3::z();
+    let tool_words = |t: &Tool, axis: &mut Vector3<f64>| match t {
+        Tool::Keep => String::new(),
+        Tool::Ijk(v) => {
+            let u = Vector3::from(*v);
+            if u.norm() > 1e-9 {
+                *axis = u.normalize();
+            }
+            format!(" I{} J{} K{}", v[0], v[1], v[2])
+        }
+        Tool::Angles(a, c) => {
+            *axis = kin.tool_axis(a.to_radians(), c.to_radians());
+            format!(" A{} C{}", num(*a), num(*c))
+        }
+    };
+    let t0 = match start.1 {
+        Tool::Keep => Tool::Ijk([0.0, 0.0, 1.0]),
+        ref t => t.clone(),
+    };
+    let w = tool_words(&t0, &mut axis);
+    let _ = writeln!(
+        s,
+        "N10 G01 X{} Y{} Z{}{w} F1000",
+        num(here[0]),
+        num(here[1]),
+        num(here[2])
+    );
+    for (i, m) in moves.iter().enumerate() {
+        let n = 20 + 10 * i;
+        match m {
+            Move::Line {
+                to,
+                tool,
+                feed,
+                rapid,
+            } => {
+                let w = tool_words(tool, &mut axis);
+                let g = if *rapid { "G00" } else { "G01" };
+                let _ = writeln!(
+                    s,
+                    "N{n} {g} X{} Y{} Z{}{w} F{}",
+                    num(to[0]),
+                    num(to[1]),
+                    num(to[2]),
+                    num(*feed)
+                );
+                here = *to;
+            }
+            Move::Huge { exp } => {
+                let _ = writeln!(s, "N{n} G01 X1{}", "0".repeat(*exp as usize));
+            }
+            Move::Nurbs {
+                degree,
+                g065,
+                pts,
+                weights,
+                interior,
+                repeat,
+                tilt,
+                len,
+                feed,
+            } => {
+                let p = *degree;
+                let ncp = pts.len() + 1;
+                let mut ks: Vec<f64> = interior.clone();
+                ks.sort_by(f64::total_cmp);
+                // Repeat the first interior knot (clustered, up to degree + 1 times).
+                if let Some(&k0) = ks.first() {
+                    for _ in 1..*repeat {
+                        if ks.len() < ncp - p - 1 {
+                            ks.push(k0);
+                        }
+                    }
+                    ks.sort_by(f64::total_cmp);
+                    ks.truncate(ncp - p - 1);
+                }
+                let mut knots = vec![0.0; p + 1];
+                knots.extend(ks);
+                knots.extend(vec![1.0; p + 1]);
+                let mut cps = vec![here];
+                let mut c = here;
+                for d in pts {
+                    c = [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
+                    cps.push(c);
+                }
+                let (g, rank) = if *g065 {
+                    ("G06.5", p)
+                } else {
+                    ("G06.2", p + 1)
+                };
+                let _ = write!(s, "N{n} {g} P{rank} F{}", num(*feed));
+                for (k, cp) in cps.iter().enumerate() {
+                    let r = if k == 0 { 1.0 } else { weights[k] };
+                    let kw = knots[k];
+                    if *g065 {
+                        let t = if k == 0 {
+                            axis
+                        } else {
+                            let d = tilt[k - 1];
+                            (axis + Vector3::new(d[0], d[1], d[2])).normalize()
+                        };
+                        let u = Vector3::from(*cp) + t * *len;
+                        let _ = writeln!(
+                            s,
+                            " X{} Y{} Z{} U{} V{} W{} R{} K{}",
+                            cp[0], cp[1], cp[2], u.x, u.y, u.z, r, kw
+                        );
+                    } else {
+                        let _ = writeln!(s, " K{kw} X{} Y{} Z{} R{r}", cp[0], cp[1], cp[2]);
+                    }
+                }
+                let tail: Vec<String> = knots[ncp..].iter().map(|k| format!("K{k}")).collect();
+                let _ = writeln!(s, "{}", tail.join(" "));
+                if *g065 {
+                    // The tool axis at the end of the block.
+                    let d = tilt[tilt.len() - 1];
+                    axis = (axis + Vector3::new(d[0], d[1], d[2])).normalize();
+                }
+                here = c;
+            }
+        }
+    }
+    s.push_str("M30\n%\n");
+    s
+}
+
+static ACCEPTED: AtomicU64 = AtomicU64::new(0);
+static REFUSED: AtomicU64 = AtomicU64::new(0);
+static LONG: AtomicU64 = AtomicU64::new(0);
+
+/// Largest chord error between two setpoints of one NURBS segment.
+fn chord(path: &Path, seg: usize, a: &Setpoint, b: &Setpoint) -> f64 {
+    let Some(Geometry::Nurbs { curve, .. }) = path.segments.get(seg).map(|s| &s.geometry) else {
+        return 0.0;
+    };
+    let (Some(ua), Some(ub)) = (a.u, b.u) else {
+        return 0.0;
+    };
+    let ab = b.p - a.p;
+    (1..8)
+        .map(|i| {
+            let p = curve.cutter(ua + (ub - ua) * f64::from(i) / 8.0, 0).p;
+            let f = if ab.norm_squared() > 0.0 {
+                ((p - a.p).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p - (a.p + ab * f)).norm()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Run the case: Ok(()) when refused with a position or when every limit holds.
+fn check(src: &str) -> Result<(), TestCaseError> {
+    let (cfg, bl, kin) = machine();
+    let program = match nc::parse::parse(src) {
+        Ok(p) => p,
+        Err(e) => {
+            prop_assert!(e.pos.line >= 1, "parse error without a line: {e}");
+            if std::env::var_os("ADV_VERBOSE").is_some() {
+                eprintln!("refused (parse): {e}");
+                if std::env::var_os("ADV_SRC").is_some() {
+                    eprintln!("{src}");
+                }
+            }
+            REFUSED.fetch_add(1, Ordering::Relaxed);
+            return Ok(());
+        }
+    };
+    let path = match build(&program, &kin, &bl) {
+        Ok(p) => p,
+        Err(e) => {
+            prop_assert!(e.pos.line >= 1, "build error without a line: {e}");
+            if std::env::var_os("ADV_VERBOSE").is_some() {
+                eprintln!("refused (build): {e}");
+            }
+            REFUSED.fetch_add(1, Ordering::Relaxed);
+            return Ok(());
+        }
+    };
+    let profile = match plan(&path, &kin, &cfg) {
+        Ok(p) => p,
+        Err(e) => {
+            prop_assert!(e.pos.line >= 1, "plan error without a line: {e}");
+            if std::env::var_os("ADV_VERBOSE").is_some() {
+                eprintln!("refused (plan): {e}");
+            }
+            REFUSED.fetch_add(1, Ordering::Relaxed);
+            return Ok(());
+        }
+    };
+    if profile.duration / PERIOD > MAX_TEST_CYCLES {
+        LONG.fetch_add(1, Ordering::Relaxed);
+        return Ok(());
+    }
+    ACCEPTED.fetch_add(1, Ordering::Relaxed);
+    let mut ip = Interpolator::new(
+        &path,
+        &profile,
+        kin,
+        cfg.rotary,
+        Method::ArcLength,
+        PERIOD,
+        0.0,
+    );
+    let mut sps: Vec<(Setpoint, usize)> = Vec::new();
+    loop {
+        let sp = ip.step();
+        sps.push((sp, ip.segment()));
+        prop_assert!(sps.len() < 2 * MAX_TEST_CYCLES as usize, "no end");
+        if sp.done || path.segments.is_empty() {
+            break;
+        }
+    }
+    // The drives hold the start before and the end after.
+    let (first, last) = (sps[0], sps[sps.len() - 1]);
+    let mut q: Vec<(Setpoint, usize)> = vec![first; 3];
+    q.extend(sps.iter().copied());
+    q.extend([last; 3]);
+    let slack = 1.0 + 1e-6;
+    for (k, w) in q.windows(4).enumerate() {
+        let [a, b, c, d] = [&w[0].0, &w[1].0, &w[2].0, &w[3].0];
+        let same_seg = w.iter().all(|x| x.1 == w[0].1) && k >= 3 && k + 4 <= q.len() - 3;
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            let (q0, q1, q2, q3) = (a.joints[j], b.joints[j], c.joints[j], d.joints[j]);
+            prop_assert!(q3.is_finite(), "NaN setpoint");
+            let v = ((q3 - q2) / PERIOD).abs();
+            let acc = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
+            prop_assert!(
+                v <= ax.velocity * slack,
+                "axis {j} velocity {v} > {} at t={}\n{src}",
+                ax.velocity,
+                d.t
+            );
+            prop_assert!(
+                acc <= ax.acceleration * slack,
+                "axis {j} acceleration {acc} > {} at t={}\n{src}",
+                ax.acceleration,
+                d.t
+            );
+            if same_seg {
+                let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / PERIOD.powi(3)).abs();
+                prop_assert!(
+                    jerk <= ax.jerk * slack,
+                    "axis {j} jerk {jerk} > {} at t={}\n{src}",
+                    ax.jerk,
+                    d.t
+                );
+            }
+            let (lo, hi) = cfg.travel[j];
+            prop_assert!(
+                q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
+                "axis {j} at {q3} outside travel\n{src}"
+            );
+        }
+        if w[2].1 == w[3].1 {
+            let e = chord(&path, w[3].1, c, d);
+            prop_assert!(e <= cfg.chord_tol * slack, "chord {e} at t={}\n{src}", d.t);
+        }
+    }
+    // The last setpoint is the program's end.
+    if let Some(seg) = path.segments.last() {
+        let end = seg.pose(seg.length).p;
+        prop_assert!(
+            (last.0.p - end).norm() < 1e-3,
+            "ends {} from the end\n{src}",
+            (last.0.p - end).norm()
+        );
+    }
+    Ok(())
+}
+
+#[test]
+fn every_accepted_program_holds_every_limit() {
+    let cases = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|c| c.parse().ok())
+        .unwrap_or(300);
+    let config = ProptestConfig {
+        cases,
+        max_shrink_iters: 64,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    };
+    let strategy = (
+        (
+            [-50.0..50.0f64, -50.0..50.0f64, -50.0..50.0f64],
+            tool_strategy(),
+        ),
+        prop::collection::vec(move_strategy(), 1..5),
+    );
+    // A fixed seed: the same programs on every machine, so a slow plan cannot appear at
+    // random in CI (see the module doc); PROPTEST_CASES and ADV_SEED widen the search.
+    let seed: u64 = std::env::var("ADV_SEED")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let mut bytes = [0u8; 32];
+    bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    let rng = proptest::test_runner::TestRng::from_seed(
+        proptest::test_runner::RngAlgorithm::ChaCha,
+        &bytes,
+    );
+    let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
+    let result = runner.run(&strategy, |(start, moves)| check(&program(start, &moves)));
+    let (acc, refd, long) = (
+        ACCEPTED.load(Ordering::Relaxed),
+        REFUSED.load(Ordering::Relaxed),
+        LONG.load(Ordering::Relaxed),
+    );
+    eprintln!("adversarial: {cases} cases: accepted and within every limit {acc}, refused with a position {refd}, too long to interpolate here {long}");
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    // The suite must exercise the limits, not only the refusals.
+    assert!(
+        acc * 5 >= u64::from(cases),
+        "only {acc} of {cases} accepted"
+    );
+    assert!(
+        long * 100 <= u64::from(cases),
+        "{long} of {cases} too long to check"
+    );
+}
