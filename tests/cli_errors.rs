@@ -142,12 +142,12 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
         "at least",
     );
 
-    // 65 control points of a degree-1 polyline: one over the capacity of 64.
+    // 100 001 control points of a degree-1 polyline: one over the block capacity.
     let mut many = String::from("N10 G01 X0 Y0 Z0 F100\nG06.2 P2 K0 X0 Y0 Z0\n");
-    for i in 1..65 {
+    for i in 1..=100_000 {
         many.push_str(&format!("K{} X{i} Y0 Z0\n", i - 1));
     }
-    check("capacity", &many, "66", "MAX_CTRL = 64");
+    check("capacity", &many, "100002", "MAX_BLOCK_CTRL = 100000");
 
     check(
         "g91",

@@ -283,14 +283,12 @@ pub(crate) mod tests {
             feed_mm_min: 400.0,
         };
         for i in 0..5 {
-            b.ctrl.push(c[i]).unwrap();
-            b.tool_ctrl.push(t[i]).unwrap();
-            b.weights.push(1.0).unwrap();
-            b.ctrl_pos.push(SrcPos::default()).unwrap();
+            b.ctrl.push(c[i]);
+            b.tool_ctrl.push(t[i]);
+            b.weights.push(1.0);
+            b.ctrl_pos.push(SrcPos::default());
         }
-        b.knots
-            .extend_from_slice(&crate::fixtures::PAPER_K)
-            .unwrap();
+        b.knots.extend_from_slice(&crate::fixtures::PAPER_K);
         let dir = [t[0][0] - c[0][0], t[0][1] - c[0][1], t[0][2] - c[0][2]];
         let n = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
         Program {

@@ -25,5 +25,6 @@ pub mod plan;
 pub mod program;
 pub mod scurve;
 pub mod segment;
+pub mod split;
 pub mod stream;
 pub mod verify;

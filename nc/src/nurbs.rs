@@ -35,7 +35,7 @@ pub enum CurveError {
         knots: usize,
         expected: usize,
     },
-    #[error("{0} control points: a degree-p curve needs p+1..={MAX_CTRL}")]
+    #[error("{0} control points: a degree-p block needs p+1 to {max} (a piece the real-time thread evaluates holds at most {MAX_CTRL})", max = crate::split::MAX_BLOCK_CTRL)]
     CtrlCount(usize),
     #[error("knot vector is not non-decreasing, clamped and finite with a non-empty range")]
     Knots,
@@ -79,6 +79,72 @@ struct Basis {
     n: [[f64; MAX_DEGREE + 1]; 3],
 }
 
+/// The rules of a control net, whatever its size: degree, counts, a clamped non-decreasing
+/// resolvable knot vector, no interior knot above the degree, weights finite and positive
+/// within [`MAX_WEIGHT_RATIO`]. Used by [`DoubleNurbs::new`] and by the block splitter.
+pub(crate) fn validate_net(
+    degree: usize,
+    n: usize,
+    tool_len: usize,
+    weights: &[f64],
+    knots: &[f64],
+) -> Result<(), CurveError> {
+    if !(1..=MAX_DEGREE).contains(&degree) {
+        return Err(CurveError::Degree(degree));
+    }
+    if n < degree + 1 || weights.len() != n {
+        return Err(CurveError::CtrlCount(n));
+    }
+    if tool_len != 0 && tool_len != n {
+        return Err(CurveError::ToolCount {
+            ctrl: n,
+            tool: tool_len,
+        });
+    }
+    let expected = n + degree + 1;
+    if knots.len() != expected {
+        return Err(CurveError::KnotCount {
+            ctrl: n,
+            knots: knots.len(),
+            expected,
+        });
+    }
+    let ok = knots.iter().all(|k| k.is_finite())
+        && knots.windows(2).all(|w| w[0] <= w[1])
+        && knots[..=degree].iter().all(|&k| k == knots[0])
+        && knots[n..].iter().all(|&k| k == knots[n + degree])
+        // The range must be resolvable: u steps of 1e-12 of it stay distinct.
+        && knots[n + degree] - knots[0] > 1e-9 * knots[0].abs().max(knots[n + degree].abs());
+    if !ok {
+        return Err(CurveError::Knots);
+    }
+    // An interior knot repeated more than the degree breaks the curve in two.
+    let mut i = degree + 1;
+    while i < n {
+        let mult = knots[i..n].iter().take_while(|&&k| k == knots[i]).count();
+        if mult > degree {
+            return Err(CurveError::Discontinuous {
+                knot: knots[i],
+                mult,
+                degree,
+            });
+        }
+        i += mult;
+    }
+    if let Some(&w) = weights.iter().find(|w| !(w.is_finite() && **w > 0.0)) {
+        return Err(CurveError::Weight(w));
+    }
+    let (wmin, wmax) = weights
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &w| {
+            (lo.min(w), hi.max(w))
+        });
+    if wmax / wmin > MAX_WEIGHT_RATIO {
+        return Err(CurveError::WeightRatio { ratio: wmax / wmin });
+    }
+    Ok(())
+}
+
 impl DoubleNurbs {
     /// Build from a control net. `tool` is either empty or as long as `ctrl`.
     pub fn new(
@@ -88,57 +154,11 @@ impl DoubleNurbs {
         weights: &[f64],
         knots: &[f64],
     ) -> Result<Self, CurveError> {
-        if !(1..=MAX_DEGREE).contains(&degree) {
-            return Err(CurveError::Degree(degree));
-        }
         let n = ctrl.len();
-        if n < degree + 1 || n > MAX_CTRL || weights.len() != n {
+        if n > MAX_CTRL {
             return Err(CurveError::CtrlCount(n));
         }
-        if !tool.is_empty() && tool.len() != n {
-            return Err(CurveError::ToolCount {
-                ctrl: n,
-                tool: tool.len(),
-            });
-        }
-        let expected = n + degree + 1;
-        if knots.len() != expected {
-            return Err(CurveError::KnotCount {
-                ctrl: n,
-                knots: knots.len(),
-                expected,
-            });
-        }
-        let ok = knots.iter().all(|k| k.is_finite())
-            && knots.windows(2).all(|w| w[0] <= w[1])
-            && knots[..=degree].iter().all(|&k| k == knots[0])
-            && knots[n..].iter().all(|&k| k == knots[n + degree])
-            // The range must be resolvable: u steps of 1e-12 of it stay distinct.
-            && knots[n + degree] - knots[0] > 1e-9 * knots[0].abs().max(knots[n + degree].abs());
-        if !ok {
-            return Err(CurveError::Knots);
-        }
-        // An interior knot repeated more than the degree breaks the curve in two.
-        let mut i = degree + 1;
-        while i < n {
-            let mult = knots[i..n].iter().take_while(|&&k| k == knots[i]).count();
-            if mult > degree {
-                return Err(CurveError::Discontinuous {
-                    knot: knots[i],
-                    mult,
-                    degree,
-                });
-            }
-            i += mult;
-        }
-        let (wmin, wmax) = weights
-            .iter()
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &w| {
-                (lo.min(w), hi.max(w))
-            });
-        if wmax / wmin > MAX_WEIGHT_RATIO {
-            return Err(CurveError::WeightRatio { ratio: wmax / wmin });
-        }
+        validate_net(degree, n, tool.len(), weights, knots)?;
         let mut out = DoubleNurbs {
             degree,
             knots: HVec::new(),
@@ -339,7 +359,7 @@ pub(crate) mod tests {
     use super::*;
 
     /// Cox-de Boor recursion (paper eq. 4), written independently of A2.2/A2.3.
-    fn n_rec(i: usize, p: usize, u: f64, k: &[f64]) -> f64 {
+    pub(crate) fn n_rec(i: usize, p: usize, u: f64, k: &[f64]) -> f64 {
         if p == 0 {
             let last = k[k.len() - 1];
             // Close the last non-empty span on the right so u = u_max evaluates.

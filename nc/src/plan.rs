@@ -204,8 +204,10 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
                     // The joint with the previous segment: one station, both sides' limits.
                     let (pd1, prev_rotary) = prev_end.unwrap_or(([0.0; 5], seg.rotary_only));
                     let mut vc = last.vlim.min(st.vlim);
-                    if prev_rotary != seg.rotary_only {
-                        vc = 0.0; // path units change (mm <-> degrees): stop between
+                    if prev_rotary != seg.rotary_only || seg.stop {
+                        // Path units change (mm <-> degrees), or the tangent kinks inside
+                        // a NURBS block: stop between.
+                        vc = 0.0;
                     }
                     for (j, ax) in cfg.axes.iter().enumerate() {
                         let jump = (d1[j] - pd1[j]).abs();

@@ -3,16 +3,16 @@
 //!
 //! Every modal value is resolved by the parser, so each move here is complete: a linear move
 //! carries its full end point and tool orientation, a NURBS block its full control net.
-//! Control nets live in fixed-capacity `heapless` vectors: a block is a value of known size
-//! that can later travel through the real-time queue without touching the heap.
-
-use heapless::Vec as HVec;
+//! A block's control net may be large (up to [`MAX_BLOCK_CTRL`](crate::split::MAX_BLOCK_CTRL)
+//! points, as CAD systems write them); the segment builder cuts it into pieces of at most
+//! [`MAX_CTRL`] points (`crate::split`), values of known size for the real-time thread.
 
 /// Highest NURBS degree accepted (`G06.5 P5`, `G06.2 P6`).
 pub const MAX_DEGREE: usize = 5;
-/// Most control points one NURBS block may carry. Fixed so a block has a known size.
+/// Most control points one piece of a NURBS block holds: the fixed capacity the real-time
+/// thread evaluates. Larger blocks are cut into pieces (`crate::split`).
 pub const MAX_CTRL: usize = 64;
-/// Most knots one NURBS block may carry: control points + degree + 1.
+/// Most knots of one piece: control points + degree + 1.
 pub const MAX_KNOTS: usize = MAX_CTRL + MAX_DEGREE + 1;
 
 /// Where a token stands in the source: 1-based line and column (in characters).
@@ -76,25 +76,21 @@ pub struct NurbsBlock {
     /// Degree p (for G06.2 the parser converts the rank P to p = P - 1).
     pub degree: u8,
     /// Control points of the cutter-centre curve C(u), X Y Z, mm.
-    pub ctrl: HVec<[f64; 3], MAX_CTRL>,
+    pub ctrl: Vec<[f64; 3]>,
     /// Control points of the orientation curve CT(u), U V W (G06.5 only; empty for G06.2).
-    pub tool_ctrl: HVec<[f64; 3], MAX_CTRL>,
+    pub tool_ctrl: Vec<[f64; 3]>,
     /// Source position of each control point's first word, for error messages.
-    pub ctrl_pos: HVec<SrcPos, MAX_CTRL>,
+    pub ctrl_pos: Vec<SrcPos>,
     /// Weights R (default 1.0 where a line has none), one per control point.
-    pub weights: HVec<f64, MAX_CTRL>,
+    pub weights: Vec<f64>,
     /// Knot vector, `ctrl.len() + degree + 1` values, non-decreasing and clamped.
-    pub knots: HVec<f64, MAX_KNOTS>,
+    pub knots: Vec<f64>,
     /// Programmed feed, mm/min (modal F resolved).
     pub feed_mm_min: f64,
 }
 
 /// One motion block of the program.
 #[derive(Clone, Debug, PartialEq)]
-#[expect(
-    clippy::large_enum_variant,
-    reason = "Block::Nurbs is large on purpose: fixed-capacity, heap-free blocks for the RT queue"
-)]
 pub enum Block {
     Linear(LinearMove),
     Nurbs(NurbsBlock),

@@ -103,6 +103,9 @@ pub struct Segment {
     pub feed: f64,
     pub rapid: bool,
     pub rotary_only: bool,
+    /// The path comes to rest where this segment starts: a kink of the cutter's tangent
+    /// inside a NURBS block (a knot of multiplicity = degree, see `crate::split`).
+    pub stop: bool,
     pub geometry: Geometry,
     pub tooling: Tooling,
 }
@@ -245,26 +248,29 @@ pub fn build(
     let mut segments: Vec<Segment> = Vec::with_capacity(program.blocks.len());
     for (i, block) in program.blocks.iter().enumerate().skip(1) {
         let index = (i + 1) as u32;
-        let seg = match block {
-            Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?,
-            Block::Nurbs(b) => Some(nurbs(index, b, &pose, kin, limits)?),
+        let segs = match block {
+            Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?
+                .into_iter()
+                .collect(),
+            Block::Nurbs(b) => nurbs(index, b, &pose, kin, limits)?,
         };
-        let Some(seg) = seg else { continue };
-        // With a vertical tool C is free: choose it where the path leaves the vertical.
-        if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
-            if segments.is_empty() {
-                start_joints[4] = c;
-                joints[4] = c;
-            } else if (c - joints[4]).abs() > 1e-9 {
-                segments.push(turn_c(&seg, &joints, c));
-                joints[4] = c;
+        for seg in segs {
+            // With a vertical tool C is free: choose it where the path leaves the vertical.
+            if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
+                if segments.is_empty() {
+                    start_joints[4] = c;
+                    joints[4] = c;
+                } else if (c - joints[4]).abs() > 1e-9 {
+                    segments.push(turn_c(&seg, &joints, c));
+                    joints[4] = c;
+                }
             }
+            // The joints at the end are those the interpolator arrives with: follow the
+            // segment, so the next block starts from the rotary branch the path really took.
+            joints = follow(&seg, kin, &joints, lim);
+            pose = seg.pose(seg.length);
+            segments.push(seg);
         }
-        // The joints at the end are those the interpolator arrives with: follow the
-        // segment, so the next block starts from the rotary branch the path really took.
-        joints = follow(&seg, kin, &joints, lim);
-        pose = seg.pose(seg.length);
-        segments.push(seg);
     }
     Ok(Path {
         start,
@@ -305,6 +311,7 @@ fn turn_c(seg: &Segment, joints: &Joints, c: f64) -> Segment {
         feed: f64::INFINITY, // limited by the C axis alone
         rapid: false,
         rotary_only: true,
+        stop: false,
         geometry: Geometry::Line { from: p, to: p },
         tooling: Tooling::Angles {
             from: (joints[3], joints[4]),
@@ -411,6 +418,7 @@ fn linear(
         feed,
         rapid: m.rapid,
         rotary_only,
+        stop: false,
         geometry: Geometry::Line { from, to },
         tooling,
     }))
@@ -422,9 +430,9 @@ fn nurbs(
     pose: &Pose,
     kin: &MachineKinematics,
     limits: &BuildLimits,
-) -> Result<Segment, BuildError> {
+) -> Result<Vec<Segment>, BuildError> {
     let err = |kind| BuildError { pos: b.pos, kind };
-    let curve = DoubleNurbs::new(
+    let pieces = crate::split::split(
         b.degree as usize,
         &b.ctrl,
         &b.tool_ctrl,
@@ -432,50 +440,81 @@ fn nurbs(
         &b.knots,
     )
     .map_err(|e| err(e.into()))?;
-    let table = ArcTable::new(&curve);
-    if table.length().is_nan() || table.length() < NULL_MOVE_MM {
-        return Err(err(BuildErrorKind::ZeroLength(table.length())));
-    }
     let current = pose.axis(kin);
-    let tooling = match b.kind {
-        NurbsKind::G062 => Tooling::Fixed(current),
-        NurbsKind::G065 => {
-            // The orientation curve must stay clear of the cutter curve everywhere, not only
-            // at the control points the parser saw.
-            let (u0, u1) = curve.range();
-            let n = 2048;
-            for i in 0..=n {
-                let u = u0 + (u1 - u0) * i as f64 / n as f64;
-                let (c, t) = curve.both(u, 0);
-                let dist = (t.p - c.p).norm();
-                if dist.is_nan() || dist < MIN_TOOL_VECTOR_MM {
-                    return Err(err(BuildErrorKind::ToolVectorTooShort { u, dist }));
+    let mut out = Vec::with_capacity(pieces.len());
+    let mut length = 0.0;
+    for (i, piece) in pieces.into_iter().enumerate() {
+        let curve = piece.curve;
+        let table = ArcTable::new(&curve);
+        length += table.length();
+        let tooling = match b.kind {
+            NurbsKind::G062 => Tooling::Fixed(current),
+            NurbsKind::G065 => {
+                tool_clear(&curve).map_err(err)?;
+                if i == 0 {
+                    let (u0, _) = curve.range();
+                    let (c, t) = curve.both(u0, 0);
+                    let start = (t.p - c.p).normalize();
+                    let deg = current
+                        .cross(&start)
+                        .norm()
+                        .atan2(current.dot(&start))
+                        .to_degrees();
+                    if deg > MAX_ORIENTATION_STEP_DEG {
+                        return Err(err(BuildErrorKind::OrientationJump { deg }));
+                    }
                 }
+                Tooling::Curve
             }
-            let (c, t) = curve.both(u0, 0);
-            let start = (t.p - c.p).normalize();
-            let deg = current
-                .cross(&start)
-                .norm()
-                .atan2(current.dot(&start))
-                .to_degrees();
-            if deg > MAX_ORIENTATION_STEP_DEG {
-                return Err(err(BuildErrorKind::OrientationJump { deg }));
+        };
+        out.push(Segment {
+            block,
+            src: b.pos,
+            length: table.length(),
+            feed: (b.feed_mm_min / 60.0).min(limits.max_feed_mm_s),
+            rapid: false,
+            rotary_only: false,
+            stop: piece.corner,
+            geometry: Geometry::Nurbs {
+                curve: Box::new(curve),
+                table: Box::new(table),
+            },
+            tooling,
+        });
+    }
+    if length.is_nan() || length < NULL_MOVE_MM {
+        return Err(err(BuildErrorKind::ZeroLength(length)));
+    }
+    // A piece too short to parametrise by arc length (a sliver between two kinks) is no
+    // motion: leave it out, the pieces on both sides meet at its (sub-micrometre) ends.
+    let keep = |s: &Segment| s.length >= NULL_MOVE_MM;
+    if !out.iter().all(keep) {
+        let mut stop = false;
+        out.retain_mut(|s| {
+            if keep(s) {
+                s.stop |= std::mem::take(&mut stop);
+                true
+            } else {
+                stop = true;
+                false
             }
-            Tooling::Curve
+        });
+    }
+    Ok(out)
+}
+
+/// The orientation curve must stay clear of the cutter curve everywhere, not only at the
+/// control points the parser saw.
+fn tool_clear(curve: &DoubleNurbs) -> Result<(), BuildErrorKind> {
+    let (u0, u1) = curve.range();
+    let n = 2048;
+    for i in 0..=n {
+        let u = u0 + (u1 - u0) * i as f64 / n as f64;
+        let (c, t) = curve.both(u, 0);
+        let dist = (t.p - c.p).norm();
+        if dist.is_nan() || dist < MIN_TOOL_VECTOR_MM {
+            return Err(BuildErrorKind::ToolVectorTooShort { u, dist });
         }
-    };
-    Ok(Segment {
-        block,
-        src: b.pos,
-        length: table.length(),
-        feed: (b.feed_mm_min / 60.0).min(limits.max_feed_mm_s),
-        rapid: false,
-        rotary_only: false,
-        geometry: Geometry::Nurbs {
-            curve: Box::new(curve),
-            table: Box::new(table),
-        },
-        tooling,
-    })
+    }
+    Ok(())
 }

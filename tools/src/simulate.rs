@@ -128,6 +128,24 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     let sps = &run.setpoints;
     let ts = setup.period;
     let seg_of = |block: u32| run.path.segments.iter().find(|s| s.block == block);
+    // A large or kinked block is cut into pieces (`nc::split`) that keep the block's
+    // parameter: a setpoint's u says which piece holds it.
+    let pieces = |block: u32| {
+        run.path
+            .segments
+            .iter()
+            .filter(move |s| s.block == block)
+            .filter_map(|s| s.nurbs().map(|(c, _)| c))
+    };
+    let piece_at = |block: u32, u: f64| {
+        let mut it = pieces(block).peekable();
+        while let Some(c) = it.next() {
+            if u <= c.range().1 || it.peek().is_none() {
+                return Some(c);
+            }
+        }
+        None
+    };
     let (mut fmax, mut fsq, mut fn_) = (0.0f64, 0.0f64, 0u64);
     let mut chord = 0.0f64;
     for w in sps.windows(2) {
@@ -137,12 +155,25 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         }
         let Some(seg) = seg_of(b.block) else { continue };
         let ds = match (seg.nurbs(), a.u, b.u) {
-            (Some((curve, _)), Some(ua), Some(ub)) => {
+            (Some(_), Some(ua), Some(ub)) => {
                 for f in [0.25, 0.5, 0.75] {
-                    let p = curve.cutter(ua + (ub - ua) * f, 0).p;
-                    chord = chord.max(dist_to_chord(&p, &a.p, &b.p));
+                    let u = ua + (ub - ua) * f;
+                    if let Some(curve) = piece_at(b.block, u) {
+                        let p = curve.cutter(u, 0).p;
+                        chord = chord.max(dist_to_chord(&p, &a.p, &b.p));
+                    }
                 }
-                arc_between(curve, ua, ub)
+                let (lo, hi) = (ua.min(ub), ua.max(ub));
+                pieces(b.block)
+                    .map(|c| {
+                        let (r0, r1) = c.range();
+                        if r1 <= lo || r0 >= hi {
+                            0.0
+                        } else {
+                            arc_between(c, lo.max(r0), hi.min(r1))
+                        }
+                    })
+                    .sum()
             }
             (None, None, None) if !seg.rotary_only => (b.p - a.p).norm(),
             _ => continue,

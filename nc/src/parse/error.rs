@@ -9,7 +9,8 @@ use core::fmt;
 
 use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
 use super::parser::{MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH, MIN_WEIGHT};
-use crate::program::{SrcPos, MAX_CTRL};
+use crate::program::SrcPos;
+use crate::split::MAX_BLOCK_CTRL;
 
 /// A parse failure: where it happened and which rule was broken.
 ///
@@ -155,7 +156,7 @@ pub enum ParseErrorKind {
     BadWeight { value: f64 },
     #[error("too few control points ({count}): a degree-{} block needs at least {min} (degree + 1)", .min - 1)]
     TooFewControlPoints { count: usize, min: usize },
-    #[error("control point {} exceeds the capacity of a block: at most MAX_CTRL = {} control points", MAX_CTRL + 1, MAX_CTRL)]
+    #[error("control point {} exceeds the capacity of a block: at most MAX_BLOCK_CTRL = {} control points", MAX_BLOCK_CTRL + 1, MAX_BLOCK_CTRL)]
     TooManyControlPoints,
     #[error(
         "block opened at {opened} has {have} knots, needs {need} (control points + degree + 1)"

@@ -6,12 +6,11 @@
 //! remaining degree + 1 knots. The first `K`-only line fixes the control-point count and so the
 //! knot count; the block is complete when that many knots have arrived.
 
-use heapless::Vec as HVec;
-
 use super::error::{Context, Motion, ParseError, ParseErrorKind};
 use super::lexer::Word;
 use super::line::Line;
-use crate::program::{NurbsBlock, NurbsKind, SrcPos, MAX_DEGREE, MAX_KNOTS};
+use crate::program::{NurbsBlock, NurbsKind, SrcPos, MAX_DEGREE};
+use crate::split::MAX_BLOCK_CTRL;
 
 /// Tolerance of the first control point against the current position, mm per axis.
 pub(super) const START_TOLERANCE_MM: f64 = 1e-3;
@@ -22,7 +21,7 @@ pub(super) struct OpenNurbs {
     block: NurbsBlock,
     motion: Motion,
     /// Position of each knot's `K` word, for errors found when the block completes.
-    knot_pos: HVec<SrcPos, MAX_KNOTS>,
+    knot_pos: Vec<SrcPos>,
     /// Knot count, fixed by the first `K`-only line.
     need: Option<usize>,
 }
@@ -69,17 +68,17 @@ impl OpenNurbs {
             n: line.n,
             kind,
             degree,
-            ctrl: HVec::new(),
-            tool_ctrl: HVec::new(),
-            ctrl_pos: HVec::new(),
-            weights: HVec::new(),
-            knots: HVec::new(),
+            ctrl: Vec::new(),
+            tool_ctrl: Vec::new(),
+            ctrl_pos: Vec::new(),
+            weights: Vec::new(),
+            knots: Vec::new(),
             feed_mm_min,
         };
         let mut open = OpenNurbs {
             block,
             motion,
-            knot_pos: HVec::new(),
+            knot_pos: Vec::new(),
             need: None,
         };
         open.add_point(line, Some(here))?;
@@ -150,12 +149,14 @@ impl OpenNurbs {
                 return Err(ParseErrorKind::StartMismatch { ctrl: xyz, current }.at(pos));
             }
         }
-        let full = ParseErrorKind::TooManyControlPoints.at(pos);
-        self.block.ctrl.push(xyz).map_err(|_| full)?;
-        self.block.ctrl_pos.push(pos).map_err(|_| full)?;
-        self.block.weights.push(weight).map_err(|_| full)?;
+        if self.block.ctrl.len() >= MAX_BLOCK_CTRL {
+            return Err(ParseErrorKind::TooManyControlPoints.at(pos));
+        }
+        self.block.ctrl.push(xyz);
+        self.block.ctrl_pos.push(pos);
+        self.block.weights.push(weight);
         if let Some(uvw) = uvw {
-            self.block.tool_ctrl.push(uvw).map_err(|_| full)?;
+            self.block.tool_ctrl.push(uvw);
         }
         self.push_knot(knot)
     }
@@ -215,13 +216,16 @@ impl OpenNurbs {
                 }));
             }
         }
-        let too_many = at(ParseErrorKind::TooManyKnots {
-            value: k.value,
-            opened: self.block.pos,
-            need: self.block.ctrl.len() + count,
-        });
-        knots.push(k.value).map_err(|_| too_many)?;
-        self.knot_pos.push(k.pos).map_err(|_| too_many)
+        if knots.len() > MAX_BLOCK_CTRL + MAX_DEGREE {
+            return Err(at(ParseErrorKind::TooManyKnots {
+                value: k.value,
+                opened: self.block.pos,
+                need: self.block.ctrl.len() + count,
+            }));
+        }
+        knots.push(k.value);
+        self.knot_pos.push(k.pos);
+        Ok(())
     }
 
     /// The error for a block cut short at `pos` (by another kind of line or the end of file).

@@ -65,12 +65,12 @@ fn too_few_control_points() {
 
 #[test]
 fn too_many_control_points() {
-    let points: String = (1..=64)
+    let points: String = (1..=100_000)
         .map(|i| format!("X{i} Y0 Z0 U{i} V0 W1 K0\n"))
         .collect();
     let src = format!("G01 X0 Y0 Z0 F500\n{OPEN}\n{points}K1 K1\n");
-    assert_eq!(fails(&src, 66, 1), E::TooManyControlPoints);
-    assert!(message(&src).contains("MAX_CTRL = 64"));
+    assert_eq!(fails(&src, 100_002, 1), E::TooManyControlPoints);
+    assert!(message(&src).contains("MAX_BLOCK_CTRL = 100000"));
 }
 
 #[test]
