@@ -11,7 +11,11 @@ fn f(v: &serde_json::Value, key: &str) -> f64 {
 }
 
 fn assert_within_limits(s: &serde_json::Value) {
-    for key in ["axis_velocity_fraction", "axis_acceleration_fraction"] {
+    for key in [
+        "axis_velocity_fraction",
+        "axis_acceleration_fraction",
+        "axis_jerk_fraction",
+    ] {
         let m = s[key]
             .as_object()
             .unwrap_or_else(|| panic!("{key} missing"));

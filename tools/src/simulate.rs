@@ -89,6 +89,9 @@ pub struct Summary {
     pub chord_tolerance_mm: f64,
     pub axis_velocity_fraction: AxisMap,
     pub axis_acceleration_fraction: AxisMap,
+    /// Jerk as the planner's setpoint check measures it (`nc::verify`: inside blocks and
+    /// across G2-continuous junctions, by third differences at the period).
+    pub axis_jerk_fraction: AxisMap,
     pub axis_travel_ok: bool,
     pub tool_axis_deviation_max_deg: f64,
     pub end_position_error_mm: f64,
@@ -263,6 +266,7 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         chord_tolerance_mm: setup.plan.chord_tol,
         axis_velocity_fraction: axis_map(&names, vfrac),
         axis_acceleration_fraction: axis_map(&names, afrac),
+        axis_jerk_fraction: axis_map(&names, run.profile.margins.jerk),
         axis_travel_ok: travel_ok,
         tool_axis_deviation_max_deg: tool_dev,
         end_position_error_mm: end_err,
@@ -289,6 +293,7 @@ impl Summary {
              chord error        max {:.3e} mm (tolerance {} mm)\n\
              axis velocity      {}  (of limit)\n\
              axis acceleration  {}  (of limit)\n\
+             axis jerk          {}  (of limit; inside blocks and over G2 junctions)\n\
              axis travel        {}\n\
              tool axis at knots max deviation {:.3e} deg\n\
              end position error {:.3e} mm\n",
@@ -306,6 +311,7 @@ impl Summary {
             self.chord_tolerance_mm,
             fr(&self.axis_velocity_fraction),
             fr(&self.axis_acceleration_fraction),
+            fr(&self.axis_jerk_fraction),
             if self.axis_travel_ok {
                 "within limits"
             } else {

@@ -1,0 +1,75 @@
+//! The benchmark curves of the NURBS-interpolation literature (`tests/data/classics`, written
+//! by `tools/classics.py`: the published butterfly, fan and dual-spline paths, and our own
+//! figure eights, star and a 500-point helix) run on the paper's machine within every limit
+//! and the tolerance. Checked twice: by the summary `simulate` prints, and from the trace
+//! alone by finite differences at the period, padded with the rest at both ends.
+
+mod common;
+use common::{simulate, Row};
+
+/// paper-ac-table.toml: X Y Z, A, C velocity / acceleration (mm or degrees, s).
+const LIMITS: [(f64, f64); 5] = [
+    (250.0, 2500.0),
+    (250.0, 2500.0),
+    (250.0, 2500.0),
+    (90.0, 900.0),
+    (180.0, 1800.0),
+];
+const PERIOD: f64 = 0.002;
+
+const CLASSICS: [&str; 7] = [
+    "butterfly",
+    "fan-5axis",
+    "dual-spline",
+    "figure-eight-circles",
+    "figure-eight-weights",
+    "star",
+    "helix-500",
+];
+
+/// Largest velocity and acceleration of each axis over the trace, as fractions of the limits.
+fn fractions(rows: &[Row]) -> [(f64, f64); 5] {
+    let mut q: Vec<[f64; 5]> = vec![rows[0].axes; 2];
+    q.extend(rows.iter().map(|r| r.axes));
+    q.extend([rows[rows.len() - 1].axes; 2]);
+    let mut out = [(0.0f64, 0.0f64); 5];
+    for w in q.windows(3) {
+        for j in 0..5 {
+            let v = (w[2][j] - w[1][j]).abs() / PERIOD;
+            let a = (w[2][j] - 2.0 * w[1][j] + w[0][j]).abs() / (PERIOD * PERIOD);
+            out[j].0 = out[j].0.max(v / LIMITS[j].0);
+            out[j].1 = out[j].1.max(a / LIMITS[j].1);
+        }
+    }
+    out
+}
+
+#[test]
+fn the_classics_run_within_every_limit_and_the_tolerance() {
+    for name in CLASSICS {
+        let program = format!("classics/{name}.nc");
+        let (s, rows) = simulate(&program, "paper-ac-table.toml", &["--method", "arclength"]);
+        for key in [
+            "axis_velocity_fraction",
+            "axis_acceleration_fraction",
+            "axis_jerk_fraction",
+        ] {
+            for (axis, frac) in s[key].as_object().unwrap() {
+                let frac = frac.as_f64().unwrap();
+                assert!(frac <= 1.0 + 1e-9, "{name}: {key} {axis} = {frac}");
+            }
+        }
+        let chord = s["chord_error_max_mm"].as_f64().unwrap();
+        assert!(chord <= 0.001 * (1.0 + 1e-9), "{name}: chord {chord} mm");
+        assert_eq!(s["axis_travel_ok"], true, "{name}");
+        let end = s["end_position_error_mm"].as_f64().unwrap();
+        assert!(end < 1e-6, "{name}: ends {end} mm from the program's end");
+        for (j, (v, a)) in fractions(&rows).iter().enumerate() {
+            assert!(*v <= 1.0 + 1e-6, "{name}: axis {j} velocity {v}x its limit");
+            assert!(
+                *a <= 1.0 + 1e-6,
+                "{name}: axis {j} acceleration {a}x its limit"
+            );
+        }
+    }
+}
