@@ -455,13 +455,32 @@ fn nurbs(
                     let (u0, _) = curve.range();
                     let (c, t) = curve.both(u0, 0);
                     let start = (t.p - c.p).normalize();
-                    let deg = current
-                        .cross(&start)
-                        .norm()
-                        .atan2(current.dot(&start))
-                        .to_degrees();
-                    if deg > MAX_ORIENTATION_STEP_DEG {
-                        return Err(err(BuildErrorKind::OrientationJump { deg }));
+                    let angle = current.cross(&start).norm().atan2(current.dot(&start));
+                    if angle.to_degrees() > MAX_ORIENTATION_STEP_DEG {
+                        return Err(err(BuildErrorKind::OrientationJump {
+                            deg: angle.to_degrees(),
+                        }));
+                    }
+                    // A post prints I J K to a few decimals: the curve's own start axis is a
+                    // hair off. Turn the tool there at rest, within the rotary limits,
+                    // rather than step the rotary axes in the block's first period (a jerk
+                    // no feed can bring within the limit).
+                    if angle >= NULL_MOVE {
+                        out.push(Segment {
+                            block,
+                            src: b.pos,
+                            length: angle.to_degrees(),
+                            feed: f64::INFINITY, // limited by the rotary axes alone
+                            rapid: false,
+                            rotary_only: true,
+                            stop: false,
+                            geometry: Geometry::Line { from: c.p, to: c.p },
+                            tooling: Tooling::Slerp {
+                                from: current,
+                                to: start,
+                                angle,
+                            },
+                        });
                     }
                 }
                 Tooling::Curve
@@ -482,12 +501,13 @@ fn nurbs(
             tooling,
         });
     }
+    // The length of the cutter curve (the turn at rest above is in degrees, not counted).
     if length.is_nan() || length < NULL_MOVE_MM {
         return Err(err(BuildErrorKind::ZeroLength(length)));
     }
     // A piece too short to parametrise by arc length (a sliver between two kinks) is no
     // motion: leave it out, the pieces on both sides meet at its (sub-micrometre) ends.
-    let keep = |s: &Segment| s.length >= NULL_MOVE_MM;
+    let keep = |s: &Segment| s.rotary_only || s.length >= NULL_MOVE_MM;
     if !out.iter().all(keep) {
         let mut stop = false;
         out.retain_mut(|s| {
