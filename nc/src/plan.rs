@@ -291,6 +291,19 @@ pub enum PlanErrorKind {
         max: f64,
         t: f64,
     },
+    #[error("the rotary axes would change solution in one period at t = {t:.3} s, for the same tool axis: {tilt} {from_tilt:.3} -> {to_tilt:.3} deg, C {from_c:.3} -> {to_c:.3} deg; following the tool axis on would leave the travel of {tilt} ({tilt_min} .. {tilt_max} deg) or C ({c_min} .. {c_max} deg)")]
+    Branch {
+        tilt: char,
+        from_tilt: f64,
+        to_tilt: f64,
+        from_c: f64,
+        to_c: f64,
+        t: f64,
+        tilt_min: f64,
+        tilt_max: f64,
+        c_min: f64,
+        c_max: f64,
+    },
     #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x its limit of {limit:.4e} {unit}, even at the slowest feed the planner schedules there ({v:.3e} {path_unit}/s){hint}", subject(*.axis), .quantity.name(), .value / .limit)]
     Limit {
         /// The axis, or `None` for the chord error of the cutter path.
@@ -339,6 +352,18 @@ fn refuse(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig, v: &Violation)
         "mm"
     };
     let kind = match v.quantity {
+        Quantity::Branch => PlanErrorKind::Branch {
+            tilt: axis_name(kin, 3),
+            from_tilt: v.rotary[0][0].to_degrees(),
+            to_tilt: v.rotary[1][0].to_degrees(),
+            from_c: v.rotary[0][1].to_degrees(),
+            to_c: v.rotary[1][1].to_degrees(),
+            t: v.t,
+            tilt_min: cfg.travel[3].0.to_degrees(),
+            tilt_max: cfg.travel[3].1.to_degrees(),
+            c_min: cfg.travel[4].0.to_degrees(),
+            c_max: cfg.travel[4].1.to_degrees(),
+        },
         Quantity::Travel => PlanErrorKind::Travel {
             axis: axis_name(kin, v.axis),
             unit: base,

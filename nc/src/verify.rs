@@ -35,6 +35,10 @@ pub enum Quantity {
     Jerk,
     Chord,
     Travel,
+    /// The rotary axes change solution within one period for the same tool axis: the
+    /// other tilt sign with C half a turn on, or C a whole turn on. The kinematics does that
+    /// only where following the tool on would leave a rotary travel; no feed can fix it.
+    Branch,
 }
 
 impl Quantity {
@@ -45,6 +49,7 @@ impl Quantity {
             Quantity::Jerk => "jerk",
             Quantity::Chord => "chord error",
             Quantity::Travel => "travel",
+            Quantity::Branch => "rotary branch",
         }
     }
 
@@ -54,7 +59,7 @@ impl Quantity {
             Quantity::Velocity => Some(1),
             Quantity::Acceleration | Quantity::Chord => Some(2),
             Quantity::Jerk => Some(3),
-            Quantity::Travel => None,
+            Quantity::Travel | Quantity::Branch => None,
         }
     }
 }
@@ -77,6 +82,8 @@ pub struct Violation {
     /// The measured value and its limit (absolute; radians for rotary axes).
     pub value: f64,
     pub limit: f64,
+    /// For [`Quantity::Branch`]: (tilt, C) before and after the change, radians.
+    pub rotary: [[f64; 2]; 2],
 }
 
 impl Violation {
@@ -194,6 +201,7 @@ fn violation(q: Quantity, axis: usize, w: &[Sample], value: f64, limit: f64) -> 
         v: w.iter().map(|x| x.v).fold(0.0, f64::max),
         value,
         limit,
+        rotary: [[0.0; 2]; 2],
     }
 }
 
@@ -281,6 +289,9 @@ fn check_window(
             }
         }
     }
+    if let Some(v) = branch_change(w) {
+        keep(v, &mut found);
+    }
     let chord = chord_error(&w[2], &w[3], path);
     m.chord = m.chord.max(chord / cfg.chord_tol);
     if chord > cfg.chord_tol * (1.0 + SLACK) || chord.is_nan() {
@@ -292,6 +303,22 @@ fn check_window(
     if let Some(v) = found {
         record(out, v);
     }
+}
+
+/// A change of rotary solution between the two newest setpoints (see [`Quantity::Branch`]).
+/// A tool passing near the vertical swings C fast but continuously, with the tilt near zero;
+/// it never steps C by exactly half a turn at a tilt of its own, nor by whole turns.
+fn branch_change(w: &[Sample; 4]) -> Option<Violation> {
+    use core::f64::consts::{PI, TAU};
+    let (a, b) = (&w[2].q, &w[3].q);
+    let (t0, t1, dc) = (a[3], b[3], b[4] - a[4]);
+    let near = |x: f64, y: f64| (x - y).abs() < 1e-3;
+    let flip = t0 * t1 < 0.0 && t0.abs() > 1e-3 && t1.abs() > 1e-3 && near(dc.abs(), PI);
+    let wrap = dc.abs() > PI && near((dc / TAU).round() * TAU, dc) && near(t0, t1);
+    (flip || wrap).then(|| Violation {
+        rotary: [[t0, a[4]], [t1, b[4]]],
+        ..violation(Quantity::Branch, 4, &w[2..], dc.abs(), 0.0)
+    })
 }
 
 fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
