@@ -130,9 +130,21 @@ fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
 pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     let sps = &run.setpoints;
     let ts = setup.period;
-    let seg_of = |block: u32| run.path.segments.iter().find(|s| s.block == block);
-    // A large or kinked block is cut into pieces (`nc::split`) that keep the block's
-    // parameter: a setpoint's u says which piece holds it.
+    // A block may be several segments: pieces of a large or kinked curve (`nc::split`), a
+    // turn at rest before it. A setpoint's u says which piece holds it; a line's setpoints
+    // (no u) belong to the block's straight move.
+    let line_of = |block: u32| {
+        run.path
+            .segments
+            .iter()
+            .find(|s| s.block == block && !s.rotary_only && s.nurbs().is_none())
+    };
+    let turns = |block: u32| {
+        run.path
+            .segments
+            .iter()
+            .any(|s| s.block == block && s.rotary_only)
+    };
     let pieces = |block: u32| {
         run.path
             .segments
@@ -156,9 +168,8 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         if a.block != b.block || b.done {
             continue;
         }
-        let Some(seg) = seg_of(b.block) else { continue };
-        let ds = match (seg.nurbs(), a.u, b.u) {
-            (Some(_), Some(ua), Some(ub)) => {
+        let ds = match (a.u, b.u) {
+            (Some(ua), Some(ub)) => {
                 for f in [0.25, 0.5, 0.75] {
                     let u = ua + (ub - ua) * f;
                     if let Some(curve) = piece_at(b.block, u) {
@@ -178,7 +189,10 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
                     })
                     .sum()
             }
-            (None, None, None) if !seg.rotary_only => (b.p - a.p).norm(),
+            // A turn at rest in the block (the cutter stands, the tool turns) is no feed.
+            (None, None) if line_of(b.block).is_some() && !(a.p == b.p && turns(b.block)) => {
+                (b.p - a.p).norm()
+            }
             _ => continue,
         };
         if a.feed == b.feed && b.feed > 0.0 {
