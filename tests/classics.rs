@@ -5,17 +5,7 @@
 //! alone by finite differences at the period, padded with the rest at both ends.
 
 mod common;
-use common::{simulate, Row};
-
-/// paper-ac-table.toml: X Y Z, A, C velocity / acceleration (mm or degrees, s).
-const LIMITS: [(f64, f64); 5] = [
-    (250.0, 2500.0),
-    (250.0, 2500.0),
-    (250.0, 2500.0),
-    (90.0, 900.0),
-    (180.0, 1800.0),
-];
-const PERIOD: f64 = 0.002;
+use common::{fractions, simulate, Row};
 
 const CLASSICS: [&str; 7] = [
     "butterfly",
@@ -26,23 +16,6 @@ const CLASSICS: [&str; 7] = [
     "star",
     "helix-500",
 ];
-
-/// Largest velocity and acceleration of each axis over the trace, as fractions of the limits.
-fn fractions(rows: &[Row]) -> [(f64, f64); 5] {
-    let mut q: Vec<[f64; 5]> = vec![rows[0].axes; 2];
-    q.extend(rows.iter().map(|r| r.axes));
-    q.extend([rows[rows.len() - 1].axes; 2]);
-    let mut out = [(0.0f64, 0.0f64); 5];
-    for w in q.windows(3) {
-        for j in 0..5 {
-            let v = (w[2][j] - w[1][j]).abs() / PERIOD;
-            let a = (w[2][j] - 2.0 * w[1][j] + w[0][j]).abs() / (PERIOD * PERIOD);
-            out[j].0 = out[j].0.max(v / LIMITS[j].0);
-            out[j].1 = out[j].1.max(a / LIMITS[j].1);
-        }
-    }
-    out
-}
 
 #[test]
 fn the_classics_run_within_every_limit_and_the_tolerance() {

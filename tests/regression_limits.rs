@@ -4,17 +4,9 @@
 //! the period.
 
 mod common;
-use common::{dnurbs, machine, read_trace, temp, Row};
+use common::{dnurbs, fractions, machine, read_trace, temp, Row};
 
-/// paper-ac-table.toml: X Y Z, A, C velocity / acceleration / jerk (mm or degrees, s).
-const LIMITS: [(f64, f64, f64); 5] = [
-    (250.0, 2500.0, 50000.0),
-    (250.0, 2500.0, 50000.0),
-    (250.0, 2500.0, 50000.0),
-    (90.0, 900.0, 20000.0),
-    (180.0, 1800.0, 40000.0),
-];
-const PERIOD: f64 = 0.002;
+const PERIOD: f64 = common::PAPER_PERIOD;
 
 /// `simulate` on paper-ac-table: Ok(rows) on success, Err(stderr) on exit 2.
 fn simulate(name: &str, program: &str) -> Result<Vec<Row>, String> {
@@ -41,24 +33,6 @@ fn simulate(name: &str, program: &str) -> Result<Vec<Row>, String> {
     };
     let _ = std::fs::remove_file(&trace);
     result
-}
-
-/// Largest velocity and acceleration of each axis as a fraction of its limit, by finite
-/// differences over the trace padded with the rest before and after.
-fn fractions(rows: &[Row]) -> [(f64, f64); 5] {
-    let mut q: Vec<[f64; 5]> = vec![rows[0].axes; 2];
-    q.extend(rows.iter().map(|r| r.axes));
-    q.extend([rows[rows.len() - 1].axes; 2]);
-    let mut out = [(0.0f64, 0.0f64); 5];
-    for w in q.windows(3) {
-        for j in 0..5 {
-            let v = (w[2][j] - w[1][j]).abs() / PERIOD;
-            let a = (w[2][j] - 2.0 * w[1][j] + w[0][j]).abs() / (PERIOD * PERIOD);
-            out[j].0 = out[j].0.max(v / LIMITS[j].0);
-            out[j].1 = out[j].1.max(a / LIMITS[j].1);
-        }
-    }
-    out
 }
 
 fn assert_within_limits(name: &str, rows: &[Row]) {

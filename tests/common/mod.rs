@@ -163,3 +163,34 @@ pub fn unit(v: [f64; 3]) -> [f64; 3] {
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     [v[0] / n, v[1] / n, v[2] / n]
 }
+
+/// paper-ac-table.toml: X Y Z, A, C velocity / acceleration / jerk (mm or degrees, s), and
+/// its period.
+pub const PAPER_LIMITS: [(f64, f64, f64); 5] = [
+    (250.0, 2500.0, 50000.0),
+    (250.0, 2500.0, 50000.0),
+    (250.0, 2500.0, 50000.0),
+    (90.0, 900.0, 20000.0),
+    (180.0, 1800.0, 40000.0),
+];
+pub const PAPER_PERIOD: f64 = 0.002;
+
+/// Largest velocity and acceleration of each axis over a trace of the paper machine, as
+/// fractions of its limits, by finite differences at the period over the trace padded with
+/// the rest before and after.
+pub fn fractions(rows: &[Row]) -> [(f64, f64); 5] {
+    let mut q: Vec<[f64; 5]> = vec![rows[0].axes; 2];
+    q.extend(rows.iter().map(|r| r.axes));
+    q.extend([rows[rows.len() - 1].axes; 2]);
+    let ts = PAPER_PERIOD;
+    let mut out = [(0.0f64, 0.0f64); 5];
+    for w in q.windows(3) {
+        for j in 0..5 {
+            let v = (w[2][j] - w[1][j]).abs() / ts;
+            let a = (w[2][j] - 2.0 * w[1][j] + w[0][j]).abs() / (ts * ts);
+            out[j].0 = out[j].0.max(v / PAPER_LIMITS[j].0);
+            out[j].1 = out[j].1.max(a / PAPER_LIMITS[j].1);
+        }
+    }
+    out
+}
