@@ -7,16 +7,14 @@
 //! socketpair link (the socketcan code path) and once over the in-memory link of
 //! `dnurbs demo`; the counts are per thread, so the two tests may run side by side.
 
-use config::bus::Drive;
+mod common;
+
 use drives::link::{CanLink, MemLink, SocketLink};
-use drives::master::{configure, Master, SetupOptions, Supervision};
-use drives::sim::{SimNodeConfig, SimThread};
-use drives::wire::NodeId;
 use nc::kinematics::MachineKinematics;
 use nc::stream::{chunks, Follower, HoldConfig, Queues};
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
-use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, Stage};
+use rt_loop::pipeline::{drive_loop, ApproachLimits, Pipeline, Progress, Stage};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -59,17 +57,6 @@ const PERIOD: f64 = 150e-6;
 const LEAD_NS: u64 = 20_000;
 const PAPER: &str = include_str!("../../tests/data/paper-example.nc");
 
-fn drive(axis: usize, node: u8, counts_per_unit: f64) -> Drive {
-    Drive {
-        axis,
-        bus: 0,
-        node,
-        counts_per_unit,
-        sign: 1,
-        offset: 0,
-    }
-}
-
 #[test]
 fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods_on_a_socketpair() {
     let (link, drive_end) = SocketLink::pair().unwrap();
@@ -82,7 +69,7 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods_on_the_memor
     prove(link, drive_end);
 }
 
-fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(mut link: L, drive_end: D) {
+fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let program = nc::parse::parse(PAPER).unwrap();
@@ -91,25 +78,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(mut link: L, drive_end:
     let (start, list) = chunks(path, &profile);
     let mut source = list.into_iter();
 
-    let drives = [
-        drive(0, 1, 10000.0),
-        drive(1, 2, 10000.0),
-        drive(2, 3, 10000.0),
-        drive(3, 4, 1000.0),
-        drive(4, 5, 1000.0),
-    ];
-    let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
-    let sims = nodes.iter().map(|&n| SimNodeConfig::new(n)).collect();
-    let sim = SimThread::start(drive_end, sims, PERIOD, Duration::from_micros(20)).unwrap();
-    let mut opts = SetupOptions::new(PERIOD);
-    opts.boot_timeout = Duration::from_secs(5);
-    let initial = configure(&mut link, &nodes, &opts, &mut |_| {}).unwrap();
-    // Function, not timing, is tested here: supervision is lenient for a loaded CI machine.
-    let sup = Supervision {
-        heartbeat_timeout_s: 10.0,
-        feedback_timeout_cycles: 1_000_000,
-    };
-    let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9).unwrap();
+    let (bus, sim) = common::sim_bus(link, drive_end, PERIOD, [1e4, 1e4, 1e4, 1e3, 1e3]);
 
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(4);
@@ -120,7 +89,6 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(mut link: L, drive_end:
         acceleration: [2500.0, 2500.0, 2500.0, 900.0, 900.0],
         jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
     };
-    let bus = BusDrives::new(master, &drives).unwrap();
     let mut pipeline = Pipeline::new(
         follower,
         vec![bus],

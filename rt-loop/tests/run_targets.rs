@@ -12,16 +12,15 @@
 //! not checked here: the recorded stream does not say where blocks meet. The check does not
 //! depend on timing: a late period delays a SYNC, it does not change the targets' sequence.
 
-use config::bus::Drive;
+mod common;
+
 use drives::link::MemLink;
-use drives::master::{configure, Master, SetupOptions, Supervision};
-use drives::sim::{Record, SimNodeConfig, SimThread};
-use drives::wire::NodeId;
+use drives::sim::Record;
 use nc::kinematics::MachineKinematics;
 use nc::stream::{chunks, Follower, HoldConfig, Queues};
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
-use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, Stage};
+use rt_loop::pipeline::{drive_loop, ApproachLimits, Pipeline, Progress, Stage};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
@@ -65,29 +64,8 @@ fn run(src: &str) -> Vec<Vec<i32>> {
     let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
     let (start, list) = chunks(path, &profile);
     let mut source = list.into_iter();
-    let (mut link, drive_end) = MemLink::pair(1024);
-    let drives: Vec<Drive> = (0..5)
-        .map(|axis| Drive {
-            axis,
-            bus: 0,
-            node: axis as u8 + 1,
-            counts_per_unit: CPU[axis],
-            sign: 1,
-            offset: 0,
-        })
-        .collect();
-    let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
-    let sims = nodes.iter().map(|&n| SimNodeConfig::new(n)).collect();
-    let sim = SimThread::start(drive_end, sims, PERIOD, Duration::from_micros(20)).unwrap();
-    let mut opts = SetupOptions::new(PERIOD);
-    opts.boot_timeout = Duration::from_secs(5);
-    let initial = configure(&mut link, &nodes, &opts, &mut |_| {}).unwrap();
-    // Function, not timing, is tested: supervision is lenient for a loaded machine.
-    let sup = Supervision {
-        heartbeat_timeout_s: 30.0,
-        feedback_timeout_cycles: 1_000_000,
-    };
-    let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9).unwrap();
+    let (link, drive_end) = MemLink::pair(1024);
+    let (bus, sim) = common::sim_bus(link, drive_end, PERIOD, CPU);
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(64);
     feeder.feed(&mut source);
@@ -97,7 +75,6 @@ fn run(src: &str) -> Vec<Vec<i32>> {
         acceleration: LIMITS.map(|l| l.1),
         jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
     };
-    let bus = BusDrives::new(master, &drives).unwrap();
     let mut pipeline = Pipeline::new(
         follower,
         vec![bus],
