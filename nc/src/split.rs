@@ -51,18 +51,15 @@ pub fn split(
     if n > MAX_BLOCK_CTRL {
         return Err(CurveError::CtrlCount(n));
     }
-    if n <= MAX_CTRL {
+    // The whole net first: the knot scan below relies on a valid knot vector.
+    crate::nurbs::validate_net(degree, n, tool.len(), weights, knots)?;
+    if n <= MAX_CTRL && !has_full_knots(degree, knots) {
         let curve = DoubleNurbs::new(degree, ctrl, tool, weights, knots)?;
-        let mut pieces = vec![Piece {
+        return Ok(vec![Piece {
             curve,
             corner: false,
-        }];
-        if has_full_knots(degree, knots) {
-            pieces = cut(degree, ctrl, tool, weights, knots)?;
-        }
-        return Ok(pieces);
+        }]);
     }
-    crate::nurbs::validate_net(degree, n, tool.len(), weights, knots)?;
     cut(degree, ctrl, tool, weights, knots)
 }
 
