@@ -165,18 +165,29 @@ impl ArcTable {
     /// Spend the rest of the node budget where the table is least accurate. A weight far
     /// below its neighbours' packs most of a curve's length into a sliver of its parameter
     /// range (a measured case: 22 of 37.6 mm within u in [0.998, 1]); intervals even in u
-    /// then cannot follow it. Each pass estimates every interval's error (the 8-point
-    /// length against the sum over its halves, and the quintic inverse at its middle) and
-    /// halves the worst ones, until all are below [`TOLERANCE`] or the budget is spent.
+    /// then cannot follow it. Every interval's error is estimated once, when it is made
+    /// (the 8-point length against the sum over its halves, and the quintic inverse at its
+    /// middle); each pass halves the worst ones, until all are below [`TOLERANCE`] or the
+    /// budget is spent.
     /// Bounded: at most `MAX_NODES` intervals, and each pass adds at least one.
     fn refine(curve: &DoubleNurbs, cuts: &mut Vec<(f64, f64)>) {
         let budget = MAX_NODES - 1;
+        // Each interval's error is estimated once, when it is made.
+        let error = |(a, b): (f64, f64)| {
+            let e = interval_error(curve, a, b);
+            if e.is_nan() {
+                f64::INFINITY
+            } else {
+                e
+            }
+        };
+        let mut errs: Vec<f64> = cuts.iter().map(|&c| error(c)).collect();
         while cuts.len() < budget {
-            let mut bad: Vec<(f64, usize)> = cuts
+            let mut bad: Vec<(f64, usize)> = errs
                 .iter()
                 .enumerate()
-                .map(|(i, &(a, b))| (interval_error(curve, a, b), i))
-                .filter(|&(e, _)| e > TOLERANCE || e.is_nan())
+                .filter(|&(_, &e)| e > TOLERANCE)
+                .map(|(i, &e)| (e, i))
                 .collect();
             if bad.is_empty() {
                 return;
@@ -186,21 +197,24 @@ impl ArcTable {
             let mut split: Vec<usize> = bad.iter().map(|&(_, i)| i).collect();
             split.sort_unstable();
             let mut out = Vec::with_capacity(cuts.len() + split.len());
+            let mut out_errs = Vec::with_capacity(cuts.len() + split.len());
             let mut next = split.iter().peekable();
             for (i, &(a, b)) in cuts.iter().enumerate() {
                 let m = 0.5 * (a + b);
                 if next.peek() == Some(&&i) && m > a && m < b {
                     next.next();
-                    out.push((a, m));
-                    out.push((m, b));
+                    out.extend([(a, m), (m, b)]);
+                    out_errs.extend([error((a, m)), error((m, b))]);
                 } else {
                     out.push((a, b));
+                    out_errs.push(errs[i]);
                 }
             }
             if out.len() == cuts.len() {
                 return; // nothing could be halved any more (f64 resolution)
             }
             *cuts = out;
+            errs = out_errs;
         }
     }
 

@@ -472,12 +472,20 @@ pub fn plan(
         stations(path, kin, cfg)
     };
     let mut round = 0;
+    // The last round's schedule and its first violation: a schedule that the caps did not
+    // change would measure the same violations again, round after round.
+    let mut last: Option<(Vec<Phase>, Violation)> = None;
     loop {
         let phases = if st.is_empty() {
             Vec::new()
         } else {
             schedule(&st, &starts, cfg)
         };
+        if let Some((prev, v)) = &last {
+            if *prev == phases {
+                return Err(refuse(path, kin, cfg, v));
+            }
+        }
         let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
         if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
             return Err(too_long(path, &seg_start, &phases, duration, cfg.period));
@@ -519,6 +527,7 @@ pub fn plan(
             };
             cap_stations(&mut st, v.s, v.v * factor * CAP_MARGIN);
         }
+        last = Some((profile.phases, checked.violations[0]));
         round += 1;
     }
 }
