@@ -105,7 +105,59 @@ pub struct Interpolator<'a> {
     done: bool,
 }
 
+/// Where an [`Interpolator`] stands between two periods ([`Interpolator::mark`]). It can
+/// go on from there on another profile whose phases up to the mark's time are the same
+/// ([`Interpolator::resume`]): the planner's check uses that to re-measure only what a
+/// round of replanning changed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mark {
+    cycle: u64,
+    phase: usize,
+    seg: usize,
+    u: f64,
+    line_s: f64,
+    prev_motion: Motion,
+    joints: Joints,
+    done: bool,
+}
+
+impl Mark {
+    /// Cycle of the next setpoint.
+    pub fn next_cycle(&self) -> u64 {
+        self.cycle
+    }
+}
+
 impl<'a> Interpolator<'a> {
+    /// Where the interpolator stands: the next [`Interpolator::step`] gives cycle
+    /// `mark.next_cycle()`.
+    pub fn mark(&self) -> Mark {
+        Mark {
+            cycle: self.cycle,
+            phase: self.phase,
+            seg: self.seg,
+            u: self.u,
+            line_s: self.line_s,
+            prev_motion: self.prev_motion,
+            joints: self.joints,
+            done: self.done,
+        }
+    }
+
+    /// Go on from `mark`, taken from an interpolator over the same path, method and period.
+    /// The setpoints that follow are those of this interpolator's own profile as long as
+    /// that profile's phases are the same as the marked one's up to the mark's time.
+    pub fn resume(&mut self, mark: &Mark) {
+        self.cycle = mark.cycle;
+        self.phase = mark.phase;
+        self.seg = mark.seg;
+        self.u = mark.u;
+        self.line_s = mark.line_s;
+        self.prev_motion = mark.prev_motion;
+        self.joints = mark.joints;
+        self.done = mark.done;
+    }
+
     /// `creep` is the speed (path units/s) used by the Taylor methods to finish the program
     /// after the profile has come to rest; pass the path acceleration times the period.
     pub fn new(

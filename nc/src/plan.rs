@@ -29,7 +29,9 @@ use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::program::SrcPos;
 use crate::scurve::{push_section, reachable, Motion, Phase};
 use crate::segment::{Geometry, Path, Segment};
-use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
+use crate::verify::{
+    check_from, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
+};
 
 /// Limits of one machine axis, in mm or radians and seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -472,18 +474,19 @@ pub fn plan(
         stations(path, kin, cfg)
     };
     let mut round = 0;
-    // The last round's schedule and its first violation: a schedule that the caps did not
-    // change would measure the same violations again, round after round.
-    let mut last: Option<(Vec<Phase>, Violation)> = None;
+    // The last round's schedule, check and trace. A schedule that the caps did not change
+    // would measure the same violations again, round after round; one they changed is
+    // re-measured from where it first differs.
+    let mut last: Option<(Vec<Phase>, Checked, Trace)> = None;
     loop {
         let phases = if st.is_empty() {
             Vec::new()
         } else {
             schedule(&st, &starts, cfg)
         };
-        if let Some((prev, v)) = &last {
+        if let Some((prev, checked, _)) = &last {
             if *prev == phases {
-                return Err(refuse(path, kin, cfg, v));
+                return Err(refuse(path, kin, cfg, &checked.violations[0]));
             }
         }
         let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
@@ -497,7 +500,12 @@ pub fn plan(
             duration,
             margins: Margins::default(),
         };
-        let checked = crate::verify::check(path, &profile, kin, cfg, &smooth);
+        let earlier = last.as_ref().map(|(phases, checked, trace)| Earlier {
+            phases,
+            checked,
+            trace,
+        });
+        let (checked, trace) = check_from(path, &profile, kin, cfg, &smooth, earlier);
         if checked.violations.is_empty() {
             profile.margins = checked.margins;
             return Ok(profile);
@@ -527,7 +535,7 @@ pub fn plan(
             };
             cap_stations(&mut st, v.s, v.v * factor * CAP_MARGIN);
         }
-        last = Some((profile.phases, checked.violations[0]));
+        last = Some((profile.phases, checked, trace));
         round += 1;
     }
 }

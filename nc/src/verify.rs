@@ -21,9 +21,10 @@
 //! What it finds drives the planner (`crate::plan::plan` lowers the speed where a limit is
 //! broken and plans again) and, where slowing cannot help, the refusal of the program.
 
-use crate::interp::{Interpolator, Method, Setpoint};
+use crate::interp::{Interpolator, Mark, Method, Setpoint};
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::plan::{FeedProfile, PlanConfig};
+use crate::scurve::Phase;
 use crate::segment::{Geometry, Path, Segment};
 use nalgebra::Vector3;
 
@@ -119,7 +120,7 @@ const SLACK: f64 = 1e-9;
 pub const MAX_CYCLES: u64 = 86_400_000;
 
 /// A setpoint with what the check needs beside it.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 struct Sample {
     q: Joints,
     p: Vector3<f64>,
@@ -141,7 +142,63 @@ pub fn check(
     cfg: &PlanConfig,
     smooth: &[bool],
 ) -> Checked {
+    check_from(path, profile, kin, cfg, smooth, None).0
+}
+
+/// Periods between two [`Trace`] marks.
+const MARK_EVERY: u64 = 2048;
+
+/// A check's state every [`MARK_EVERY`] periods, to start the next round's check where the
+/// replanned profile first differs ([`check_from`]).
+#[derive(Clone, Debug, Default)]
+pub struct Trace {
+    marks: Vec<TraceMark>,
+}
+
+#[derive(Clone, Debug)]
+struct TraceMark {
+    ip: Mark,
+    win: [Sample; 4],
+    cursor: usize,
+    margins: Margins,
+    /// Violations recorded before the mark.
+    violations: usize,
+}
+
+/// A check of an earlier profile of the same path: its phases, result and trace.
+pub struct Earlier<'a> {
+    pub phases: &'a [Phase],
+    pub checked: &'a Checked,
+    pub trace: &'a Trace,
+}
+
+/// As [`check`], and where `earlier` is given, start from its last mark before the first
+/// phase in which `profile` differs from it: up to there the interpolator computes the same
+/// setpoints, so their measurements (margins and violations) are taken over. Returns the
+/// trace for the next round.
+pub fn check_from(
+    path: &Path,
+    profile: &FeedProfile,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+    smooth: &[bool],
+    earlier: Option<Earlier>,
+) -> (Checked, Trace) {
+    check_marked(path, profile, kin, cfg, smooth, earlier, MARK_EVERY)
+}
+
+/// [`check_from`] with a mark every `every` periods.
+fn check_marked(
+    path: &Path,
+    profile: &FeedProfile,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+    smooth: &[bool],
+    earlier: Option<Earlier>,
+    every: u64,
+) -> (Checked, Trace) {
     let mut out = Checked::default();
+    let mut trace = Trace::default();
     let ts = cfg.period;
     let mut ip = Interpolator::new(path, profile, *kin, cfg.rotary, Method::ArcLength, ts, 0.0);
     let mut cursor = 0;
@@ -153,6 +210,31 @@ pub fn check(
     let mut done = first.cycle == 0 && path.segments.is_empty();
     out.margins.cycles = 1;
     check_travel(&first, cfg, &mut out);
+    if let Some(e) = earlier {
+        let same = e
+            .phases
+            .iter()
+            .zip(&profile.phases)
+            .take_while(|(a, b)| a == b)
+            .count();
+        let t0 = |p: &[Phase]| p.get(same).map_or(f64::INFINITY, |x| x.t0);
+        let changed = t0(e.phases).min(t0(&profile.phases));
+        // The mark's own and earlier setpoints were computed before the change.
+        let usable = e
+            .trace
+            .marks
+            .iter()
+            .take_while(|m| (m.win[3].t + ts) < changed)
+            .count();
+        if let Some(m) = usable.checked_sub(1).map(|i| &e.trace.marks[i]) {
+            ip.resume(&m.ip);
+            win = m.win;
+            cursor = m.cursor;
+            out.margins = m.margins;
+            out.violations = e.checked.violations[..m.violations].to_vec();
+            trace.marks = e.trace.marks[..usable].to_vec();
+        }
+    }
     while tail < 3 {
         let next = if done {
             tail += 1;
@@ -171,8 +253,17 @@ pub fn check(
         win = [win[1], win[2], win[3], next];
         check_travel(&next, cfg, &mut out);
         check_window(&win, path, cfg, smooth, &mut out);
+        if !done && next.cycle % every == 0 {
+            trace.marks.push(TraceMark {
+                ip: ip.mark(),
+                win,
+                cursor,
+                margins: out.margins,
+                violations: out.violations.len(),
+            });
+        }
     }
-    out
+    (out, trace)
 }
 
 fn sample(sp: &Setpoint, seg: usize, profile: &FeedProfile, cursor: &mut usize) -> Sample {
@@ -406,3 +497,6 @@ fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bo
             && (d2a - d2b).abs() < 1e-2 * scale
     })
 }
+
+#[cfg(test)]
+mod tests;
