@@ -26,10 +26,16 @@ fn nodes(n: u8) -> Vec<NodeId> {
 }
 
 fn sim_nodes(n: u8, faults: impl Fn(u8) -> Faults) -> Vec<SimNodeConfig> {
+    lagging_nodes(n, 0.0, faults)
+}
+
+/// As [`sim_nodes`], each drive's position following its target with time constant `lag_s`.
+fn lagging_nodes(n: u8, lag_s: f64, faults: impl Fn(u8) -> Faults) -> Vec<SimNodeConfig> {
     (1..=n)
         .map(|i| {
             let mut c = SimNodeConfig::new(NodeId::new(i).unwrap());
             c.initial_position = 1000 * i32::from(i);
+            c.lag_s = lag_s;
             c.faults = faults(i);
             c
         })
@@ -53,8 +59,15 @@ fn start(
     n: u8,
     faults: impl Fn(u8) -> Faults,
 ) -> (Master<SocketLink>, SimThread, Instant, Vec<i32>) {
+    start_nodes(n, sim_nodes(n, faults))
+}
+
+fn start_nodes(
+    n: u8,
+    sims: Vec<SimNodeConfig>,
+) -> (Master<SocketLink>, SimThread, Instant, Vec<i32>) {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
-    let drives = sim_thread(drive_end, sim_nodes(n, faults));
+    let drives = sim_thread(drive_end, sims);
     let initial =
         configure(&mut link, &nodes(n), &options(), &mut |_| {}).expect("set-up succeeds");
     let t0 = Instant::now();
@@ -186,6 +199,43 @@ fn drive_fault_stops_every_drive_and_names_the_node() {
     assert_stopped(&m, None);
     assert_eq!(m.status()[2].state, Some(State::Fault));
     drives.finish();
+}
+
+#[test]
+fn after_a_fault_no_target_steps_back_to_a_lagging_drive() {
+    // Drives 50 ms behind a ramp of 10 counts per cycle (5000 counts/s) are 250 counts
+    // behind their targets. Measured before the fix: on the fault every target stepped back
+    // to the actual position: node 1 by 255 counts in one period (25x the ramp step).
+    let (mut m, drives, t0, initial) = start_nodes(
+        3,
+        lagging_nodes(3, 0.05, |i| Faults {
+            fault_at_sync: (i == 2).then_some(300),
+            ..Faults::default()
+        }),
+    );
+    run(&mut m, t0, &initial, 2000, stopped);
+    expect_fault(m.fault(), 2);
+    let records = drives.finish();
+    for node in 1u8..=3 {
+        let mine: Vec<&Record> = records.iter().filter(|r| r.node == node).collect();
+        let lagging = mine
+            .iter()
+            .map(|r| (r.target_counts - r.actual_counts).abs())
+            .max()
+            .unwrap_or(0);
+        assert!(
+            lagging > 100,
+            "node {node}: the drive lagged only {lagging}"
+        );
+        for w in mine.windows(2) {
+            let step = w[1].target_counts - w[0].target_counts;
+            assert!(
+                (0..=10).contains(&step),
+                "node {node}: target moved by {step} at sync {} (ramp step 10)",
+                w[1].sync
+            );
+        }
+    }
 }
 
 #[test]

@@ -11,9 +11,11 @@
 //! 3. steps each node's CiA-402 sequencer toward the goal and sends one RPDO1 per node
 //!    (controlword + target) and one SYNC.
 //!
-//! While not Operation enabled, and after a fault, a drive is sent its own actual position
-//! as target, so that no state change can make it jump: the drive decelerates by its own
-//! quick-stop ramp, never toward a stale target.
+//! Before it is Operation enabled a drive is sent its own actual position as target, so
+//! that enabling cannot make it jump. After a fault every drive is sent its last commanded
+//! target, held: the commanded position never moves again, in particular never back to a
+//! lagging actual position (a step against the motion), while each drive stops by its own
+//! quick-stop ramp and is disabled.
 
 use crate::cia402::{Goal, Sequencer, State, Statusword};
 use crate::frame::CanFrame;
@@ -160,6 +162,12 @@ impl<L: CanLink> Master<L> {
     /// Whether every node is in `state`.
     pub fn all_in(&self, state: State) -> bool {
         self.nodes.iter().all(|n| n.state == Some(state))
+    }
+
+    /// Whether the node has been silent longer than its feedback supervision allows: lost,
+    /// nothing more can be learnt of it or done with it on this bus.
+    pub fn lost(&self, n: &NodeStatus) -> bool {
+        n.cycles_without_feedback > self.sup.feedback_timeout_cycles
     }
 
     /// Frames that could not be sent because the transmit queue was full.
@@ -321,7 +329,11 @@ impl<L: CanLink> Master<L> {
             let state = n.state.unwrap_or(State::SwitchOnDisabled);
             let cw = n.seq.step(state, goal);
             n.target = match (state, targets.get(i)) {
-                (State::OperationEnabled, Some(&t)) if !hold => t,
+                // After a fault: the last commanded target, whatever the state. A drive
+                // behind its target (its own lag) would otherwise see the target step back
+                // to where it is, a velocity reversal beyond any limit.
+                _ if hold => n.target,
+                (State::OperationEnabled, Some(&t)) => t,
                 _ => n.actual,
             };
             // At most MAX_NODES nodes: there is room.
