@@ -23,9 +23,21 @@ pub struct Machine {
     /// One drive per axis in joint order (X Y Z tilt C) when `buses` is not empty, else none.
     pub drives: Vec<crate::bus::Drive>,
     pub realtime: Realtime,
+    /// A bus over its `max_load` at this period: `file:line:col: ...` of its `max_load`.
+    /// The file is valid; [`Machine::check_bus_load`] refuses it where the bus is used.
+    pub bus_overload: Option<String>,
 }
 
 impl Machine {
+    /// Every bus within its `max_load` at the machine's period; else the message naming the
+    /// bus, its load and by how much it is over.
+    pub fn check_bus_load(&self) -> Result<(), &str> {
+        match &self.bus_overload {
+            Some(m) => Err(m),
+            None => Ok(()),
+        }
+    }
+
     /// `[machine] period_ms` when omitted.
     pub const DEFAULT_PERIOD_MS: f64 = 2.0;
     /// Smallest allowed `period_ms`.
@@ -219,6 +231,9 @@ pub struct Realtime {
     pub lead_s: f64,
     /// Segments the planner may keep queued ahead of the interpolator, 1..=1024.
     pub queue_depth: usize,
+    /// More periods in a row than this overrunning their deadline stop the run along the
+    /// path (exit 3), 1..=100000.
+    pub max_consecutive_overruns: u64,
     /// A drive whose heartbeat is older than this is lost, s.
     pub heartbeat_timeout_s: f64,
     /// A drive without position feedback for this long is lost, s.
@@ -243,6 +258,7 @@ impl Default for Realtime {
             idle_poll: false,
             lead_s: 0.0,
             queue_depth: 64,
+            max_consecutive_overruns: 10,
             heartbeat_timeout_s: 0.3,
             feedback_timeout_s: 0.02,
             boot_timeout_s: 3.0,

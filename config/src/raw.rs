@@ -40,6 +40,8 @@ pub(crate) struct RawRealtime {
     pub lead_us: Option<f64>,
     /// Segments the planner may have queued ahead of the interpolator.
     pub queue_depth: Option<i64>,
+    /// Consecutive overrun periods that stop the run along the path.
+    pub max_consecutive_overruns: Option<i64>,
     /// ms without a heartbeat before a drive counts as lost.
     pub heartbeat_timeout_ms: Option<f64>,
     /// ms without position feedback (TPDO) before a drive counts as lost.
