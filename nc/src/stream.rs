@@ -326,6 +326,11 @@ impl<'q> Follower<'q> {
         (self.motion.s, self.tau, self.k)
     }
 
+    /// Source line of the block being machined (0 before the first has arrived).
+    pub fn line(&self) -> u32 {
+        self.local.front().map_or(0, |c| c.segment.src.line)
+    }
+
     /// Fraction of the program's chunks finished, 0..=1.
     pub fn progress(&self) -> f64 {
         if self.start.chunks == 0 || self.done {

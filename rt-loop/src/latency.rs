@@ -157,6 +157,7 @@ pub fn periodic(rec: &mut Recorder<'_>, period_ns: u64, duration_ns: u64) {
     let start = os::now();
     let end = start.saturating_add(duration_ns);
     let mut next = start.saturating_add(period);
+    let mut run = crate::stats::OverrunRun::default();
     while next <= end {
         os::sleep_until(next);
         let woke = os::now();
@@ -170,8 +171,9 @@ pub fn periodic(rec: &mut Recorder<'_>, period_ns: u64, duration_ns: u64) {
             done.saturating_sub(woke),
         );
         next += period;
-        if done > next {
-            stats.overruns += 1;
+        let overrun = done > next;
+        run.period(overrun, stats);
+        if overrun {
             next += (done - next) / period * period + period;
         }
         rec.maybe_rotate(done);

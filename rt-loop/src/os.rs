@@ -149,6 +149,17 @@ pub fn pin_to_cpu(cpu: usize) -> Result<(), RtError> {
         .map_err(|errno| RtError::Affinity { cpu, errno })
 }
 
+/// The CPUs the calling thread may run on (its affinity mask), in order; empty if the
+/// mask cannot be read.
+pub fn allowed_cpus() -> Vec<usize> {
+    match nix::sched::sched_getaffinity(nix::unistd::Pid::from_raw(0)) {
+        Ok(set) => (0..nix::sched::CpuSet::count())
+            .filter(|&c| set.is_set(c).unwrap_or(false))
+            .collect(),
+        Err(_) => Vec::new(),
+    }
+}
+
 /// Take `cpu` out of the calling thread's affinity (threads it spawns later inherit it), so
 /// the non-real-time threads leave that CPU to the real-time thread. Nothing changes if
 /// `cpu` is the only CPU allowed.

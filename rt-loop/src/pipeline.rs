@@ -59,6 +59,26 @@ pub enum StopReason {
          stopped along the path"
     )]
     CountOverflow { axis: usize, position: f64 },
+    #[error(
+        "{0} periods in a row overran (more than [realtime] max_consecutive_overruns); \
+         stopped along the path, drives disabled"
+    )]
+    Overruns(u64),
+}
+
+impl StopReason {
+    /// The operator asked for it (not a fault).
+    pub fn by_operator(&self) -> bool {
+        matches!(self, StopReason::Requested)
+    }
+
+    /// The drive that caused it, if one did.
+    pub fn node(&self) -> Option<u8> {
+        match self {
+            StopReason::Fault(f) => Some(f.node),
+            _ => None,
+        }
+    }
 }
 
 /// The drives of one bus and the master driving them.
@@ -191,6 +211,7 @@ pub struct Pipeline<'q, L: CanLink> {
     pub buses: Vec<BusDrives<L>>,
     stage: Stage,
     reason: Option<StopReason>,
+    stop_line: Option<u32>,
     approach: Option<Approach>,
     period: f64,
     enable_timeout_cycles: u64,
@@ -201,6 +222,8 @@ pub struct Pipeline<'q, L: CanLink> {
     cycles: u64,
     settle: u64,
     prepared: Option<Prepared>,
+    /// More consecutive overruns than this stop the run along the path.
+    max_overruns: u64,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
@@ -266,6 +289,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             buses,
             stage: Stage::Enabling,
             reason: None,
+            stop_line: None,
             approach,
             period,
             enable_timeout_cycles,
@@ -275,7 +299,20 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             cycles: 0,
             settle: 0,
             prepared: None,
+            max_overruns: u64::MAX,
         })
+    }
+
+    /// Stop the run along the path once more than `n` consecutive periods overrun.
+    pub fn set_max_consecutive_overruns(&mut self, n: u64) {
+        self.max_overruns = n;
+    }
+
+    /// The loop's count of consecutive overruns up to the period just done.
+    pub fn overruns_in_a_row(&mut self, n: u64) {
+        if n > self.max_overruns && self.reason.is_none() && self.stage != Stage::Finished {
+            self.stop(StopReason::Overruns(n));
+        }
     }
 
     pub fn stage(&self) -> Stage {
@@ -287,15 +324,26 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         self.reason
     }
 
+    /// The program line being machined when the stop began (0 before the program).
+    pub fn stop_line(&self) -> Option<u32> {
+        self.stop_line
+    }
+
+    /// The first reason is kept, with the program line where it came.
+    fn set_reason(&mut self, reason: StopReason) {
+        if self.reason.is_none() {
+            self.reason = Some(reason);
+            self.stop_line = Some(self.follower.line());
+        }
+    }
+
     fn enter(&mut self, stage: Stage) {
         self.stage = stage;
         self.stage_cycles = 0;
     }
 
     fn stop(&mut self, reason: StopReason) {
-        if self.reason.is_none() {
-            self.reason = Some(reason);
-        }
+        self.set_reason(reason);
         self.follower.request_stop();
     }
 
@@ -406,7 +454,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                     };
                     self.enter(next);
                 } else if self.stage_cycles > self.enable_timeout_cycles {
-                    self.reason = Some(StopReason::EnableTimeout(self.enable_timeout_cycles));
+                    self.set_reason(StopReason::EnableTimeout(self.enable_timeout_cycles));
                     self.enter(Stage::Disabling);
                 }
             }
@@ -421,7 +469,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 } else if let Some(ap) = self.approach.as_mut() {
                     let (axes, done) = ap.step(self.period);
                     if let Err(r) = self.set_targets(&axes) {
-                        self.reason = Some(r);
+                        self.set_reason(r);
                     }
                     if done {
                         self.enter(Stage::Running);
@@ -467,7 +515,15 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                             | State::NotReadyToSwitchOn
                     )
                 };
-                if self.all_in(stopped) || self.stage_cycles > self.enable_timeout_cycles {
+                // A lost drive (silent past its supervision) cannot report a state: it
+                // does not hold the run up until the timeout.
+                let all_stopped = self.buses.iter().all(|b| {
+                    b.master
+                        .status()
+                        .iter()
+                        .all(|s| s.state.is_some_and(stopped) || b.master.lost(s))
+                });
+                if all_stopped || self.stage_cycles > self.enable_timeout_cycles {
                     self.enter(Stage::Finished);
                 } else if goal_quick && self.all_in(|s| s != State::OperationEnabled) {
                     for b in self.buses.iter_mut() {
@@ -482,19 +538,23 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 b.master.set_goal(Goal::Enabled);
             }
         }
+        let mut fault = None;
         for b in self.buses.iter_mut() {
             let n = b.master.status().len().min(MAX_NODES);
             if let Some(f) = b.master.cycle(&b.targets[..n], now) {
-                if self.reason.is_none() {
-                    self.reason = Some(StopReason::Fault(f));
-                    self.follower.request_stop();
-                    if matches!(
-                        self.stage,
-                        Stage::Running | Stage::Approach | Stage::Enabling
-                    ) {
-                        self.stage = Stage::Disabling;
-                        self.stage_cycles = 0;
-                    }
+                fault = fault.or(Some(f));
+            }
+        }
+        if let Some(f) = fault {
+            if self.reason.is_none() {
+                self.set_reason(StopReason::Fault(f));
+                self.follower.request_stop();
+                if matches!(
+                    self.stage,
+                    Stage::Running | Stage::Approach | Stage::Enabling
+                ) {
+                    self.stage = Stage::Disabling;
+                    self.stage_cycles = 0;
                 }
             }
         }
@@ -602,6 +662,7 @@ pub fn drive_loop<L: CanLink>(
     let mut slots = Slots::new(lead);
     let mut next = os::now().saturating_add(period);
     let (mut underruns, mut total_overruns) = (0, 0);
+    let mut run = crate::stats::OverrunRun::default();
     for _ in 0..max_cycles {
         let wake_at = next.saturating_sub(lead);
         os::sleep_until(wake_at);
@@ -635,11 +696,13 @@ pub fn drive_loop<L: CanLink>(
             stats.record_idle(late, busy);
         }
         next += period;
-        if done > next {
-            stats.overruns += 1;
+        let overrun = done > next;
+        let in_a_row = run.period(overrun, stats);
+        if overrun {
             total_overruns += 1;
             next += (done - next) / period * period + period;
         }
+        pipeline.overruns_in_a_row(in_a_row);
         let c = pipeline.follower.counters();
         stats.underruns += c.underruns - underruns;
         underruns = c.underruns;

@@ -23,6 +23,9 @@ pub struct Stats {
     pub cycles: u64,
     /// Periods whose work was not done before the next wake-up was due (one or more missed).
     pub overruns: u64,
+    /// Longest run of consecutive overrun periods (kept as a maximum, not summed, when
+    /// statistics are added).
+    pub max_consecutive_overruns: u64,
     /// Periods in which the interpolator had no data (feed hold).
     pub underruns: u64,
     /// Minor page faults of the process while the loop ran (getrusage), -1 if unknown.
@@ -45,6 +48,7 @@ impl Stats {
             cycle: h(),
             cycles: 0,
             overruns: 0,
+            max_consecutive_overruns: 0,
             underruns: 0,
             minor_faults: -1,
         }
@@ -57,6 +61,7 @@ impl Stats {
         self.cycle.reset();
         self.cycles = 0;
         self.overruns = 0;
+        self.max_consecutive_overruns = 0;
         self.underruns = 0;
         self.minor_faults = -1;
     }
@@ -69,6 +74,9 @@ impl Stats {
         let _ = self.cycle.add(&other.cycle);
         self.cycles += other.cycles;
         self.overruns += other.overruns;
+        self.max_consecutive_overruns = self
+            .max_consecutive_overruns
+            .max(other.max_consecutive_overruns);
         self.underruns += other.underruns;
     }
 
@@ -92,6 +100,7 @@ impl Stats {
         Summary {
             cycles: self.cycles,
             overruns: self.overruns,
+            max_consecutive_overruns: self.max_consecutive_overruns,
             underruns: self.underruns,
             minor_faults_in_loop: self.minor_faults,
             histograms: Histograms {
@@ -100,6 +109,28 @@ impl Stats {
                 cycle_ns: Percentiles::of(&self.cycle),
             },
         }
+    }
+}
+
+/// Consecutive overruns, counted across the statistics intervals of a loop.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OverrunRun {
+    current: u64,
+}
+
+impl OverrunRun {
+    /// One period, overrun or not: counts it into `stats` and returns how many periods in a
+    /// row have overrun up to this one (0 if this one did not). Allocation-free.
+    #[inline]
+    pub fn period(&mut self, overrun: bool, stats: &mut Stats) -> u64 {
+        if overrun {
+            self.current += 1;
+            stats.overruns += 1;
+            stats.max_consecutive_overruns = stats.max_consecutive_overruns.max(self.current);
+        } else {
+            self.current = 0;
+        }
+        self.current
     }
 }
 
@@ -114,6 +145,7 @@ impl Default for Stats {
 pub struct Summary {
     pub cycles: u64,
     pub overruns: u64,
+    pub max_consecutive_overruns: u64,
     pub underruns: u64,
     pub minor_faults_in_loop: i64,
     pub histograms: Histograms,
@@ -167,10 +199,11 @@ impl Summary {
     /// `summary.txt`, also printed at the end of every run.
     pub fn text(&self) -> String {
         let mut s = format!(
-            "cycles {}   overruns {}   underruns {}   minor page faults in loop {}\n\
+            "cycles {}   overruns {} (at most {} in a row)   underruns {}   minor page faults in loop {}\n\
              {:<18} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}   (us)\n",
             self.cycles,
             self.overruns,
+            self.max_consecutive_overruns,
             self.underruns,
             self.minor_faults_in_loop,
             "histogram",

@@ -14,15 +14,9 @@
 
 mod common;
 
-use drives::link::MemLink;
-use drives::sim::Record;
-use nc::kinematics::MachineKinematics;
-use nc::stream::{chunks, Follower, HoldConfig, Queues};
-use rt_loop::interval::{Queues as IntervalQueues, Recorder};
-use rt_loop::os;
-use rt_loop::pipeline::{drive_loop, ApproachLimits, Pipeline, Progress, Stage};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use drives::sim::{Record, SimNodeConfig};
+use drives::wire::NodeId;
+use rt_loop::pipeline::{ApproachLimits, Stage};
 
 const PERIOD: f64 = 0.001;
 /// Counts per mm (X Y Z) and per degree (A C).
@@ -57,66 +51,29 @@ const SAMPLE: [(&str, &str); 4] = [
 
 /// Run one program through the pipeline; the targets each node received, by SYNC.
 fn run(src: &str) -> Vec<Vec<i32>> {
-    let kin = MachineKinematics::Paper;
-    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
-    let program = nc::parse::parse(src).unwrap();
-    let path = nc::segment::build(&program, &kin, &bl).unwrap();
-    let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, list) = chunks(path, &profile);
-    let mut source = list.into_iter();
-    let (link, drive_end) = MemLink::pair(1024);
-    let (bus, sim) = common::sim_bus(link, drive_end, PERIOD, CPU);
-    let mut queues = Queues::new();
-    let (mut feeder, inlet) = queues.split(64);
-    feeder.feed(&mut source);
-    let follower = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(&cfg));
-    let lim = ApproachLimits {
-        velocity: LIMITS.map(|l| l.0),
-        acceleration: LIMITS.map(|l| l.1),
-        jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
-    };
-    let mut pipeline = Pipeline::new(
-        follower,
-        vec![bus],
-        start.joints,
-        PERIOD,
-        Some(lim),
-        true,
-        1000,
-    )
-    .unwrap();
-    let (mut iq, first) = IntervalQueues::new();
-    let (full, _full_c) = iq.full.split();
-    let (_free_p, free) = iq.free.split();
-    let progress = Progress::default();
-    let finished = AtomicBool::new(false);
-    let stop = AtomicBool::new(false);
-    std::thread::scope(|s| {
-        let (progress, finished, stop, pl) = (&progress, &finished, &stop, &mut pipeline);
-        let rt = s.spawn(move || {
-            let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
-            drive_loop(
-                &mut rec,
-                pl,
-                (PERIOD * 1e9) as u64,
-                50_000,
-                stop,
-                progress,
-                200_000,
-            );
-            finished.store(true, Ordering::SeqCst);
-        });
-        while !finished.load(Ordering::SeqCst) {
-            feeder.feed(&mut source);
-            std::thread::sleep(Duration::from_millis(1));
-        }
-        rt.join().unwrap();
-    });
-    feeder.feed(&mut std::iter::empty());
-    let records = sim.finish();
-    assert_eq!(pipeline.stage(), Stage::Finished);
-    assert_eq!(pipeline.reason(), None, "stopped early");
-    by_node(&records)
+    let out = common::run_pipeline(
+        src,
+        common::Rig {
+            period: PERIOD,
+            counts_per_unit: CPU,
+            sims: (1..=5)
+                .map(|n| SimNodeConfig::new(NodeId::new(n).unwrap()))
+                .collect(),
+            sup: common::LENIENT,
+            approach: Some(ApproachLimits {
+                velocity: LIMITS.map(|l| l.0),
+                acceleration: LIMITS.map(|l| l.1),
+                jerk: [50000.0, 50000.0, 50000.0, 20000.0, 20000.0],
+            }),
+            enable_cycles: 1000,
+            max_cycles: 200_000,
+            loop_period_ns: None,
+            max_overruns: u64::MAX,
+        },
+    );
+    assert_eq!(out.stage, Stage::Finished);
+    assert_eq!(out.reason, None, "stopped early");
+    by_node(&out.records)
 }
 
 /// The targets of each node in SYNC order, one per SYNC every node saw.

@@ -17,16 +17,30 @@ pub struct SimThread {
 impl SimThread {
     /// Serve `link` with `nodes` at `period_s`, polling every `poll` when idle.
     pub fn start<L: CanLink + Send + 'static>(
+        link: L,
+        nodes: Vec<SimNodeConfig>,
+        period_s: f64,
+        poll: Duration,
+    ) -> std::io::Result<SimThread> {
+        Self::start_with(link, nodes, period_s, poll, || {})
+    }
+
+    /// As [`SimThread::start`], running `setup` first in the new thread (to give it a
+    /// real-time priority, say: drives answer within their cycle, so on a loaded host their
+    /// simulation must not starve).
+    pub fn start_with<L: CanLink + Send + 'static>(
         mut link: L,
         nodes: Vec<SimNodeConfig>,
         period_s: f64,
         poll: Duration,
+        setup: impl FnOnce() + Send + 'static,
     ) -> std::io::Result<SimThread> {
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
         let thread = std::thread::Builder::new()
             .name("dnurbs-sim-drives".into())
             .spawn(move || {
+                setup();
                 let mut bus = SimBus::new(nodes, period_s);
                 let t0 = Instant::now();
                 let mut out = Vec::new();
