@@ -288,11 +288,7 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
         "--report",
         dir.to_str().unwrap(),
     ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    common::assert_completed(&out);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("wakeup latency") && text.contains("p99.99"),
@@ -300,13 +296,20 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
     );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    for key in ["cycles", "overruns", "underruns"] {
+    for key in ["overruns", "max_consecutive_overruns", "exit_code"] {
         assert!(json[key].is_u64(), "{key} missing: {json}");
     }
-    assert!(json["cycles"].as_u64().unwrap() > 200, "{json}");
+    for key in ["outcome", "started", "dnurbs_version"] {
+        assert!(json[key].is_string(), "{key} missing: {json}");
+    }
+    let lat = &json["latency"];
+    for key in ["cycles", "overruns", "underruns"] {
+        assert!(lat[key].is_u64(), "{key} missing: {json}");
+    }
+    assert!(lat["cycles"].as_u64().unwrap() > 200, "{json}");
     for h in ["wakeup_latency_ns", "compute_ns", "cycle_ns"] {
         for k in ["min", "p50", "p90", "p99", "p99_9", "p99_99", "max"] {
-            assert!(json["histograms"][h][k].is_u64(), "{h}.{k} missing: {json}");
+            assert!(lat["histograms"][h][k].is_u64(), "{h}.{k} missing: {json}");
         }
     }
     assert_eq!(
@@ -355,7 +358,7 @@ fn idle_polling_needs_a_cpu_and_polls_it_during_the_run() {
         "--idle-poll",
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
+    common::assert_completed(&out);
     assert!(
         err.contains("real-time thread on CPU 0 (idle polled)"),
         "{err}"

@@ -80,8 +80,8 @@ fn run_on_vcan(program: &str) {
     let stdout = String::from_utf8_lossy(&run.stdout);
     let stderr = String::from_utf8_lossy(&run.stderr);
     println!("dnurbs run {program}:\n{stdout}{stderr}");
-    assert!(run.status.success(), "dnurbs run failed");
-    assert!(stdout.contains("program completed"));
+    common::assert_completed(&run);
+    assert!(stdout.contains("outcome: completed"), "{stdout}");
     assert!(report.join("summary.json").is_file());
 
     let sim_out = Command::new(bin)

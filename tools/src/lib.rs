@@ -1,33 +1,39 @@
 //! The `dnurbs` command-line tool as a library, so the integration tests and benchmarks can
-//! use the same code paths as the binary. `main.rs` only parses arguments and maps errors to
-//! exit codes.
+//! use the same code paths as the binary. `main.rs` only parses the arguments ([`cli`]),
+//! calls the command ([`commands`]) and maps its outcome or error to an exit code ([`exit`]).
 
+pub mod cli;
+pub mod commands;
+pub mod exit;
+pub mod report;
 pub mod run;
 pub mod setup;
 pub mod simdrives;
 pub mod simulate;
 
+pub use exit::InputError;
 use std::path::Path;
-
-/// A failure the user can fix in their input (exit code 2), already formatted as
-/// `file:line:col: message` where a position is known.
-#[derive(Debug)]
-pub struct InputError(pub String);
-
-impl std::fmt::Display for InputError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for InputError {}
 
 /// Read and parse an NC program; errors name the file, line and column.
 pub fn load_program(path: &Path) -> Result<nc::program::Program, InputError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| InputError(format!("{}: cannot read the program: {e}", path.display())))?;
-    let text = program_text(&bytes).map_err(|e| InputError(format!("{}:{e}", path.display())))?;
-    nc::parse::parse(text).map_err(|e| InputError(format!("{}:{e}", path.display())))
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|source| InputError::ReadProgram {
+        file: file.clone(),
+        source,
+    })?;
+    parse_program(&bytes, &file)
+}
+
+/// Parse an NC program held in memory; `file` names it in errors.
+pub fn parse_program(bytes: &[u8], file: &str) -> Result<nc::program::Program, InputError> {
+    let text = program_text(bytes).map_err(|message| InputError::Encoding {
+        file: file.to_owned(),
+        message,
+    })?;
+    nc::parse::parse(text).map_err(|source| InputError::Parse {
+        file: file.to_owned(),
+        source,
+    })
 }
 
 /// The program's text: UTF-8, with a leading byte-order mark dropped. Invalid UTF-8 is an
@@ -49,5 +55,12 @@ pub fn program_text(bytes: &[u8]) -> Result<&str, String> {
 
 /// Read and validate a machine file.
 pub fn load_machine(path: &Path) -> Result<config::Machine, InputError> {
-    config::load(path).map_err(|e| InputError(e.to_string()))
+    Ok(config::load(path)?)
+}
+
+/// Refuse a machine whose bus is over its load at its period (for the commands that use
+/// the bus).
+pub fn check_bus_load(m: &config::Machine) -> Result<(), InputError> {
+    m.check_bus_load()
+        .map_err(|e| InputError::MachineUse(e.to_owned()))
 }

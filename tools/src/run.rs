@@ -10,6 +10,7 @@
 //!   `latency.hlog`, prints progress on stderr when that is a terminal, and at the end prints
 //!   and writes the latency report.
 
+use crate::report::{DriveEnd, Report, RtMode, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
@@ -54,8 +55,12 @@ pub struct RunResult {
     pub stats: Stats,
     /// Why it stopped early; `None` when the program ran to its end.
     pub reason: Option<StopReason>,
-    /// Whether the loop ran with SCHED_FIFO and locked memory; if not, why.
-    pub realtime: Result<(), String>,
+    /// The program line being machined when the stop began.
+    pub stop_line: Option<u32>,
+    /// How the real-time thread ran.
+    pub realtime: RtMode,
+    /// When the run started (UTC, RFC 3339).
+    pub started: String,
     /// Per drive: axis, node, last target, last actual position (counts).
     pub drives: Vec<(usize, u8, i32, i32)>,
     /// Per drive: the program's end point in counts (same order as `drives`).
@@ -64,18 +69,54 @@ pub struct RunResult {
     pub hard_stops: u64,
 }
 
+impl RunResult {
+    /// The report of this run of `program` on `machine`.
+    pub fn report(&self, program: &str, machine: &str) -> Report {
+        let outcome = crate::report::outcome(self.reason.as_ref(), self.stats.overruns);
+        Report {
+            dnurbs_version: env!("CARGO_PKG_VERSION"),
+            started: self.started.clone(),
+            program: program.to_owned(),
+            machine: machine.to_owned(),
+            outcome: outcome.name(),
+            exit_code: outcome.code(),
+            stop_reason: self.reason.map(|r| r.to_string()),
+            stop_node: self.reason.and_then(|r| r.node()),
+            stop_line: self.stop_line.filter(|&l| l > 0).map(|l| l as usize),
+            realtime: self.realtime.clone(),
+            overruns: self.stats.overruns,
+            max_consecutive_overruns: self.stats.max_consecutive_overruns,
+            feed_holds: self.underruns,
+            hard_stops: self.hard_stops,
+            drives: self
+                .drives
+                .iter()
+                .zip(&self.end_counts)
+                .map(|(&(axis, node, target, actual), &end)| DriveEnd {
+                    axis: AXES.get(axis).copied().unwrap_or("?"),
+                    node,
+                    target_counts: target,
+                    actual_counts: actual,
+                    program_end_counts: end,
+                })
+                .collect(),
+            latency: self.stats.summary(),
+        }
+    }
+}
+
 /// Planner output before streaming.
 #[allow(clippy::vec_box)] // the boxes travel through the queue as pointers
 fn plan_program(
-    src: &str,
+    src: &[u8],
     name: &str,
     setup: &MachineSetup,
 ) -> Result<(Start, Vec<Box<nc::stream::Chunk>>, nc::kinematics::Joints), InputError> {
-    let program = nc::parse::parse(src).map_err(|e| InputError(format!("{name}:{e}")))?;
+    let program = crate::parse_program(src, name)?;
+    let file = std::path::Path::new(name);
     let path =
-        build(&program, &setup.kin, &setup.build).map_err(|e| InputError(format!("{name}:{e}")))?;
-    let profile =
-        plan(&path, &setup.kin, &setup.plan).map_err(|e| InputError(format!("{name}:{e}")))?;
+        build(&program, &setup.kin, &setup.build).map_err(|e| InputError::program(file, e))?;
+    let profile = plan(&path, &setup.kin, &setup.plan).map_err(|e| InputError::program(file, e))?;
     // The program's end, for the closing check of the drive positions.
     let end = match path.segments.last() {
         Some(seg) => {
@@ -100,7 +141,7 @@ fn plan_program(
 fn check_drives(m: &Machine) -> Result<(), InputError> {
     for (j, (name, _)) in m.axes.all().iter().enumerate() {
         if !m.drives.iter().any(|d| d.axis == j) {
-            return Err(InputError(format!(
+            return Err(InputError::MachineUse(format!(
                 "machine {:?}: axis {name} has no drive: add [axes.{}.drive] with bus, node and \
                  counts_per_unit",
                 m.name,
@@ -109,7 +150,7 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
         }
     }
     if m.buses.is_empty() {
-        return Err(InputError(format!(
+        return Err(InputError::MachineUse(format!(
             "machine {:?} has no [[bus]]: dnurbs run needs the CAN bus of the drives",
             m.name
         )));
@@ -121,12 +162,14 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
 /// order); it is called once the program has been parsed, built and planned, so a bad
 /// program is reported before anything touches the bus.
 pub fn run<L: CanLink + Send>(
-    src: &str,
+    src: &[u8],
     machine: &Machine,
     open_links: impl FnOnce() -> anyhow::Result<Vec<L>>,
     opts: &RunOptions,
 ) -> anyhow::Result<RunResult> {
     check_drives(machine)?;
+    crate::check_bus_load(machine)?;
+    let started = crate::report::now_utc();
     let setup = MachineSetup::new(machine);
     let rtc = &machine.realtime;
     let period = machine.period_s;
@@ -249,8 +292,10 @@ pub fn run<L: CanLink + Send>(
                 machine.axes.c.is_unlimited(),
                 enable_cycles,
             )
-            .map_err(|e| InputError(e.to_string()))?;
+            .map_err(InputError::from)?;
+            pipeline.set_max_consecutive_overruns(rtc.max_consecutive_overruns);
             run_threads(&mut pipeline, period_ns, stop, opts, log, end_counts)
+                .map(|r| RunResult { started, ..r })
         })();
         finished.store(true, Ordering::Release);
         let _ = planner.join();
@@ -282,13 +327,13 @@ fn run_threads<L: CanLink + Send>(
             .name("dnurbs-rt".into())
             .stack_size(STACK_PREFAULT * 2)
             .spawn_scoped(scope, move || {
-                let realtime = rt_setup(rt, fallback);
-                if let Err(e) = &realtime {
-                    if !fallback {
+                let realtime = match rt_setup(rt, fallback) {
+                    Ok(mode) => mode,
+                    Err(e) => {
                         done.store(true, Ordering::Release);
-                        return Err(e.clone());
+                        return Err(e);
                     }
-                }
+                };
                 os::set_timer_slack(1);
                 os::prefault_stack(STACK_PREFAULT);
                 let mut rec = Recorder::new(first, full_p, free_c, INTERVAL_NS, os::now());
@@ -343,6 +388,8 @@ fn run_threads<L: CanLink + Send>(
         Ok(RunResult {
             stats: totals,
             reason: None,
+            stop_line: None,
+            started: String::new(),
             realtime,
             drives: Vec::new(),
             end_counts,
@@ -352,6 +399,7 @@ fn run_threads<L: CanLink + Send>(
     })
     .map(|mut r| {
         r.reason = pipeline.reason();
+        r.stop_line = pipeline.stop_line();
         r.drives = pipeline.drive_positions().collect();
         let c = pipeline.follower.counters();
         r.underruns = c.underruns;
@@ -360,25 +408,32 @@ fn run_threads<L: CanLink + Send>(
     })
 }
 
-/// Lock memory, SCHED_FIFO, CPU; `Err` says what is missing.
-fn rt_setup(rt: RtSettings, fallback: bool) -> Result<(), String> {
-    let mut result = Ok(());
-    if let Some(priority) = rt.priority {
-        if let Err(e) = os::lock_memory().and_then(|()| os::set_fifo(priority)) {
-            result = Err(e.to_string());
-            if !fallback {
-                return result;
+/// Lock memory, SCHED_FIFO, CPU. Without `fallback`, a missing privilege is an error;
+/// with it, the mode says what the thread runs without, and why.
+fn rt_setup(rt: RtSettings, fallback: bool) -> Result<RtMode, String> {
+    let mut mode = RtMode {
+        cpu: rt.cpu,
+        ..RtMode::default()
+    };
+    match rt.priority {
+        Some(priority) => {
+            let locked = os::lock_memory();
+            mode.memory_locked = locked.is_ok();
+            match locked.and_then(|()| os::set_fifo(priority)) {
+                Ok(()) => {
+                    mode.sched_fifo = true;
+                    mode.priority = Some(priority);
+                }
+                Err(e) if fallback => mode.without_because = Some(e.to_string()),
+                Err(e) => return Err(e.to_string()),
             }
         }
-    } else {
-        result = Err("--no-rt".to_owned());
+        None => mode.without_because = Some("--no-rt".to_owned()),
     }
     if let Some(cpu) = rt.cpu {
-        if let Err(e) = os::pin_to_cpu(cpu) {
-            return Err(e.to_string());
-        }
+        os::pin_to_cpu(cpu).map_err(|e| e.to_string())?;
     }
-    result
+    Ok(mode)
 }
 
 /// The demo's machine: the paper's machine (its drives on an in-process bus).
@@ -434,43 +489,23 @@ fn demo_on<L: CanLink + Send + 'static>(
                 Some(c)
             })
             .collect();
-        sims.push(drives::sim::SimThread::start(
+        // The drives answer within their cycle: with real-time privileges their thread runs
+        // SCHED_FIFO one priority below the controller's, so a loaded host cannot starve it.
+        let below = opts.rt.priority.map(|p| (p - 1).max(1));
+        sims.push(drives::sim::SimThread::start_with(
             drive_end,
             nodes,
             machine.period_s,
             Duration::from_micros(200),
+            move || {
+                if let Some(p) = below {
+                    let _ = os::set_fifo(p);
+                }
+            },
         )?);
         links.push(master_end);
     }
-    let result = run(DEMO_PROGRAM, machine, move || Ok(links), opts);
+    let result = run(DEMO_PROGRAM.as_bytes(), machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))
-}
-
-/// The closing lines of a run: outcome and drive positions against the program's end.
-pub fn outcome_text(r: &RunResult) -> String {
-    let mut s = String::new();
-    match &r.realtime {
-        Ok(()) => s.push_str("real-time: SCHED_FIFO, memory locked\n"),
-        Err(why) => s.push_str(&format!("real-time: no ({why})\n")),
-    }
-    s.push_str(&format!(
-        "feed holds (planner underruns): {}   hard stops: {}\n",
-        r.underruns, r.hard_stops
-    ));
-    for ((axis, node, target, actual), end) in r.drives.iter().zip(&r.end_counts) {
-        let name = ["X", "Y", "Z", "A/B", "C"]
-            .get(*axis)
-            .copied()
-            .unwrap_or("?");
-        let end = end.map_or("-".to_owned(), |e| e.to_string());
-        s.push_str(&format!(
-            "axis {name:<3} node {node:>3}: target {target:>11}  actual {actual:>11}  program end {end:>11} counts\n"
-        ));
-    }
-    match &r.reason {
-        None => s.push_str("program completed\n"),
-        Some(why) => s.push_str(&format!("stopped: {why}\n")),
-    }
-    s
 }

@@ -59,8 +59,10 @@ pub struct SimArgs {
     pub iface: String,
     pub machine: config::Machine,
     pub record: Option<std::path::PathBuf>,
-    pub lag_ms: f64,
-    pub duration_s: Option<f64>,
+    /// Motor lag time constant, ns.
+    pub lag_ns: u64,
+    /// Run this long, ns (None: until stopped).
+    pub duration_ns: Option<u64>,
     pub faults: FaultArgs,
 }
 
@@ -74,7 +76,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
         .position(|b| b.interface == args.iface)
         .or_else(|| (m.buses.len() == 1).then_some(0))
         .ok_or_else(|| {
-            InputError(format!(
+            InputError::MachineUse(format!(
                 "the machine has no [[bus]] on interface {:?}",
                 args.iface
             ))
@@ -86,7 +88,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
         .filter_map(|d| {
             let mut c = SimNodeConfig::new(NodeId::new(d.node)?);
             c.initial_position = d.offset;
-            c.lag_s = args.lag_ms / 1000.0;
+            c.lag_s = args.lag_ns as f64 * 1e-9;
             c.faults = args.faults.for_node(d.node);
             Some(c)
         })
@@ -112,6 +114,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
         nodes.iter().map(|n| n.node.get()).collect::<Vec<_>>()
     );
     let mut sim = SimBus::new(nodes, m.period_s);
+    let duration_s = args.duration_ns.map(|d| d as f64 * 1e-9);
     let t0 = Instant::now();
     let mut last_flush = t0;
     let mut out = Vec::new();
@@ -132,7 +135,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
             link.send(&f)?;
         }
         if last_flush.elapsed() >= Duration::from_millis(100)
-            || args.duration_s.is_some_and(|d| now >= d)
+            || duration_s.is_some_and(|d| now >= d)
         {
             last_flush = Instant::now();
             if let Some(w) = record.as_mut() {
@@ -148,7 +151,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
                 sim.take_records();
             }
         }
-        if args.duration_s.is_some_and(|d| now >= d) {
+        if duration_s.is_some_and(|d| now >= d) {
             return Ok(());
         }
         if idle {

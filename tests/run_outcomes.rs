@@ -1,0 +1,129 @@
+//! How a run ends, as the operator reads it: the outcome, its exit code, the reason with
+//! the node and the program line, in the report. Against simulated drives on the in-memory
+//! link (`dnurbs_tools::run::run`, the code path of `dnurbs run`), and through the binary
+//! for SIGTERM.
+
+mod common;
+
+use dnurbs_tools::exit;
+use dnurbs_tools::run::{run, RunOptions, DEMO_MACHINE, DEMO_PROGRAM};
+use drives::link::MemLink;
+use drives::sim::{Faults, SimNodeConfig, SimThread};
+use drives::wire::NodeId;
+use std::time::Duration;
+
+/// The paper example on the paper's machine, its drives simulated with `faults(node)`.
+fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
+    let machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
+        .expect("the demo machine");
+    let (master_end, drive_end) = MemLink::pair(1024);
+    let nodes = machine
+        .drives
+        .iter()
+        .map(|d| {
+            let mut c = SimNodeConfig::new(NodeId::new(d.node).unwrap());
+            c.initial_position = d.offset;
+            c.faults = faults(d.node);
+            c
+        })
+        .collect();
+    let sim = SimThread::start(
+        drive_end,
+        nodes,
+        machine.period_s,
+        Duration::from_micros(200),
+    )
+    .expect("simulated drives");
+    let opts = RunOptions {
+        name: "paper-example.nc".into(),
+        approach: true,
+        rt: rt_loop::latency::RtSettings {
+            priority: None,
+            cpu: None,
+            idle_poll: false,
+        },
+        lead_ns: 0,
+        rt_fallback: true,
+        report: None,
+        progress: false,
+    };
+    let r = run(
+        DEMO_PROGRAM.as_bytes(),
+        &machine,
+        move || Ok(vec![master_end]),
+        &opts,
+    )
+    .expect("the run starts");
+    sim.finish();
+    r
+}
+
+#[test]
+fn a_drive_fault_ends_the_run_with_exit_3_naming_node_and_line() {
+    // Node 3 (Z) faults 3000 SYNCs in: after the approach, inside the G06.5 block (line 11).
+    let r = run_with(|n| Faults {
+        fault_at_sync: (n == 3).then_some(3000),
+        ..Faults::default()
+    });
+    let rep = r.report("paper-example.nc", "paper-ac-table");
+    assert_eq!(rep.exit_code, exit::STOPPED_FAULT, "{}", rep.text());
+    assert_eq!(rep.outcome, "stopped by a fault");
+    assert_eq!(rep.stop_node, Some(3), "{}", rep.text());
+    assert_eq!(rep.stop_line, Some(11), "{}", rep.text());
+    let text = rep.text();
+    assert!(text.contains("node 3"), "{text}");
+    assert!(text.contains("at program line 11 (exit 3)"), "{text}");
+}
+
+#[test]
+fn a_run_that_completes_says_so_with_exit_0_or_5() {
+    let r = run_with(|_| Faults::default());
+    let rep = r.report("paper-example.nc", "paper-ac-table");
+    let expected = if rep.overruns == 0 {
+        exit::COMPLETED
+    } else {
+        exit::COMPLETED_OVERRUNS
+    };
+    assert_eq!(rep.exit_code, expected, "{}", rep.text());
+    assert_eq!(rep.stop_reason, None);
+    assert_eq!(rep.stop_line, None);
+    for d in &rep.drives {
+        assert_eq!(Some(d.target_counts), d.program_end_counts, "{d:?}");
+    }
+}
+
+#[test]
+fn sigterm_stops_the_demo_along_the_path_with_exit_4() {
+    let dir = common::temp("sigterm-report");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args(["demo", "--no-rt", "--report", dir.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("dnurbs demo starts");
+    // Into the program (the approach takes about 1 s of the 20 s run).
+    std::thread::sleep(Duration::from_secs(4));
+    let _ = std::process::Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status();
+    let out = child.wait_with_output().expect("dnurbs demo ends");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(i32::from(exit::STOPPED_OPERATOR)),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("outcome: stopped by the operator"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["exit_code"], 4);
+    assert!(
+        json["stop_reason"].as_str().unwrap().contains("SIGTERM"),
+        "{json}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,378 @@
+//! The command line: every subcommand and option, with one syntax for durations
+//! ([`duration`]: a number and a unit, `500us`, `10ms`, `5s`, `2min`) and ranges stated in
+//! every range error.
+
+use crate::run::DemoLink;
+use crate::simdrives;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "dnurbs",
+    version,
+    about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007)",
+    long_about = "Real-time 5-axis double-NURBS interpolation (Wang et al. 2007).\n\n\
+        An NC program (G01 5-axis lines, G06.2 NURBS, G06.5 double NURBS) is parsed, planned \
+        with jerk-limited look-ahead and interpolated period by period into X Y Z A C setpoints, \
+        sent to CiA-402 drives over SocketCAN.\n\n\
+        Durations take a unit: 500us, 10ms, 5s, 2min (also ns, µs).",
+    after_help = crate::exit::TABLE,
+    after_long_help = crate::exit::TABLE
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MethodArg {
+    /// Advance the cutter by the commanded arc length each period (arc-length table + Newton).
+    Arclength,
+    /// Paper eq. 9: first-order Taylor update of u.
+    Taylor1,
+    /// Paper eq. 10 with the feed-acceleration term: second-order Taylor update of u.
+    Taylor2,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// The main job on built-in defaults: the paper's example on simulated drives.
+    ///
+    /// The paper's example program on the paper's machine, its five CiA-402 drives simulated
+    /// on an in-process CAN link (no hardware, no root). The real-time thread runs with
+    /// SCHED_FIFO and locked memory when the privileges allow, without them otherwise (said
+    /// in the output and the report); the simulated drives' thread runs SCHED_FIFO one
+    /// priority below it. Prints the latency report.
+    #[command(after_help = crate::exit::TABLE)]
+    Demo {
+        /// Write summary.txt, summary.json, latency.hlog and latency.svg into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Do not even try SCHED_FIFO and mlockall.
+        #[arg(long)]
+        no_rt: bool,
+        /// The in-process bus between the master and the simulated drives: `memory` (lock-free
+        /// queues, no system call per frame) or `socketpair` (a kernel socket carrying
+        /// can_frame structs through the same socketcan calls as a CAN interface).
+        #[arg(long, value_enum, default_value_t = DemoLink::Memory)]
+        link: DemoLink,
+        #[command(flatten)]
+        cpu: CpuArgs,
+        /// Wake this long before each 2 ms deadline: rehearse the interpolation step (warm
+        /// caches), compute it in a quiet moment, wait on the clock and send the frames at the
+        /// deadline. Costs the lead in CPU time per period. 0 sleeps to the deadline and
+        /// computes after it. 0..=1ms.
+        #[arg(long, default_value = "60us", value_parser = lead)]
+        lead: u64,
+    },
+    /// Run a program on the machine's CiA-402 drives over SocketCAN.
+    ///
+    /// Sets up the drives on the machine file's CAN interfaces (SDO, PDO mapping, NMT
+    /// start), enables them (CiA-402), interpolates in the real-time thread while a planner
+    /// thread streams planned segments, disables them, prints the report.
+    ///
+    /// The axes must be at the program's start pose (its first block) unless --approach is
+    /// given. SIGINT (Ctrl-C) or SIGTERM stops along the path,
+    /// then disables the drives. A drive fault quick-stops and disables every drive and
+    /// names the node and the cause. Real-time
+    /// settings come from the machine file's [realtime] section.
+    #[command(after_help = crate::exit::TABLE)]
+    Run {
+        /// NC program.
+        program: PathBuf,
+        /// Machine file (TOML) with [[bus]] and [axes.*.drive].
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Write summary.txt, summary.json, latency.hlog and latency.svg into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+        /// Before the program, move all axes from where the drives are to the program's start
+        /// in one jerk-limited straight move in axis space (mind the fixtures).
+        #[arg(long)]
+        approach: bool,
+        /// Run without mlockall and SCHED_FIFO (development machines; timing not guaranteed).
+        #[arg(long)]
+        no_rt: bool,
+    },
+    /// Interpolate a program offline, exactly as the real-time thread does, and report.
+    ///
+    /// Reports machining time, feed fluctuation, chord error and each axis's velocity,
+    /// acceleration and jerk against its limits. The machine file's buses are not used: a
+    /// bus over its load at this period is only warned about.
+    #[command(after_help = crate::exit::TABLE)]
+    Simulate {
+        /// NC program (G-code with G01 / G06.2 / G06.5 blocks).
+        program: PathBuf,
+        /// Machine file (TOML), e.g. config/machines/paper-ac-table.toml.
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Parameter update method [default: the machine file's, else arclength].
+        #[arg(long, value_enum)]
+        method: Option<MethodArg>,
+        /// Write one CSV row per period:
+        /// cycle,t,block,u,x,y,z,i,j,k,feed,X,Y,Z,A,C (mm, mm/min, degrees).
+        #[arg(long, value_name = "OUT.csv")]
+        trace: Option<PathBuf>,
+        /// Print the summary as one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Simulate a machine's drives on a CAN interface (tests without hardware).
+    ///
+    /// Boot-up, NMT slave, SDO server, PDO mapping, CiA-402 state machine, CSP motor model,
+    /// heartbeats, with fault injection. Stop it with Ctrl-C or --duration.
+    #[command(after_help = crate::exit::TABLE)]
+    SimDrives {
+        /// CAN interface, e.g. vcan0 (`ip link add dev vcan0 type vcan`).
+        #[arg(long)]
+        iface: String,
+        /// Machine file whose [[bus]] on this interface (or only bus) lists the drives.
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Write every target received: CSV sync,node,target_counts,actual_counts,statusword.
+        #[arg(long, value_name = "FILE.csv")]
+        record: Option<PathBuf>,
+        /// Motor lag: time constant of the actual position following the target, 0..=10s.
+        #[arg(long, default_value = "0ms", value_parser = lag)]
+        lag: u64,
+        /// Exit after this long, 1ms..=30days (default: run until stopped).
+        #[arg(long, value_parser = sim_duration)]
+        duration: Option<u64>,
+        /// Drive fault (EMCY 0x8611, statusword Fault) on NODE at SYNC count N.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        fault_at: Vec<(u8, u64)>,
+        /// NODE stops sending heartbeats after SYNC count N.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        heartbeat_stops: Vec<(u8, u64)>,
+        /// NODE never boots: silent from power-on.
+        #[arg(long, value_name = "NODE")]
+        never_boots: Vec<u8>,
+        /// NODE drops every N-th frame it sends.
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u32>)]
+        drop_every: Vec<(u8, u32)>,
+        /// NODE sends nothing from SYNC count N on (a broken cable).
+        #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
+        silent_from: Vec<(u8, u64)>,
+    },
+    /// Measure this computer's real-time wake-up latency (like cyclictest).
+    ///
+    /// The real-time loop with nothing to do, with the same set-up and report as `dnurbs
+    /// run`. Run it on a controller PC before deploying.
+    #[command(after_help = crate::exit::TABLE)]
+    Latency {
+        /// Period, 100us..=100ms.
+        #[arg(long, default_value = "1ms", value_parser = period)]
+        period: u64,
+        /// How long to measure, 1ms..=7days.
+        #[arg(long, default_value = "10s", value_parser = measure_duration)]
+        duration: u64,
+        /// SCHED_FIFO priority of the loop thread (1..=99).
+        #[arg(long, default_value_t = 80, value_parser = clap::value_parser!(i32).range(1..=99))]
+        priority: i32,
+        #[command(flatten)]
+        cpu: CpuArgs,
+        /// Run the same loop without mlockall and SCHED_FIFO (development machines).
+        #[arg(long)]
+        no_rt: bool,
+        /// Write summary.txt, summary.json, latency.hlog (HdrHistogram interval log) and
+        /// latency.svg (percentile plot) into this directory.
+        #[arg(long, value_name = "DIR")]
+        report: Option<PathBuf>,
+    },
+    /// Print the worst-case CAN bus load of a machine file, per bus.
+    ///
+    /// SYNC plus one 6-byte RPDO and TPDO per drive each cycle, at 55 + 10 n bits per frame
+    /// (stuffing and interframe space included). vcan has no bit timing, so this is
+    /// computed, not measured. Exit 2 if a bus is over its max_load.
+    #[command(after_help = crate::exit::TABLE)]
+    Busload {
+        /// Machine file (TOML) with [[bus]] tables and [axes.*.drive] mappings.
+        #[arg(long, short)]
+        machine: PathBuf,
+    },
+    /// Compare the parameter-update methods on programs (a Markdown table).
+    ///
+    /// Simulates each program with taylor1, taylor2 and arclength and prints feed
+    /// fluctuation and chord error.
+    #[command(after_help = crate::exit::TABLE)]
+    Compare {
+        /// NC programs to compare on.
+        #[arg(required = true)]
+        programs: Vec<PathBuf>,
+        /// Machine file (TOML).
+        #[arg(long, short)]
+        machine: PathBuf,
+    },
+}
+
+/// `--cpu N [--idle-poll]` of `demo` and `latency`.
+#[derive(clap::Args, Clone, Copy)]
+pub struct CpuArgs {
+    /// Pin the real-time thread to this CPU (pair with isolcpus= on the kernel command
+    /// line) and keep dnurbs's other threads off it. Must be one this process may use.
+    #[arg(long, value_parser = cpu)]
+    pub cpu: Option<usize>,
+    /// Keep the --cpu CPU busy between periods with a SCHED_IDLE polling thread, so it
+    /// never halts (a user-space idle=poll for that CPU). Helps on virtual machines and PCs
+    /// without a cpuidle driver; costs that CPU's power. Needs --cpu.
+    #[arg(long, requires = "cpu")]
+    pub idle_poll: bool,
+}
+
+impl CpuArgs {
+    pub fn settings(&self, priority: Option<i32>) -> rt_loop::latency::RtSettings {
+        rt_loop::latency::RtSettings {
+            priority,
+            cpu: self.cpu,
+            idle_poll: self.idle_poll,
+        }
+    }
+}
+
+const NS: u64 = 1;
+const US: u64 = 1_000;
+const MS: u64 = 1_000_000;
+const S: u64 = 1_000_000_000;
+const MIN: u64 = 60 * S;
+const DAY: u64 = 24 * 60 * MIN;
+
+/// A duration as written on the command line: a number and a unit (`ns`, `us`/`µs`, `ms`,
+/// `s`, `min`), into nanoseconds. `0` alone is accepted (it is zero in every unit); any
+/// other bare number is refused with a hint.
+pub fn duration(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    if t == "0" {
+        return Ok(0);
+    }
+    let split = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    let (num, unit) = t.split_at(split);
+    let value: f64 = num
+        .parse()
+        .map_err(|_| format!("{s:?} is not a duration: write a number and a unit, like 10ms"))?;
+    let scale = match unit.trim() {
+        "" => {
+            return Err(format!(
+                "{s:?} has no unit: write {num}ms, {num}s, {num}us, ... (units ns, us, ms, s, min)"
+            ))
+        }
+        "ns" => NS,
+        "us" | "µs" => US,
+        "ms" => MS,
+        "s" => S,
+        "min" => MIN,
+        other => {
+            return Err(format!(
+                "{s:?}: unknown unit {other:?}: use ns, us, ms, s or min"
+            ))
+        }
+    };
+    let ns = value * scale as f64;
+    if !(ns.is_finite() && ns < 1e18) {
+        return Err(format!("{s:?} is too long"));
+    }
+    Ok(ns.round() as u64)
+}
+
+/// Write `ns` with the largest unit that keeps it readable.
+pub fn show(ns: u64) -> String {
+    let units = [
+        (DAY, "days"),
+        (MIN, "min"),
+        (S, "s"),
+        (MS, "ms"),
+        (US, "us"),
+    ];
+    for (scale, name) in units {
+        if ns >= scale && ns % scale == 0 {
+            return format!("{}{name}", ns / scale);
+        }
+    }
+    format!("{ns}ns")
+}
+
+/// [`duration`] within `lo..=hi`; the error states the range.
+fn within(s: &str, lo: u64, hi: u64) -> Result<u64, String> {
+    let ns = duration(s)?;
+    if ns < lo || ns > hi {
+        return Err(format!(
+            "{s:?} is out of range {}..={}",
+            if lo == 0 { "0".to_owned() } else { show(lo) },
+            show(hi)
+        ));
+    }
+    Ok(ns)
+}
+
+/// `latency --period`: the machine file's range, 100us..=100ms.
+pub fn period(s: &str) -> Result<u64, String> {
+    within(s, 100 * US, 100 * MS)
+}
+
+fn measure_duration(s: &str) -> Result<u64, String> {
+    within(s, MS, 7 * DAY)
+}
+
+fn sim_duration(s: &str) -> Result<u64, String> {
+    within(s, MS, 30 * DAY)
+}
+
+fn lag(s: &str) -> Result<u64, String> {
+    within(s, 0, 10 * S)
+}
+
+/// `demo --lead`: 0 or up to half the demo's 2 ms period.
+fn lead(s: &str) -> Result<u64, String> {
+    within(s, 0, MS)
+}
+
+/// `--cpu N`: a CPU this process may run on.
+fn cpu(s: &str) -> Result<usize, String> {
+    let n: usize = s
+        .parse()
+        .map_err(|_| format!("{s:?} is not a CPU number"))?;
+    let allowed = rt_loop::os::allowed_cpus();
+    if allowed.contains(&n) {
+        return Ok(n);
+    }
+    Err(format!(
+        "CPU {n} is not one this process may use (allowed: {})",
+        allowed
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_need_a_unit_and_state_their_range() {
+        assert_eq!(duration("500us"), Ok(500 * US));
+        assert_eq!(duration("1.5ms"), Ok(1_500 * US));
+        assert_eq!(duration("2min"), Ok(2 * MIN));
+        assert_eq!(duration("0"), Ok(0));
+        let bare = duration("5").unwrap_err();
+        assert!(bare.contains("no unit") && bare.contains("5ms"), "{bare}");
+        assert!(duration("5 parsec").unwrap_err().contains("unknown unit"));
+        assert!(duration("ms").unwrap_err().contains("not a duration"));
+        let zero = period("0ms").unwrap_err();
+        assert!(zero.contains("100us..=100ms"), "{zero}");
+        assert!(lead("2ms").unwrap_err().contains("0..=1ms"));
+        assert_eq!(show(7 * DAY), "7days");
+        assert_eq!(show(1_500 * US), "1500us");
+    }
+
+    #[test]
+    fn a_cpu_this_process_cannot_use_is_refused() {
+        let allowed = rt_loop::os::allowed_cpus();
+        assert!(cpu(&allowed[0].to_string()).is_ok());
+        let e = cpu("4095").unwrap_err();
+        assert!(e.contains("allowed"), "{e}");
+    }
+}

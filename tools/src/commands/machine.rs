@@ -1,0 +1,134 @@
+//! `run` and `demo`: the drives, the real-time thread, the report.
+
+use super::{cpu_text, keep_off_rt_cpu, report_dir};
+use crate::exit::{InputError, Outcome};
+use crate::run::{DemoLink, RunOptions, RunResult};
+use anyhow::Context;
+use std::path::{Path, PathBuf};
+
+/// Print the report of a run (and write it with `--report`); its outcome.
+fn finish(
+    r: &RunResult,
+    report: Option<PathBuf>,
+    program: &str,
+    machine: &str,
+    title: &str,
+) -> anyhow::Result<Outcome> {
+    let rep = r.report(program, machine);
+    print!("{}", rep.text());
+    if let Some(dir) = report {
+        rep.write(&dir, &r.stats, title)?;
+        eprintln!("report: {}", dir.display());
+    }
+    Ok(crate::report::outcome(r.reason.as_ref(), r.stats.overruns))
+}
+
+pub fn demo(
+    report: Option<PathBuf>,
+    link: DemoLink,
+    rt: rt_loop::latency::RtSettings,
+    lead_ns: u64,
+) -> anyhow::Result<Outcome> {
+    keep_off_rt_cpu(rt)?;
+    report_dir(&report)?;
+    let opts = RunOptions {
+        name: "paper-example.nc".into(),
+        approach: true,
+        rt,
+        lead_ns,
+        rt_fallback: true,
+        report: report.clone(),
+        progress: true,
+    };
+    let bus = match link {
+        DemoLink::Memory => "an in-memory CAN link",
+        DemoLink::Socketpair => "a socketpair CAN link",
+    };
+    eprintln!(
+        "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
+         CiA-402 drives on {bus}, 2 ms period{}{}",
+        lead_text(lead_ns),
+        cpu_text(rt)
+    );
+    let (r, records) = crate::run::demo(&opts, link)?;
+    println!("simulated drives received {} targets", records.len());
+    finish(
+        &r,
+        report,
+        "paper-example.nc",
+        "paper-ac-table",
+        "dnurbs demo: paper example, 2 ms",
+    )
+}
+
+pub fn run(
+    program: &Path,
+    machine: &Path,
+    report: Option<PathBuf>,
+    approach: bool,
+    no_rt: bool,
+) -> anyhow::Result<Outcome> {
+    let m = crate::load_machine(machine)?;
+    let src = std::fs::read(program).map_err(|source| InputError::ReadProgram {
+        file: program.display().to_string(),
+        source,
+    })?;
+    let open_links = || -> anyhow::Result<Vec<drives::link::SocketLink>> {
+        let mut links = Vec::new();
+        for b in &m.buses {
+            links.push(
+                drives::link::SocketLink::open(&b.interface).with_context(|| {
+                    format!(
+                        "cannot open CAN interface {:?} (bus {:?}); is it up? \
+                         `ip link set {} up type can bitrate {}`",
+                        b.interface, b.name, b.interface, b.bitrate
+                    )
+                })?,
+            );
+        }
+        Ok(links)
+    };
+    let opts = RunOptions {
+        name: program.display().to_string(),
+        approach,
+        rt: rt_loop::latency::RtSettings {
+            priority: (!no_rt).then_some(m.realtime.priority),
+            cpu: m.realtime.cpu,
+            idle_poll: m.realtime.idle_poll,
+        },
+        lead_ns: (m.realtime.lead_s * 1e9).round() as u64,
+        rt_fallback: false,
+        report: report.clone(),
+        progress: true,
+    };
+    keep_off_rt_cpu(opts.rt)?;
+    eprintln!(
+        "dnurbs run: {} on {} ({} drives, {} ms period{}{})",
+        program.display(),
+        m.name,
+        m.drives.len(),
+        m.period_s * 1000.0,
+        lead_text(opts.lead_ns),
+        cpu_text(opts.rt)
+    );
+    if m.interpolation.method != config::Method::Arclength {
+        eprintln!(
+            "dnurbs run: note: the real-time interpolator uses the arclength method; \
+             [interpolation] method = \"{}\" applies to simulate and compare",
+            m.interpolation.method
+        );
+    }
+    report_dir(&report)?;
+    let r = crate::run::run(&src, &m, open_links, &opts)?;
+    let name = program.display().to_string();
+    let title = format!("dnurbs run: {name} on {}", m.name);
+    finish(&r, report, &name, &m.name, &title)
+}
+
+/// ", 60 µs lead" or nothing.
+fn lead_text(lead_ns: u64) -> String {
+    if lead_ns == 0 {
+        return String::new();
+    }
+    format!(", {} µs lead", lead_ns as f64 / 1e3)
+}

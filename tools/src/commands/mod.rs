@@ -1,0 +1,119 @@
+//! The subcommands' bodies. Each returns the [`Outcome`] of what it ran, or an error whose
+//! kind picks the exit code ([`crate::exit`]).
+//!
+//! * [`offline`]: `simulate`, `compare`, `busload` (no bus, no real time);
+//! * [`machine`]: `run` and `demo` (drives, real-time thread, report);
+//! * [`latency`]: `latency` (the real-time loop alone).
+
+pub mod latency;
+pub mod machine;
+pub mod offline;
+
+use crate::cli::{Command, MethodArg};
+use crate::exit::Outcome;
+use crate::simdrives;
+
+/// Run one subcommand.
+pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
+    match command {
+        Command::Demo {
+            report,
+            no_rt,
+            link,
+            cpu,
+            lead,
+        } => machine::demo(report, link, cpu.settings((!no_rt).then_some(80)), lead),
+        Command::Run {
+            program,
+            machine,
+            report,
+            approach,
+            no_rt,
+        } => machine::run(&program, &machine, report, approach, no_rt),
+        Command::Simulate {
+            program,
+            machine,
+            method,
+            trace,
+            json,
+        } => offline::simulate(&program, &machine, method.map(method_of), trace, json),
+        Command::Compare { programs, machine } => offline::compare(&programs, &machine),
+        Command::Busload { machine } => offline::busload(&machine),
+        Command::Latency {
+            period,
+            duration,
+            priority,
+            cpu,
+            no_rt,
+            report,
+        } => latency::latency(
+            period,
+            duration,
+            cpu.settings((!no_rt).then_some(priority)),
+            report,
+        ),
+        Command::SimDrives {
+            iface,
+            machine,
+            record,
+            lag,
+            duration,
+            fault_at,
+            heartbeat_stops,
+            never_boots,
+            drop_every,
+            silent_from,
+        } => {
+            let machine = crate::load_machine(&machine)?;
+            simdrives::run(simdrives::SimArgs {
+                iface,
+                machine,
+                record,
+                lag_ns: lag,
+                duration_ns: duration,
+                faults: simdrives::FaultArgs {
+                    fault_at,
+                    heartbeat_stops,
+                    never_boots,
+                    drop_every,
+                    silent_from,
+                },
+            })?;
+            Ok(Outcome::Completed)
+        }
+    }
+}
+
+fn method_of(m: MethodArg) -> nc::interp::Method {
+    match m {
+        MethodArg::Arclength => nc::interp::Method::ArcLength,
+        MethodArg::Taylor1 => nc::interp::Method::Taylor1,
+        MethodArg::Taylor2 => nc::interp::Method::Taylor2,
+    }
+}
+
+/// With a real-time CPU: this thread, and every thread it starts from now on, stays off it.
+fn keep_off_rt_cpu(rt: rt_loop::latency::RtSettings) -> anyhow::Result<()> {
+    if let Some(cpu) = rt.cpu {
+        rt_loop::os::avoid_cpu(cpu)?;
+    }
+    Ok(())
+}
+
+/// ", real-time thread on CPU n (idle polled)" or nothing.
+fn cpu_text(rt: rt_loop::latency::RtSettings) -> String {
+    match rt.cpu {
+        Some(c) if rt.idle_poll => format!(", real-time thread on CPU {c} (idle polled)"),
+        Some(c) => format!(", real-time thread on CPU {c}"),
+        None => String::new(),
+    }
+}
+
+/// Create the report directory.
+fn report_dir(dir: &Option<std::path::PathBuf>) -> anyhow::Result<()> {
+    use anyhow::Context;
+    if let Some(d) = dir {
+        std::fs::create_dir_all(d).with_context(|| format!("{}: cannot create", d.display()))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,105 @@
+//! `simulate`, `compare` and `busload`: the machine file and programs, no bus, no real time.
+
+use crate::exit::{InputError, Outcome};
+use crate::setup::MachineSetup;
+use crate::simulate::{run, summarize, write_trace};
+use crate::{load_machine, load_program};
+use anyhow::Context;
+use nc::interp::Method;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub fn simulate(
+    program: &Path,
+    machine: &Path,
+    method: Option<Method>,
+    trace: Option<PathBuf>,
+    json: bool,
+) -> anyhow::Result<Outcome> {
+    let machine = load_machine(machine)?;
+    if let Err(e) = machine.check_bus_load() {
+        eprintln!("dnurbs simulate: warning (simulate uses no bus; run would refuse): {e}");
+    }
+    let prog = load_program(program)?;
+    let setup = MachineSetup::new(&machine);
+    let method = method.unwrap_or(setup.method);
+    let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
+    if let Some(path) = &trace {
+        let file = std::fs::File::create(path)
+            .with_context(|| format!("{}: cannot create the trace", path.display()))?;
+        let mut w = std::io::BufWriter::new(file);
+        write_trace(&mut w, &result.setpoints)
+            .and_then(|_| w.flush())
+            .with_context(|| format!("{}: cannot write the trace", path.display()))?;
+    }
+    let summary = summarize(&result, &setup, prog.blocks.len());
+    if json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print!("{}", summary.text());
+    }
+    Ok(Outcome::Completed)
+}
+
+pub fn compare(programs: &[PathBuf], machine: &Path) -> anyhow::Result<Outcome> {
+    let setup = MachineSetup::new(&load_machine(machine)?);
+    println!(
+        "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles |"
+    );
+    println!("|---|---|---|---|---|---|");
+    for program in programs {
+        let prog = load_program(program)?;
+        let name = program.file_name().map_or_else(
+            || program.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        );
+        for method in [Method::Taylor1, Method::Taylor2, Method::ArcLength] {
+            let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
+            let s = summarize(&result, &setup, prog.blocks.len());
+            println!(
+                "| {name} | {} | {:.2e} | {:.2e} | {:.2e} | {} |",
+                s.method,
+                s.feed_fluctuation_max,
+                s.feed_fluctuation_rms,
+                s.chord_error_max_mm,
+                s.cycles
+            );
+        }
+    }
+    Ok(Outcome::Completed)
+}
+
+/// Print each bus's load; a bus over its max_load is then an input error (exit 2).
+pub fn busload(machine: &Path) -> anyhow::Result<Outcome> {
+    let m = load_machine(machine)?;
+    if m.buses.is_empty() {
+        println!(
+            "{}: no [[bus]] tables: the machine has no drives",
+            machine.display()
+        );
+        return Ok(Outcome::Completed);
+    }
+    println!("period {} ms", m.period_s * 1e3);
+    for (i, b) in m.buses.iter().enumerate() {
+        let drives: Vec<String> = m
+            .drives
+            .iter()
+            .filter(|d| d.bus == i)
+            .map(|d| format!("{}=node {}", m.axes.all()[d.axis].0, d.node))
+            .collect();
+        let n = drives.len() as u32;
+        println!(
+            "bus {} ({}, {} bit/s): {} drives [{}]: {} bits per cycle, load {:.2} % (max {:.0} %)",
+            b.name,
+            b.interface,
+            b.bitrate,
+            n,
+            drives.join(", "),
+            config::bus::cycle_bits(n),
+            config::bus::load(n, b.bitrate, m.period_s) * 100.0,
+            b.max_load * 100.0
+        );
+    }
+    crate::check_bus_load(&m)?;
+    Ok(Outcome::Completed)
+}

@@ -1,0 +1,121 @@
+//! Exit codes, the same for every subcommand, and the errors that choose them.
+//!
+//! A command returns an [`Outcome`] when it ran (a run that stopped early ran: the drives
+//! were brought to rest), or an error: an [`InputError`] is the user's input (exit 2),
+//! anything else a failure of the environment or of dnurbs itself (exit 1).
+
+use std::path::Path;
+
+/// The program (or the command) completed cleanly.
+pub const COMPLETED: u8 = 0;
+/// Failed: a file could not be written, a CAN interface could not be opened, the real-time
+/// privileges are missing, an internal error.
+pub const FAILED: u8 = 1;
+/// Bad input: the NC program, the machine file or a command-line value (nothing moved).
+/// clap uses 2 for usage errors too.
+pub const BAD_INPUT: u8 = 2;
+/// Stopped by a fault: a drive fault or lost drive, drives not enabled in time, a target
+/// outside the drive's counts, too many consecutive overruns.
+pub const STOPPED_FAULT: u8 = 3;
+/// Stopped by the operator: SIGINT/SIGTERM.
+pub const STOPPED_OPERATOR: u8 = 4;
+/// Completed, but the real-time thread missed deadlines (overruns; see the report).
+pub const COMPLETED_OVERRUNS: u8 = 5;
+
+/// The table printed by `dnurbs --help` and kept in the README.
+pub const TABLE: &str = "Exit codes (every subcommand):
+  0  completed cleanly
+  1  failed (cannot write a file, open a CAN interface, get real-time privileges; internal)
+  2  bad input: NC program, machine file or command-line value (nothing moved)
+  3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
+     too many consecutive overruns); the drives were stopped and disabled
+  4  stopped by the operator (SIGINT/SIGTERM); stopped along the path
+  5  completed, with real-time overruns (missed deadlines: see the report)";
+
+/// How a command that ran ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    Completed,
+    CompletedWithOverruns,
+    StoppedByFault,
+    StoppedByOperator,
+}
+
+impl Outcome {
+    pub fn code(self) -> u8 {
+        match self {
+            Outcome::Completed => COMPLETED,
+            Outcome::CompletedWithOverruns => COMPLETED_OVERRUNS,
+            Outcome::StoppedByFault => STOPPED_FAULT,
+            Outcome::StoppedByOperator => STOPPED_OPERATOR,
+        }
+    }
+
+    /// The word in the report's `outcome` field.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Completed => "completed",
+            Outcome::CompletedWithOverruns => "completed with overruns",
+            Outcome::StoppedByFault => "stopped by a fault",
+            Outcome::StoppedByOperator => "stopped by the operator",
+        }
+    }
+}
+
+/// A failure the user can fix in their input (exit code 2). Each names the file and, where
+/// known, `line:col`.
+#[derive(Debug, thiserror::Error)]
+pub enum InputError {
+    #[error("{file}: cannot read the program: {source}")]
+    ReadProgram {
+        file: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Not UTF-8: `line:col: ...` from [`crate::program_text`].
+    #[error("{file}:{message}")]
+    Encoding { file: String, message: String },
+    #[error("{file}:{source}")]
+    Parse {
+        file: String,
+        #[source]
+        source: nc::parse::ParseError,
+    },
+    /// The program does not fit the machine: geometry or plan.
+    #[error("{file}:{source}")]
+    Program {
+        file: String,
+        #[source]
+        source: nc::plan::ProgramError,
+    },
+    #[error(transparent)]
+    Machine(#[from] config::ConfigError),
+    /// The machine file is valid but cannot serve this command (no drive for an axis,
+    /// no bus, a bus over its load at this period).
+    #[error("{0}")]
+    MachineUse(String),
+    /// A command-line value clap could not check alone.
+    #[error("{0}")]
+    Usage(String),
+    /// The drives are not where the program starts (and no --approach).
+    #[error(transparent)]
+    Start(#[from] rt_loop::pipeline::PipelineError),
+}
+
+impl InputError {
+    pub fn program(file: &Path, source: impl Into<nc::plan::ProgramError>) -> Self {
+        InputError::Program {
+            file: file.display().to_string(),
+            source: source.into(),
+        }
+    }
+}
+
+/// The exit code for an error: 2 for the user's input, 1 for everything else.
+pub fn code_of(e: &anyhow::Error) -> u8 {
+    if e.downcast_ref::<InputError>().is_some() {
+        BAD_INPUT
+    } else {
+        FAILED
+    }
+}

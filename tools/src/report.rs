@@ -1,0 +1,201 @@
+//! The report of a run or a latency measurement: what happened, not only how fast.
+//!
+//! `summary.txt` (also printed at the end) and `summary.json` carry the outcome (completed,
+//! or stopped with the reason, the node and the program line), the real-time mode, the
+//! overruns and the longest run of them, feed holds and hard stops, each drive's final
+//! target and actual position against the program's end, the program, the machine, the
+//! dnurbs version and the start time, and the latency statistics. `latency.svg` plots the
+//! histograms; `latency.hlog` is written while the run goes.
+
+use crate::exit::Outcome;
+use serde::Serialize;
+use std::path::Path;
+
+/// How the real-time thread ran.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RtMode {
+    pub sched_fifo: bool,
+    /// SCHED_FIFO priority, when it ran with it.
+    pub priority: Option<i32>,
+    pub memory_locked: bool,
+    /// CPU the thread was pinned to.
+    pub cpu: Option<usize>,
+    /// Why it ran without real-time privileges, if it did.
+    pub without_because: Option<String>,
+}
+
+impl RtMode {
+    pub fn text(&self) -> String {
+        let cpu = self.cpu.map_or(String::new(), |c| format!(", CPU {c}"));
+        match (&self.without_because, self.priority) {
+            (None, Some(p)) if self.sched_fifo && self.memory_locked => {
+                format!("SCHED_FIFO priority {p}, memory locked{cpu}")
+            }
+            (Some(why), _) => format!("no ({why}){cpu}"),
+            _ => format!("no{cpu}"),
+        }
+    }
+}
+
+/// One drive at the end.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DriveEnd {
+    pub axis: &'static str,
+    pub node: u8,
+    pub target_counts: i32,
+    pub actual_counts: i32,
+    /// The program's end point in this drive's counts (when the program was planned).
+    pub program_end_counts: Option<i32>,
+}
+
+/// `summary.json`; [`Report::text`] is `summary.txt`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    pub dnurbs_version: &'static str,
+    /// UTC, RFC 3339.
+    pub started: String,
+    /// What ran: the program file (or "latency").
+    pub program: String,
+    /// The machine's name (empty for `latency`).
+    pub machine: String,
+    pub outcome: &'static str,
+    pub exit_code: u8,
+    /// Why it stopped early, if it did.
+    pub stop_reason: Option<String>,
+    /// The drive that caused the stop, if one did.
+    pub stop_node: Option<u8>,
+    /// The program line being machined when the stop began.
+    pub stop_line: Option<usize>,
+    pub realtime: RtMode,
+    pub overruns: u64,
+    pub max_consecutive_overruns: u64,
+    /// Feed holds because the planner fell behind (planner underruns).
+    pub feed_holds: u64,
+    /// Periods where the path ran out before a hold had stopped the tool (should be 0).
+    pub hard_stops: u64,
+    pub drives: Vec<DriveEnd>,
+    pub latency: rt_loop::stats::Summary,
+}
+
+/// Axis names in joint order.
+pub const AXES: [&str; 5] = ["X", "Y", "Z", "A/B", "C"];
+
+/// The outcome of a run that ended (`reason` is why it stopped early, if it did).
+pub fn outcome(reason: Option<&rt_loop::pipeline::StopReason>, overruns: u64) -> Outcome {
+    match reason {
+        None if overruns == 0 => Outcome::Completed,
+        None => Outcome::CompletedWithOverruns,
+        Some(r) if r.by_operator() => Outcome::StoppedByOperator,
+        Some(_) => Outcome::StoppedByFault,
+    }
+}
+
+impl Report {
+    /// `summary.txt`: the latency table, then what happened.
+    pub fn text(&self) -> String {
+        let mut s = self.latency.text();
+        s.push_str(&format!("real-time: {}\n", self.realtime.text()));
+        s.push_str(&format!(
+            "overruns: {} (longest run {})   feed holds (planner underruns): {}   hard stops: {}\n",
+            self.overruns, self.max_consecutive_overruns, self.feed_holds, self.hard_stops
+        ));
+        for d in &self.drives {
+            let end = d
+                .program_end_counts
+                .map_or("-".to_owned(), |e| e.to_string());
+            s.push_str(&format!(
+                "axis {:<3} node {:>3}: target {:>11}  actual {:>11}  program end {end:>11} counts\n",
+                d.axis, d.node, d.target_counts, d.actual_counts
+            ));
+        }
+        let what = if self.machine.is_empty() {
+            self.program.clone()
+        } else {
+            format!("{} on {}", self.program, self.machine)
+        };
+        s.push_str(&format!(
+            "{what}, dnurbs {}, started {}\n",
+            self.dnurbs_version, self.started
+        ));
+        match &self.stop_reason {
+            None => s.push_str(&format!(
+                "outcome: {} (exit {})\n",
+                self.outcome, self.exit_code
+            )),
+            Some(why) => {
+                let line = self
+                    .stop_line
+                    .map_or(String::new(), |l| format!(" at program line {l}"));
+                s.push_str(&format!(
+                    "outcome: {}{line} (exit {}): {why}\n",
+                    self.outcome, self.exit_code
+                ));
+            }
+        }
+        s
+    }
+
+    /// Write summary.txt, summary.json and latency.svg into `dir` (latency.hlog is written
+    /// during the run).
+    pub fn write(
+        &self,
+        dir: &Path,
+        stats: &rt_loop::stats::Stats,
+        title: &str,
+    ) -> anyhow::Result<()> {
+        use anyhow::Context;
+        let write = |name: &str, body: String| {
+            let path = dir.join(name);
+            std::fs::write(&path, body).with_context(|| format!("{}: cannot write", path.display()))
+        };
+        write("summary.txt", self.text())?;
+        write("summary.json", serde_json::to_string_pretty(self)? + "\n")?;
+        let svg = dir.join("latency.svg");
+        rt_loop::report::write_svg(&svg, stats, title)
+            .with_context(|| format!("{}: cannot write", svg.display()))?;
+        Ok(())
+    }
+}
+
+/// The current time, UTC, RFC 3339 to the second.
+pub fn now_utc() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    rfc3339(secs)
+}
+
+/// Seconds since 1970 as `YYYY-MM-DDTHH:MM:SSZ` (proleptic Gregorian, days to civil date
+/// after H. Hinnant's algorithm).
+fn rfc3339(secs: u64) -> String {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rfc3339_dates() {
+        assert_eq!(rfc3339(0), "1970-01-01T00:00:00Z");
+        // date -u -d @1795430096
+        assert_eq!(rfc3339(1_795_430_096), "2026-11-23T10:34:56Z");
+        assert_eq!(rfc3339(951_782_400), "2000-02-29T00:00:00Z");
+    }
+}
