@@ -46,6 +46,7 @@ fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
         rt_fallback: true,
         report: None,
         progress: false,
+        control: None,
     };
     let r = run(
         DEMO_PROGRAM.as_bytes(),

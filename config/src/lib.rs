@@ -71,6 +71,9 @@
 //! feedback_timeout_ms = 20      # ... without TPDO feedback (default max(20, 5 periods))
 //! boot_timeout_ms = 3000        # wait for the boot-ups after the NMT reset
 //! sdo_timeout_ms = 200          # wait for one SDO answer during set-up
+//!
+//! [control]                 # optional
+//! # socket = "/run/dnurbs/control.sock"   # `dnurbs ctl` talks to the run here (mode 0660)
 //! ```
 //!
 //! Example files: `config/machines/*.toml`.

@@ -26,6 +26,8 @@ pub struct Machine {
     /// A bus over its `max_load` at this period: `file:line:col: ...` of its `max_load`.
     /// The file is valid; [`Machine::check_bus_load`] refuses it where the bus is used.
     pub bus_overload: Option<String>,
+    /// `[control] socket`: where `dnurbs run` serves the operator's control socket.
+    pub control_socket: Option<std::path::PathBuf>,
 }
 
 impl Machine {

@@ -24,6 +24,15 @@ pub(crate) struct RawFile {
     #[serde(default)]
     pub bus: Vec<RawBus>,
     pub realtime: Option<RawRealtime>,
+    pub control: Option<RawControl>,
+}
+
+/// `[control]`: the operator's control socket of `dnurbs run`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawControl {
+    /// Path of the Unix socket.
+    pub socket: Option<String>,
 }
 
 /// `[realtime]`: the real-time thread and drive supervision; every key optional.

@@ -32,6 +32,16 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     let drives = check.drives(&raw.axes, &axes, &buses)?;
     let bus_overload = check.bus_load(&buses, &drives, period_s);
     let realtime = check.realtime(&raw.realtime.unwrap_or_default(), period_s)?;
+    let control_socket = match raw.control.and_then(|c| c.socket) {
+        Some(s) if s.trim().is_empty() || s.contains('\0') => {
+            return Err(check.invalid(
+                &["control", "socket"],
+                Some(format!("{s:?}")),
+                "must be a path (e.g. \"/run/dnurbs/control.sock\")".into(),
+            ))
+        }
+        other => other.map(std::path::PathBuf::from),
+    };
     Ok(Machine {
         name,
         period_s,
@@ -42,6 +52,7 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
         drives,
         realtime,
         bus_overload,
+        control_socket,
     })
 }
 

@@ -12,7 +12,7 @@
 //! `k * Ts` each period. The override `k` in [0, 1] is driven by a rate- and jerk-limited
 //! tracker toward 1, or toward 0 when the path that has arrived ends within the distance
 //! needed to stop (an underrun: the planner fell behind), or when a stop is requested
-//! (SIGINT, a fault). Geometry is untouched, so the tool slows along the path and stops on
+//! (SIGINT, a fault), or toward the operator's override (0 while paused). Geometry is untouched, so the tool slows along the path and stops on
 //! it, then resumes the plan where it left off; the position never jumps. The tracker's rate
 //! is limited to `hold_acc / v` and its rate of change to `hold_jerk / v`, with `v` the
 //! highest planned speed of the chunks at hand, so holding adds at most `hold_acc` of path
@@ -253,6 +253,10 @@ pub struct Follower<'q> {
     motion: Motion,
     stop_requested: bool,
     holding: bool,
+    /// The operator's feed override (0..=1) and pause: the tracker's target when the
+    /// data suffices.
+    feed_override: f64,
+    paused: bool,
     done: bool,
     pose: Pose,
     joints: Joints,
@@ -295,6 +299,8 @@ impl<'q> Follower<'q> {
             motion: Motion::default(),
             stop_requested: false,
             holding: false,
+            feed_override: 1.0,
+            paused: false,
             done: start.chunks == 0,
             pose: start.pose,
             joints: start.joints,
@@ -306,6 +312,30 @@ impl<'q> Follower<'q> {
     /// Decelerate along the path to a stop and stay there (SIGINT, a drive fault).
     pub fn request_stop(&mut self) {
         self.stop_requested = true;
+    }
+
+    /// The operator's feed override, a fraction of the planned feed in 0..=1 (clamped; NaN
+    /// counts as 0). Reached, like a feed hold, by the rate- and jerk-limited tracker.
+    pub fn set_override(&mut self, k: f64) {
+        self.feed_override = if k.is_nan() { 0.0 } else { k.clamp(0.0, 1.0) };
+    }
+
+    pub fn feed_override(&self) -> f64 {
+        self.feed_override
+    }
+
+    /// Decelerate along the path and hold there until [`Self::resume`]. Unlike a stop, the
+    /// run is not over.
+    pub fn pause(&mut self) {
+        self.paused = true;
+    }
+
+    pub fn resume(&mut self) {
+        self.paused = false;
+    }
+
+    pub fn is_paused(&self) -> bool {
+        self.paused
     }
 
     /// At rest after [`Self::request_stop`], or at the end of the program.
@@ -324,6 +354,11 @@ impl<'q> Follower<'q> {
     /// Path position, plan time and override of the last step.
     pub fn state(&self) -> (f64, f64, f64) {
         (self.motion.s, self.tau, self.k)
+    }
+
+    /// The last setpoint (the start pose before the first step).
+    pub fn last(&self) -> Setpoint {
+        self.setpoint(self.cycle.saturating_sub(1), self.motion.v)
     }
 
     /// Source line of the block being machined (0 before the first has arrived).
@@ -463,7 +498,11 @@ impl<'q> Follower<'q> {
             0.0
         } else {
             self.holding = false;
-            1.0
+            if self.paused {
+                0.0
+            } else {
+                self.feed_override
+            }
         };
         if self.holding {
             self.counters.hold_periods += 1;
@@ -766,5 +805,56 @@ mod tests {
         assert!((c.p - last.p).norm() < 1e-9);
         let v = 400.0 / 60.0;
         check_smooth(&sps, &hold, v, 1.5 * cfg.path_acc + hold.acc);
+    }
+
+    #[test]
+    fn an_operator_pause_override_and_resume_stay_on_the_path_within_the_hold_limits() {
+        let (_, cfg, _) = machine();
+        let (path, profile, hold) = planned(None);
+        let (kin, _, _) = machine();
+        let keep = path.clone();
+        let (start, all) = chunks(path, &profile);
+        let mut source = all.into_iter();
+        let mut q = Queues::new();
+        let (mut feeder, inlet) = q.split(16);
+        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+        feeder.feed(&mut source);
+        let mut sps = Vec::new();
+        let mut paused_at_rest = 0;
+        for i in 0..100_000u64 {
+            match i {
+                1000 => f.pause(),
+                2500 => f.resume(),
+                3000 => f.set_override(0.3),
+                5000 => f.set_override(1.0),
+                _ => {}
+            }
+            let sp = f.step();
+            if (1500..2500).contains(&i) {
+                assert_eq!(sp.feed, 0.0, "paused, still moving at {i}");
+                paused_at_rest += 1;
+            }
+            if (4000..5000).contains(&i) {
+                assert!(sp.feed <= 0.3 * 400.0 / 60.0 + 1e-9, "{} at {i}", sp.feed);
+            }
+            sps.push(sp);
+            if sp.done {
+                break;
+            }
+        }
+        feeder.feed(&mut std::iter::empty());
+        assert_eq!(paused_at_rest, 1000);
+        assert!(
+            sps.last().unwrap().done,
+            "the program finished after the resume"
+        );
+        assert_eq!(f.counters().hard_stops, 0);
+        // Every setpoint on the curve, the end reached.
+        let (curve, _) = keep.segments[0].nurbs().unwrap();
+        for sp in &sps[1..] {
+            let (c, _) = curve.both(sp.u.unwrap(), 0);
+            assert!((c.p - sp.p).norm() < 1e-9);
+        }
+        check_smooth(&sps, &hold, 400.0 / 60.0, 1.5 * cfg.path_acc + hold.acc);
     }
 }

@@ -21,6 +21,8 @@
 //! A drive fault is handled by the master itself (quick stop, then disable, targets = actual
 //! positions, so nothing jumps); the pipeline stops interpolating and waits for that to end.
 
+pub use crate::control::Progress;
+use crate::control::{Command, Consumer};
 use crate::os;
 use config::bus::Drive;
 use drives::cia402::{Goal, State};
@@ -50,6 +52,8 @@ pub enum Stage {
 pub enum StopReason {
     #[error("stop requested (SIGINT/SIGTERM): stopped along the path, drives disabled")]
     Requested,
+    #[error("stopped by the operator (dnurbs ctl stop): stopped along the path, drives disabled")]
+    Operator,
     #[error("drive fault: {0}; drives quick-stopped and disabled")]
     Fault(DriveFault),
     #[error("drives not Operation enabled within {0} cycles; disabled")]
@@ -69,7 +73,7 @@ pub enum StopReason {
 impl StopReason {
     /// The operator asked for it (not a fault).
     pub fn by_operator(&self) -> bool {
-        matches!(self, StopReason::Requested)
+        matches!(self, StopReason::Requested | StopReason::Operator)
     }
 
     /// The drive that caused it, if one did.
@@ -154,6 +158,16 @@ impl Approach {
         }
     }
 
+    /// The axis positions now, without advancing.
+    fn now(&self) -> [f64; 5] {
+        if self.t >= self.duration || self.phases.is_empty() {
+            return if self.t > 0.0 { self.to } else { self.from };
+        }
+        let ph = &self.phases[self.cursor.min(self.phases.len() - 1)];
+        let l = ph.at((self.t - ph.t0).clamp(0.0, ph.dur)).s.clamp(0.0, 1.0);
+        core::array::from_fn(|k| self.from[k] + (self.to[k] - self.from[k]) * l)
+    }
+
     /// Advance one period; the axis positions, and whether the move is over.
     fn step(&mut self, period: f64) -> ([f64; 5], bool) {
         self.t += period;
@@ -224,6 +238,8 @@ pub struct Pipeline<'q, L: CanLink> {
     prepared: Option<Prepared>,
     /// More consecutive overruns than this stop the run along the path.
     max_overruns: u64,
+    /// The operator's commands, if a control socket serves them.
+    commands: Option<Consumer<'q, Command>>,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
@@ -300,7 +316,58 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             settle: 0,
             prepared: None,
             max_overruns: u64::MAX,
+            commands: None,
         })
+    }
+
+    /// Take the operator's commands from this queue, at the start of every period.
+    pub fn set_commands(&mut self, commands: Consumer<'q, Command>) {
+        self.commands = Some(commands);
+    }
+
+    /// Apply the commands that arrived (at most the queue's capacity: bounded).
+    fn take_commands(&mut self) {
+        for _ in 0..crate::control::QUEUE {
+            let Some(c) = self.commands.as_mut().and_then(|q| q.dequeue()) else {
+                return;
+            };
+            match c {
+                Command::Pause => self.follower.pause(),
+                Command::Resume => self.follower.resume(),
+                Command::Override(p) => self.follower.set_override(f64::from(p.min(100)) / 100.0),
+                Command::Stop => {
+                    if self.stage != Stage::Finished {
+                        self.stop(StopReason::Operator);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Publish where the run is (every period, allocation-free).
+    pub fn publish(&self, progress: &Progress) {
+        let stage = match self.stage {
+            Stage::Enabling => 0,
+            Stage::Approach => 1,
+            Stage::Running => 2,
+            Stage::Stopping => 3,
+            Stage::Disabling => 4,
+            Stage::Finished => 5,
+        };
+        let sp = self.follower.last();
+        let axes = match (&self.approach, self.stage) {
+            (Some(ap), Stage::Enabling | Stage::Approach) => ap.now(),
+            _ => self.joints_to_axes(&sp.joints),
+        };
+        progress.publish(
+            stage,
+            self.follower.is_paused(),
+            self.follower.line(),
+            sp.block,
+            &axes,
+            sp.feed * 60.0,
+            (self.follower.feed_override() * 100.0).round() as u8,
+        );
     }
 
     /// Stop the run along the path once more than `n` consecutive periods overrun.
@@ -441,6 +508,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         if stop && self.reason.is_none() && self.stage != Stage::Finished {
             self.stop(StopReason::Requested);
         }
+        self.take_commands();
         let mut compute_ns = 0;
         match self.stage {
             Stage::Enabling => {
@@ -621,16 +689,6 @@ impl Slots {
     }
 }
 
-/// What the real-time thread publishes for the progress line (lock-free).
-#[derive(Debug, Default)]
-pub struct Progress {
-    pub cycles: std::sync::atomic::AtomicU64,
-    pub overruns: std::sync::atomic::AtomicU64,
-    /// Program progress, parts per million.
-    pub ppm: std::sync::atomic::AtomicU64,
-    pub underruns: std::sync::atomic::AtomicU64,
-}
-
 /// The interpolating loop: sleep to the absolute deadline, run one [`Pipeline::cycle`],
 /// record wake-up latency, compute time and whole-cycle time, publish progress. Ends when
 /// the pipeline has finished, or after `max_cycles` (a bound for tests and a last resort).
@@ -706,6 +764,7 @@ pub fn drive_loop<L: CanLink>(
         let c = pipeline.follower.counters();
         stats.underruns += c.underruns - underruns;
         underruns = c.underruns;
+        pipeline.publish(progress);
         progress.cycles.fetch_add(1, Relaxed);
         progress.overruns.store(total_overruns, Relaxed);
         progress.underruns.store(c.underruns, Relaxed);

@@ -3,7 +3,8 @@
 //! against simulated drives in another thread, while a planner thread streams segments
 //! through a 4-deep queue. A counting global allocator counts allocations and frees made
 //! by the loop's own thread (the planner and the drives allocate freely in theirs), and
-//! getrusage(RUSAGE_THREAD) counts its minor page faults. Run once over the kernel
+//! getrusage(RUSAGE_THREAD) counts its minor page faults. Meanwhile an operator pauses,
+//! resumes and overrides the feed through the control queue. Run once over the kernel
 //! socketpair link (the socketcan code path) and once over the in-memory link of
 //! `dnurbs demo`; the counts are per thread, so the two tests may run side by side.
 
@@ -12,6 +13,7 @@ mod common;
 use drives::link::{CanLink, MemLink, SocketLink};
 use nc::kinematics::MachineKinematics;
 use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use rt_loop::control::{Command, Commands};
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, ApproachLimits, Pipeline, Progress, Stage};
@@ -99,6 +101,17 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
         100_000,
     )
     .unwrap();
+    // The operator's commands arrive through the lock-free queue during the counted loop.
+    let mut commands = Commands::new();
+    let (mut command_tx, command_rx) = commands.split();
+    pipeline.set_commands(command_rx);
+    let script = [
+        (200, Command::Pause),
+        (400, Command::Resume),
+        (500, Command::Override(60)),
+        (700, Command::Override(100)),
+    ];
+    let mut paused_seen = false;
 
     let (mut iq, first) = IntervalQueues::new();
     let (full, _full_c) = iq.full.split();
@@ -136,10 +149,18 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
                 (e, f)
             })
             .unwrap();
-        // The planner: stream the rest, free what comes back.
+        // The planner: stream the rest, free what comes back; the operator: the script.
+        let mut ms = 0;
         while !finished.load(Ordering::SeqCst) {
             feeder.feed(&mut source);
+            for (at, c) in script {
+                if ms == at {
+                    command_tx.enqueue(c).unwrap();
+                }
+            }
+            paused_seen |= progress.snapshot().paused;
             std::thread::sleep(Duration::from_millis(1));
+            ms += 1;
         }
         rt.join().unwrap()
     });
@@ -147,6 +168,10 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
     let records = sim.finish();
 
     let cycles = progress.cycles.load(Ordering::SeqCst);
+    assert!(
+        paused_seen,
+        "the pause was never seen in the published status"
+    );
     assert_eq!(pipeline.stage(), Stage::Finished);
     assert_eq!(pipeline.reason(), None, "stopped early");
     assert!(cycles >= 100_000, "only {cycles} periods");

@@ -25,6 +25,10 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// `dnurbs ctl --help`'s exit codes.
+const CTL_HELP: &str = "Exit codes: 0 done, 1 cannot reach the run (no socket, run ended), \
+    2 the run refused the command (the reason is printed).";
+
 #[derive(Clone, Copy, ValueEnum)]
 pub enum MethodArg {
     /// Advance the cutter by the commanded arc length each period (arc-length table + Newton).
@@ -65,6 +69,9 @@ pub enum Command {
         /// computes after it. 0..=1ms.
         #[arg(long, default_value = "60us", value_parser = lead)]
         lead: u64,
+        /// Serve the control socket here (see `dnurbs ctl`).
+        #[arg(long, value_name = "SOCKET")]
+        control: Option<PathBuf>,
     },
     /// Run a program on the machine's CiA-402 drives over SocketCAN.
     ///
@@ -73,7 +80,7 @@ pub enum Command {
     /// thread streams planned segments, disables them, prints the report.
     ///
     /// The axes must be at the program's start pose (its first block) unless --approach is
-    /// given. SIGINT (Ctrl-C) or SIGTERM stops along the path,
+    /// given. SIGINT (Ctrl-C), SIGTERM or `dnurbs ctl SOCKET stop` stops along the path,
     /// then disables the drives. A drive fault quick-stops and disables every drive and
     /// names the node and the cause. Real-time
     /// settings come from the machine file's [realtime] section.
@@ -94,6 +101,23 @@ pub enum Command {
         /// Run without mlockall and SCHED_FIFO (development machines; timing not guaranteed).
         #[arg(long)]
         no_rt: bool,
+        /// Serve the control socket here (mode 0660; overrides the machine file's
+        /// [control] socket). See `dnurbs ctl`.
+        #[arg(long, value_name = "SOCKET")]
+        control: Option<PathBuf>,
+    },
+    /// Operate a running `dnurbs run` or `demo` through its control socket.
+    ///
+    /// Commands: `status` (one line; `--watch` repeats it), `pause` (decelerate along the
+    /// path and hold), `resume`, `stop` (decelerate along the path, then disable the
+    /// drives), `override PCT` (0..=100 % of the planned feed, reached with jerk-limited
+    /// transitions; above 100 % is refused: the plan already runs at the machine's limits).
+    #[command(after_help = CTL_HELP)]
+    Ctl {
+        /// The socket given to `run --control` (or the machine file's [control] socket).
+        socket: PathBuf,
+        #[command(subcommand)]
+        command: CtlCommand,
     },
     /// Interpolate a program offline, exactly as the real-time thread does, and report.
     ///
@@ -203,6 +227,28 @@ pub enum Command {
         /// Machine file (TOML).
         #[arg(long, short)]
         machine: PathBuf,
+    },
+}
+
+#[derive(Subcommand, Clone, Copy, Debug, PartialEq)]
+pub enum CtlCommand {
+    /// Print the run's state: stage, program line, block, axes, feed, override, counts.
+    Status {
+        /// Repeat every 200 ms until the run ends (Ctrl-C to leave).
+        #[arg(long)]
+        watch: bool,
+    },
+    /// Decelerate along the path within the limits and hold there.
+    Pause,
+    /// Go on after a pause (or an M00/M01 stop).
+    Resume,
+    /// Decelerate along the path, then disable the drives; the run ends (exit 4).
+    Stop,
+    /// Feed override, 0..=100 % of the planned feed.
+    Override {
+        /// Percent, 0..=100.
+        #[arg(value_parser = clap::value_parser!(u8).range(0..=100))]
+        percent: u8,
     },
 }
 

@@ -17,7 +17,7 @@ pub const BAD_INPUT: u8 = 2;
 /// Stopped by a fault: a drive fault or lost drive, drives not enabled in time, a target
 /// outside the drive's counts, too many consecutive overruns.
 pub const STOPPED_FAULT: u8 = 3;
-/// Stopped by the operator: SIGINT/SIGTERM.
+/// Stopped by the operator: SIGINT/SIGTERM or `dnurbs ctl stop`.
 pub const STOPPED_OPERATOR: u8 = 4;
 /// Completed, but the real-time thread missed deadlines (overruns; see the report).
 pub const COMPLETED_OVERRUNS: u8 = 5;
@@ -29,7 +29,7 @@ pub const TABLE: &str = "Exit codes (every subcommand):
   2  bad input: NC program, machine file or command-line value (nothing moved)
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
-  4  stopped by the operator (SIGINT/SIGTERM); stopped along the path
+  4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path
   5  completed, with real-time overruns (missed deadlines: see the report)";
 
 /// How a command that ran ended.

@@ -20,6 +20,7 @@ use drives::wire::NodeId;
 use nc::plan::plan;
 use nc::segment::build;
 use nc::stream::{chunks, Follower, HoldConfig, Queues, Start};
+use rt_loop::control::{Command, Commands, Producer};
 use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
 use rt_loop::latency::{RtSettings, INTERVAL_NS, STACK_PREFAULT};
 use rt_loop::os;
@@ -47,6 +48,8 @@ pub struct RunOptions {
     pub report: Option<PathBuf>,
     /// Print progress on stderr (when it is a terminal).
     pub progress: bool,
+    /// Serve the operator's control socket here ([`crate::control`]).
+    pub control: Option<PathBuf>,
 }
 
 /// What a run did.
@@ -176,6 +179,22 @@ pub fn run<L: CanLink + Send>(
     let period_ns = (period * 1e9).round() as u64;
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(rtc.queue_depth);
+    let mut commands = Commands::new();
+    let (command_tx, command_rx) = commands.split();
+    let server = match &opts.control {
+        Some(path) => {
+            let tilt = if machine.axes.tilt_name == config::RotaryName::B {
+                "B"
+            } else {
+                "A"
+            };
+            Some(crate::control::Server::bind(
+                path,
+                ["X", "Y", "Z", tilt, "C"],
+            )?)
+        }
+        None => None,
+    };
     let finished = AtomicBool::new(false);
     let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
     let log = match &opts.report {
@@ -294,8 +313,18 @@ pub fn run<L: CanLink + Send>(
             )
             .map_err(InputError::from)?;
             pipeline.set_max_consecutive_overruns(rtc.max_consecutive_overruns);
-            run_threads(&mut pipeline, period_ns, stop, opts, log, end_counts)
-                .map(|r| RunResult { started, ..r })
+            pipeline.set_commands(command_rx);
+            let control = server.as_ref().map(|s| (s, command_tx));
+            run_threads(
+                &mut pipeline,
+                period_ns,
+                stop,
+                opts,
+                log,
+                end_counts,
+                control,
+            )
+            .map(|r| RunResult { started, ..r })
         })();
         finished.store(true, Ordering::Release);
         let _ = planner.join();
@@ -310,6 +339,7 @@ fn run_threads<L: CanLink + Send>(
     opts: &RunOptions,
     mut log: Option<rt_loop::report::HlogFile>,
     end_counts: Vec<Option<i32>>,
+    control: Option<(&crate::control::Server, Producer<'_, Command>)>,
 ) -> anyhow::Result<RunResult> {
     let (mut iq, first) = IntervalQueues::new();
     let (full_p, mut full_c) = iq.full.split();
@@ -322,6 +352,11 @@ fn run_threads<L: CanLink + Send>(
     let _poller = rt.idle_poller()?;
     std::thread::scope(|scope| -> anyhow::Result<RunResult> {
         let (progress, done) = (&progress, &done);
+        if let Some((server, mut tx)) = control {
+            std::thread::Builder::new()
+                .name("dnurbs-control".into())
+                .spawn_scoped(scope, move || server.serve(&mut tx, progress, done))?;
+        }
         let pl = &mut *pipeline;
         let rt_thread = std::thread::Builder::new()
             .name("dnurbs-rt".into())

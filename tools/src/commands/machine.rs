@@ -28,6 +28,7 @@ pub fn demo(
     link: DemoLink,
     rt: rt_loop::latency::RtSettings,
     lead_ns: u64,
+    control: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
     keep_off_rt_cpu(rt)?;
     report_dir(&report)?;
@@ -39,6 +40,7 @@ pub fn demo(
         rt_fallback: true,
         report: report.clone(),
         progress: true,
+        control,
     };
     let bus = match link {
         DemoLink::Memory => "an in-memory CAN link",
@@ -67,6 +69,7 @@ pub fn run(
     report: Option<PathBuf>,
     approach: bool,
     no_rt: bool,
+    control: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
     let m = crate::load_machine(machine)?;
     let src = std::fs::read(program).map_err(|source| InputError::ReadProgram {
@@ -100,6 +103,7 @@ pub fn run(
         rt_fallback: false,
         report: report.clone(),
         progress: true,
+        control: control.or_else(|| m.control_socket.clone()),
     };
     keep_off_rt_cpu(opts.rt)?;
     eprintln!(

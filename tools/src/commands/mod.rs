@@ -3,8 +3,10 @@
 //!
 //! * [`offline`]: `simulate`, `compare`, `busload` (no bus, no real time);
 //! * [`machine`]: `run` and `demo` (drives, real-time thread, report);
-//! * [`latency`]: `latency` (the real-time loop alone).
+//! * [`latency`]: `latency` (the real-time loop alone);
+//! * [`ctl`]: `ctl` (the client of a run's control socket).
 
+pub mod ctl;
 pub mod latency;
 pub mod machine;
 pub mod offline;
@@ -22,14 +24,23 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             link,
             cpu,
             lead,
-        } => machine::demo(report, link, cpu.settings((!no_rt).then_some(80)), lead),
+            control,
+        } => machine::demo(
+            report,
+            link,
+            cpu.settings((!no_rt).then_some(80)),
+            lead,
+            control,
+        ),
         Command::Run {
             program,
             machine,
             report,
             approach,
             no_rt,
-        } => machine::run(&program, &machine, report, approach, no_rt),
+            control,
+        } => machine::run(&program, &machine, report, approach, no_rt, control),
+        Command::Ctl { socket, command } => ctl::ctl(&socket, command),
         Command::Simulate {
             program,
             machine,
