@@ -16,29 +16,41 @@ use std::time::{Duration, SystemTime};
 pub struct HlogFile {
     out: BufWriter<std::fs::File>,
     serializer: V2DeflateSerializer,
-    header: Option<SystemTime>,
 }
 
 impl HlogFile {
+    /// Create the file and write the log's header: a comment naming the contents, the
+    /// format version, the start time and the legend line, as the Java HdrHistogram's
+    /// `HistogramLogWriter` writes them.
     pub fn create(path: &Path) -> io::Result<HlogFile> {
+        let mut out = BufWriter::new(std::fs::File::create(path)?);
+        let start = SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .unwrap_or_default()
+            .as_secs_f64();
+        writeln!(
+            out,
+            "#[dnurbs: wake-up latency (Tag=wakeup), compute (Tag=compute) and whole-cycle \
+             time (Tag=cycle) per interval, values in ns, Interval_Max in ms]"
+        )?;
+        writeln!(out, "#[Histogram log format version 1.3]")?;
+        writeln!(out, "#[StartTime: {start:.3} (seconds since epoch)]")?;
+        writeln!(out, "#[BaseTime: {start:.3} (seconds since epoch)]")?;
+        writeln!(
+            out,
+            "\"StartTimestamp\",\"Interval_Length\",\"Interval_Max\",\"Interval_Compressed_Histogram\""
+        )?;
+        out.flush()?;
         Ok(HlogFile {
-            out: BufWriter::new(std::fs::File::create(path)?),
+            out,
             serializer: V2DeflateSerializer::new(),
-            header: Some(SystemTime::now()),
         })
     }
 
     /// Append one interval's three histograms; `t0` is the run's start (monotonic ns).
     pub fn append(&mut self, iv: &Interval, t0: u64) -> io::Result<()> {
         let mut builder = IntervalLogWriterBuilder::new();
-        if let Some(start) = self.header.take() {
-            builder
-                .add_comment(
-                    "dnurbs: wake-up latency, compute and whole-cycle time per interval, in ns",
-                )
-                .with_start_time(start)
-                .with_base_time(start);
-        }
+        builder.with_max_value_divisor(1_000_000.0);
         let mut log = builder.begin_log_with(&mut self.out, &mut self.serializer)?;
         let start = Duration::from_nanos(iv.start_ns.saturating_sub(t0));
         let length = Duration::from_nanos(iv.end_ns.saturating_sub(iv.start_ns));
@@ -58,26 +70,37 @@ impl HlogFile {
 }
 
 /// Percentile distribution plot: x = percentile on the usual 1/(1-p) log scale, y = time
-/// in us on a log scale, one line per histogram, and the paper's ~28 us per period.
-pub fn write_svg(path: &Path, stats: &Stats, title: &str) -> io::Result<()> {
-    const W: f64 = 820.0;
+/// in us on a log scale, one line per histogram. Each curve ends at the highest percentile
+/// its sample count resolves (1 - 1/n), not at a fixed axis end. The deadline (the period)
+/// is drawn across; the paper's ~28 us figure is the compute time, so it is drawn in the
+/// compute curve's colour and named so; the overruns and their longest run are stated.
+pub fn write_svg(path: &Path, stats: &Stats, title: &str, period_ns: u64) -> io::Result<()> {
+    const W: f64 = 860.0;
     const H: f64 = 480.0;
     const L: f64 = 70.0;
-    const R: f64 = 160.0;
+    const R: f64 = 190.0;
     const T: f64 = 40.0;
     const B: f64 = 50.0;
-    let x_max = 6.0; // 99.9999 %
+    // The x axis reaches the highest percentile any curve resolves (at least 99.9 %).
+    let resolved = |h: &Histogram<u64>| (h.len().max(1) as f64).log10();
     let series: [(&str, &str, &Histogram<u64>); 3] = [
         ("wake-up latency", "#d62728", &stats.wakeup),
         ("compute", "#1f77b4", &stats.compute),
         ("whole cycle", "#2ca02c", &stats.cycle),
     ];
+    let x_max = series
+        .iter()
+        .map(|s| resolved(s.2))
+        .fold(3.0f64, f64::max)
+        .ceil()
+        .min(9.0);
     let all_max = series
         .iter()
         .map(|s| s.2.max())
         .max()
         .unwrap_or(1)
-        .max(28_000) as f64
+        .max(28_000)
+        .max(period_ns) as f64
         / 1000.0;
     let all_min = series
         .iter()
@@ -101,10 +124,12 @@ pub fn write_svg(path: &Path, stats: &Stats, title: &str) -> io::Result<()> {
          <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{L}\" y=\"22\" font-size=\"15\">{}</text>\n",
         escape(title)
     ));
-    for (i, label) in ["0%", "90%", "99%", "99.9%", "99.99%", "99.999%", "99.9999%"]
-        .iter()
-        .enumerate()
-    {
+    for i in 0..=(x_max as usize) {
+        let label = match i {
+            0 => "0%".to_owned(),
+            1 => "90%".to_owned(),
+            _ => format!("99.{}%", "9".repeat(i - 2)).replace("99.%", "99%"),
+        };
         let x = px(i as f64);
         s.push_str(&format!(
             "<line x1=\"{x:.1}\" y1=\"{T}\" x2=\"{x:.1}\" y2=\"{:.1}\" stroke=\"#ddd\"/><text x=\"{x:.1}\" y=\"{:.1}\" text-anchor=\"middle\">{label}</text>\n",
@@ -130,25 +155,51 @@ pub fn write_svg(path: &Path, stats: &Stats, title: &str) -> io::Result<()> {
         (L + W - R) / 2.0,
         H - 12.0
     ));
-    let y28 = py(28.0);
+    let hline = |s: &mut String, us: f64, color: &str, dash: &str, label: &str| {
+        let y = py(us);
+        s.push_str(&format!(
+            "<line x1=\"{L}\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"{color}\" stroke-dasharray=\"{dash}\"/>\n\
+             <text x=\"{:.1}\" y=\"{:.1}\" fill=\"{color}\" text-anchor=\"end\">{label}</text>\n",
+            W - R,
+            W - R - 6.0,
+            y - 5.0
+        ));
+    };
+    if period_ns > 0 {
+        let us = period_ns as f64 / 1000.0;
+        hline(
+            &mut s,
+            us,
+            "#000",
+            "2 0",
+            &format!("deadline: period {} us", fmt_us(us)),
+        );
+    }
+    hline(&mut s, 28.0, "#1f77b4", "6 4", "paper: compute ~28 us");
+    let over = if stats.overruns > 0 {
+        "#d62728"
+    } else {
+        "#555"
+    };
     s.push_str(&format!(
-        "<line x1=\"{L}\" y1=\"{y28:.1}\" x2=\"{:.1}\" y2=\"{y28:.1}\" stroke=\"#555\" stroke-dasharray=\"6 4\"/>\n\
-         <text x=\"{:.1}\" y=\"{:.1}\">paper: ~28 us per period</text>\n",
-        W - R,
-        W - R + 6.0,
-        y28 + 4.0
+        "<text x=\"{:.1}\" y=\"22\" text-anchor=\"end\" fill=\"{over}\">{} periods, overruns {} (longest run {})</text>\n",
+        W - 10.0,
+        stats.cycles,
+        stats.overruns,
+        stats.max_consecutive_overruns,
     ));
     for (k, (name, color, h)) in series.iter().enumerate() {
         if h.is_empty() {
             continue;
         }
         let mut points = Vec::new();
+        let end = resolved(h);
         for v in h.iter_quantiles(2) {
             let q = v.quantile_iterated_to();
             let x = if q >= 1.0 {
-                x_max
+                end
             } else {
-                (1.0 / (1.0 - q)).log10().min(x_max)
+                (1.0 / (1.0 - q)).log10().min(end)
             };
             points.push(format!(
                 "{:.1},{:.1}",

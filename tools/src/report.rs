@@ -142,6 +142,7 @@ impl Report {
         dir: &Path,
         stats: &rt_loop::stats::Stats,
         title: &str,
+        period_ns: u64,
     ) -> anyhow::Result<()> {
         use anyhow::Context;
         let write = |name: &str, body: String| {
@@ -151,7 +152,7 @@ impl Report {
         write("summary.txt", self.text())?;
         write("summary.json", serde_json::to_string_pretty(self)? + "\n")?;
         let svg = dir.join("latency.svg");
-        rt_loop::report::write_svg(&svg, stats, title)
+        rt_loop::report::write_svg(&svg, stats, title, period_ns)
             .with_context(|| format!("{}: cannot write", svg.display()))?;
         Ok(())
     }

@@ -70,7 +70,7 @@ pub fn latency(
             stats.cycles,
             period as f64 / 1000.0
         );
-        rep.write(&dir, &stats, &title)?;
+        rep.write(&dir, &stats, &title, period)?;
         eprintln!("report: {}", dir.display());
     }
     Ok(outcome)

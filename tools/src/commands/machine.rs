@@ -13,11 +13,12 @@ fn finish(
     program: &str,
     machine: &str,
     title: &str,
+    period_ns: u64,
 ) -> anyhow::Result<Outcome> {
     let rep = r.report(program, machine);
     print!("{}", rep.text());
     if let Some(dir) = report {
-        rep.write(&dir, &r.stats, title)?;
+        rep.write(&dir, &r.stats, title, period_ns)?;
         eprintln!("report: {}", dir.display());
     }
     Ok(crate::report::outcome(r.reason.as_ref(), r.stats.overruns))
@@ -60,6 +61,7 @@ pub fn demo(
         "paper-example.nc",
         "paper-ac-table",
         "dnurbs demo: paper example, 2 ms",
+        2_000_000,
     )
 }
 
@@ -126,7 +128,14 @@ pub fn run(
     let r = crate::run::run(&src, &m, open_links, &opts)?;
     let name = program.display().to_string();
     let title = format!("dnurbs run: {name} on {}", m.name);
-    finish(&r, report, &name, &m.name, &title)
+    finish(
+        &r,
+        report,
+        &name,
+        &m.name,
+        &title,
+        (m.period_s * 1e9).round() as u64,
+    )
 }
 
 /// ", 60 µs lead" or nothing.
