@@ -244,7 +244,7 @@ fn degenerate_programs_are_errors_or_stand_still_never_panics() {
 }
 
 #[test]
-fn busload_prints_the_design_md_numbers_and_refuses_an_overloaded_bus() {
+fn busload_prints_the_documented_numbers_and_refuses_an_overloaded_bus() {
     let mach = machine("paper-ac-table.toml");
     let out = dnurbs(&["busload", "--machine", mach.to_str().unwrap()]);
     let text = String::from_utf8_lossy(&out.stdout);

@@ -1,7 +1,7 @@
 //! CAN buses and the CiA-402 drive behind each axis (`[[bus]]`, `[axes.*.drive]`), and the
 //! worst-case bus load that decides whether a machine file is accepted.
 //!
-//! Bus load (design.md section 2): a standard CAN frame with n data bytes takes at most
+//! Bus load (docs/canopen.md): a standard CAN frame with n data bytes takes at most
 //! `55 + 10 n` bits on the wire with worst-case bit stuffing and the interframe space
 //! (`47 + 8 n` without stuffing). Each cycle a bus carries one SYNC (0 bytes), and per drive
 //! one RPDO (controlword + target, 6 bytes) and one TPDO (statusword + actual, 6 bytes).
@@ -78,7 +78,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn design_md_bus_load_example() {
+    fn the_documented_bus_load_example() {
         // 5 axes: one SYNC + 5 RPDO(6 B) + 5 TPDO(6 B) = 55 + 10 * 115 = 1205 bits.
         assert_eq!(frame_bits(0), 55);
         assert_eq!(frame_bits(6), 115);

@@ -60,7 +60,7 @@ pub enum State {
 }
 
 impl State {
-    /// (mask, value) of the statusword for each state (design.md section 2).
+    /// (mask, value) of the statusword for each state (docs/canopen.md).
     const PATTERNS: [(u16, u16, State); 8] = [
         (0x4F, 0x00, State::NotReadyToSwitchOn),
         (0x4F, 0x40, State::SwitchOnDisabled),

@@ -1,5 +1,5 @@
 //! Object dictionary entries this master reads or writes (CiA-301 and CiA-402), as named in
-//! design.md section 2. Indices only; the SDO codec takes them with a sub-index and a value.
+//! docs/canopen.md. Indices only; the SDO codec takes them with a sub-index and a value.
 #![forbid(unsafe_code)]
 
 /// Heartbeat consumer time (u32 per sub-index: `node << 16 | ms`).

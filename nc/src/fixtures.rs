@@ -1,5 +1,5 @@
 //! Reference data shared by the unit tests, integration tests and benchmarks of this crate:
-//! the paper's double-NURBS block (design.md section 1) and a small 5-axis mill. Not part of
+//! the paper's double-NURBS block (docs/paper.md) and a small 5-axis mill. Not part of
 //! the interpolator; kept public so `tests/` and `benches/` use the same values.
 
 use crate::kinematics::RotaryLimits;

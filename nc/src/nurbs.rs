@@ -390,7 +390,7 @@ pub(crate) mod tests {
         [num[0] / den, num[1] / den, num[2] / den]
     }
 
-    /// The paper's block (design.md section 1).
+    /// The paper's block (docs/paper.md).
     #[test]
     fn a_knot_repeated_more_than_the_degree_is_a_discontinuity() {
         // Measured: an interior knot repeated degree + 1 times stepped Y by 5 mm in a period.

@@ -138,7 +138,7 @@ pub fn nurbs_point(p: usize, ctrl: &[[f64; 3]], w: &[f64], k: &[f64], u: f64) ->
     [num[0] / den, num[1] / den, num[2] / den]
 }
 
-/// The paper's block (design.md section 1): degree, C net, CT net, knots.
+/// The paper's block (docs/paper.md): degree, C net, CT net, knots.
 pub const PAPER_C: [[f64; 3]; 5] = [
     [47.7773, 71.0202, 58.8006],
     [44.3229, 75.6066, 54.4778],

@@ -42,7 +42,7 @@ fn enabled() -> (DriveModel, Sequencer) {
 }
 
 #[test]
-fn statusword_patterns_of_design_md() {
+fn statusword_patterns_of_the_docs() {
     let cases = [
         (0x0000, Some(State::NotReadyToSwitchOn)),
         (0x0250, Some(State::SwitchOnDisabled)),

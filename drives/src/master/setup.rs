@@ -3,7 +3,7 @@
 //! 1. NMT reset communication, then wait for each node's boot-up message;
 //! 2. SDO: modes of operation 0x6060 = 8 (CSP), read back from 0x6061;
 //! 3. SDO: interpolation time period 0x60C2 = the machine period (value * 10^exponent s);
-//! 4. PDO mapping exactly as CiA-301 prescribes (design.md section 2): RPDO1 = controlword
+//! 4. PDO mapping exactly as CiA-301 prescribes (docs/canopen.md): RPDO1 = controlword
 //!    0x6040 + target 0x607A, TPDO1 = statusword 0x6041 + actual 0x6064, both disabled while
 //!    mapped, transmission type 1 (every SYNC), then re-enabled;
 //! 5. SDO: heartbeat producer 0x1017;

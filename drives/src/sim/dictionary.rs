@@ -150,7 +150,7 @@ const fn pdo_objects(kind: PdoKind) -> (u16, u16) {
     }
 }
 
-/// The objects a PDO of `kind` may map (design.md section 2's CSP layout).
+/// The objects a PDO of `kind` may map (docs/canopen.md's CSP layout).
 fn mappable(kind: PdoKind, index: u16, sub: u8) -> bool {
     let objects: [u16; 2] = match kind {
         PdoKind::Rpdo => [od::CONTROLWORD, od::TARGET_POSITION],

@@ -147,7 +147,7 @@ impl Master {
         self.poll()
     }
 
-    /// design.md section 2's PDO mapping procedure, step by step, every step acknowledged.
+    /// docs/canopen.md's PDO mapping procedure, step by step, every step acknowledged.
     pub fn map_csp(&mut self, n: NodeId) {
         let steps = [
             (
@@ -179,7 +179,7 @@ impl Master {
         }
     }
 
-    /// Boots, selects CSP, maps the PDOs as design.md says and starts every node.
+    /// Boots, selects CSP, maps the PDOs as docs/canopen.md says and starts every node.
     pub fn operational(&mut self, ids: &[u8]) {
         self.power_on();
         for &id in ids {

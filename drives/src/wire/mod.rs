@@ -6,7 +6,7 @@
 //! whatever the frame contains: decoders read fixed positions of [`CanFrame::raw_data`] only
 //! after checking the length.
 //!
-//! COB-IDs are those of the CiA-301 predefined connection set (design.md section 2): the top
+//! COB-IDs are those of the CiA-301 predefined connection set (docs/canopen.md): the top
 //! four bits of the 11-bit identifier are the function code, the low seven bits the node id.
 //!
 //! | service            | COB-ID          | module        |

@@ -3,7 +3,7 @@
 //!
 //! RPDOn (received by the drive) has COB-ID 0x200/0x300/0x400/0x500 + node, TPDOn (transmitted
 //! by the drive) 0x180/0x280/0x380/0x480 + node. Only PDO 1 is used, mapped in
-//! pre-operational (design.md section 2) to six bytes, little-endian, transmission type 1:
+//! pre-operational (docs/canopen.md) to six bytes, little-endian, transmission type 1:
 //!
 //! ```text
 //! RPDO1  205#0F00A0860100   controlword 0x6040 (u16) | target position 0x607A (i32)
@@ -133,7 +133,7 @@ mod tests {
     }
 
     #[test]
-    fn mapping_entries_match_design_md() {
+    fn mapping_entries_match_the_docs() {
         assert_eq!(
             RPDO1_CSP_MAPPING,
             [mapping_entry(0x6040, 0, 16), mapping_entry(0x607A, 0, 32)]

@@ -3,7 +3,7 @@
 //! # The language
 //!
 //! A small, strict G-code dialect: the paper's `G06.5` double-NURBS block (Wang et al. 2007,
-//! design.md section 1), Fanuc's 3-axis `G06.2` NURBS block and 5-axis `G00`/`G01`. Whatever is
+//! docs/paper.md), Fanuc's 3-axis `G06.2` NURBS block and 5-axis `G00`/`G01`. Whatever is
 //! not listed here is an error, never silently ignored.
 //!
 //! ```text

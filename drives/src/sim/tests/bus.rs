@@ -233,7 +233,7 @@ fn a_session_through_the_socket_link() {
     let script: &[(&[&str], &[&str])] = &[
         (&[], &["701#00"]),
         (&["601#2F60600008000000"], &["581#6060600000000000"]),
-        // design.md's mapping procedure, RPDO1 then TPDO1.
+        // the mapping procedure of docs/canopen.md, RPDO1 then TPDO1.
         (&["601#2300140101020080"], &["581#6000140100000000"]),
         (&["601#2F00160000000000"], &["581#6000160000000000"]),
         (&["601#2300160110004060"], &["581#6000160100000000"]),

@@ -1,5 +1,5 @@
 //! A whole master session, scripted step by step as the master will run it: boot, set-up
-//! over SDO, PDO mapping exactly as design.md, start, enable, then 1000 cycles of a ramp.
+//! over SDO, PDO mapping exactly as docs/canopen.md, start, enable, then 1000 cycles of a ramp.
 
 use super::*;
 use crate::wire::heartbeat::NmtState;
