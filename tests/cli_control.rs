@@ -50,7 +50,7 @@ fn ctl_pauses_overrides_resumes_and_stops_a_run() {
     let sock = common::temp("control.sock");
     let report = common::temp("control-report");
     let demo = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
-        .args(["demo", "--no-rt", "--control", sock.to_str().unwrap()])
+        .args(["demo", "--control", sock.to_str().unwrap()])
         .args(["--report", report.to_str().unwrap()])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

@@ -58,7 +58,12 @@ pub fn sim_bus_with<L: CanLink, D: CanLink + Send + 'static>(
         })
         .collect();
     let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
-    let sim = SimThread::start(drive_end, sims, period, Duration::from_micros(20)).unwrap();
+    // SCHED_FIFO where allowed (one below the loop's): on a loaded machine a starved drive
+    // thread would miss its feedback deadline, a fault these tests did not inject.
+    let sim = SimThread::start_with(drive_end, sims, period, Duration::from_micros(20), || {
+        let _ = os::set_fifo(79);
+    })
+    .unwrap();
     let mut opts = SetupOptions::new(period);
     opts.boot_timeout = Duration::from_secs(5);
     let initial = configure(&mut link, &nodes, &opts, &mut |_| {}).unwrap();
@@ -136,6 +141,7 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     std::thread::scope(|s| {
         let (progress, finished, stop, pl) = (&progress, &finished, &stop, &mut pipeline);
         let rt = s.spawn(move || {
+            let _ = os::set_fifo(80);
             let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
             drive_loop(
                 &mut rec,
