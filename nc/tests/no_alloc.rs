@@ -9,37 +9,9 @@ use nc::interp::{Interpolator, Method};
 use nc::kinematics::{MachineKinematics, Tilt};
 use nc::plan::{plan, PlanConfig};
 use nc::segment::build;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-struct Counting;
-
-static ARMED: AtomicBool = AtomicBool::new(false);
-static EVENTS: AtomicU64 = AtomicU64::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ARMED.load(Ordering::Relaxed) {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        if ARMED.load(Ordering::Relaxed) {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new: usize) -> *mut u8 {
-        if ARMED.load(Ordering::Relaxed) {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.realloc(ptr, layout, new) }
-    }
-}
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 
 const PROGRAMS: [&str; 4] = [
     include_str!("../../tests/data/paper-example.nc"),
@@ -70,8 +42,7 @@ fn step_never_allocates() {
                 let mut ip =
                     Interpolator::new(&path, &profile, kin, cfg.rotary, method, cfg.period, 2.0);
                 let mut sum = 0.0;
-                EVENTS.store(0, Ordering::SeqCst);
-                ARMED.store(true, Ordering::SeqCst);
+                test_support::arm_this_thread();
                 loop {
                     let sp = ip.step();
                     sum += sp.joints[0];
@@ -80,14 +51,9 @@ fn step_never_allocates() {
                         break;
                     }
                 }
-                ARMED.store(false, Ordering::SeqCst);
+                let events = test_support::disarm_this_thread();
                 assert!(sum.is_finite());
-                assert_eq!(
-                    EVENTS.load(Ordering::SeqCst),
-                    0,
-                    "heap touched during {} steps",
-                    method.name()
-                );
+                assert_eq!(events, 0, "heap touched during {} steps", method.name());
             }
         }
     }

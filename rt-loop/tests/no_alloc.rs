@@ -6,30 +6,9 @@
 use rt_loop::interval::{Queues, Recorder};
 use rt_loop::latency::periodic;
 use rt_loop::os;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-
-struct Counting;
-static ARMED: AtomicBool = AtomicBool::new(false);
-static EVENTS: AtomicU64 = AtomicU64::new(0);
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if ARMED.load(Ordering::Relaxed) {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        if ARMED.load(Ordering::Relaxed) {
-            EVENTS.fetch_add(1, Ordering::Relaxed);
-        }
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
 
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 
 #[test]
 fn loop_neither_allocates_nor_faults_over_100k_periods() {
@@ -48,19 +27,18 @@ fn loop_neither_allocates_nor_faults_over_100k_periods() {
     // skips the periods it overran, so it runs in 1 s slices (20 us periods) until 100 000
     // periods have been measured, for at most 120 slices. Only the slices are watched; the
     // hand-offs are collected (and their boxes dropped) between them.
-    let (mut faulted, mut handed, mut slices) = (0, 0u64, 0);
+    let (mut faulted, mut handed, mut slices, mut allocs) = (0, 0u64, 0, 0);
     while handed + rec.stats().cycles < 100_000 && slices < 120 {
         let faults = os::minor_faults();
-        ARMED.store(true, Ordering::SeqCst);
+        test_support::arm_this_thread();
         periodic(&mut rec, 20_000, 1_000_000_000);
-        ARMED.store(false, Ordering::SeqCst);
+        allocs += test_support::disarm_this_thread();
         faulted += os::minor_faults() - faults;
         handed += core::iter::from_fn(|| full_c.dequeue())
             .map(|iv| iv.stats.cycles)
             .sum::<u64>();
         slices += 1;
     }
-    let allocs = EVENTS.load(Ordering::SeqCst);
     assert_eq!(allocs, 0, "heap touched in the loop");
     assert_eq!(faulted, 0, "minor page faults in the loop");
     // No reporter returns boxes to `free`, so hand-offs run late after the first few.

@@ -17,41 +17,11 @@ use rt_loop::control::{Command, Commands};
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, ApproachLimits, Pipeline, Progress, Stage};
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-struct Counting;
-thread_local! {
-    static ARMED: Cell<bool> = const { Cell::new(false) };
-    /// Allocations and frees made by this thread while armed.
-    static EVENTS: Cell<u64> = const { Cell::new(0) };
-}
-
-fn count() {
-    if ARMED.try_with(Cell::get).unwrap_or(false) {
-        let _ = EVENTS.try_with(|e| e.set(e.get() + 1));
-    }
-}
-
-fn events() -> u64 {
-    EVENTS.with(Cell::get)
-}
-
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        count();
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
 #[global_allocator]
-static ALLOC: Counting = Counting;
+static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 
 const PERIOD: f64 = 150e-6;
 /// The loop wakes this early and rehearses the step before each deadline, so the warm-up
@@ -131,8 +101,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
                 let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
                 os::sleep_until(os::now());
                 let f0 = os::minor_faults();
-                let e0 = events();
-                ARMED.with(|a| a.set(true));
+                test_support::arm_this_thread();
                 drive_loop(
                     &mut rec,
                     pl,
@@ -142,8 +111,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
                     progress,
                     2_000_000,
                 );
-                ARMED.with(|a| a.set(false));
-                let e = events() - e0;
+                let e = test_support::disarm_this_thread();
                 let f = os::minor_faults() - f0;
                 finished.store(true, Ordering::SeqCst);
                 (e, f)
