@@ -459,6 +459,8 @@ impl<'q> Follower<'q> {
 
     /// The first half of a period: take arrived chunks, move the override and the plan time,
     /// and find the new path position s. No curve is evaluated here.
+    ///
+    /// Real-time thread.
     pub fn advance(&mut self) {
         self.pull();
         let ts = self.hold.period;
@@ -553,6 +555,8 @@ impl<'q> Follower<'q> {
     /// The second half of a period, the interpolation proper: u at the new path position
     /// (arc-length inverse), both curves from one basis evaluation, the tool axis, inverse
     /// kinematics. Calling it again before the next [`Follower::advance`] repeats the setpoint.
+    ///
+    /// Real-time thread.
     pub fn evaluate(&mut self) -> Setpoint {
         match self.pending {
             Pending::Fixed(cycle, feed) => self.setpoint(cycle, feed),
@@ -570,6 +574,8 @@ impl<'q> Follower<'q> {
     /// real-time loop calls it before the deadline so that the step's code and data, the
     /// next segment's at a hand-over, are in the caches when the timed step runs.
     /// Allocation-free; bounded by [`LOOKAHEAD`].
+    ///
+    /// Real-time thread.
     pub fn rehearse(&self) -> Joints {
         let s = self.motion.s + self.motion.v.max(0.0) * self.hold.period;
         let chunk = self

@@ -103,6 +103,8 @@ pub struct Snapshot {
 
 impl Progress {
     /// Publish the per-period status (real-time thread; allocation-free).
+    ///
+    /// Real-time thread.
     #[allow(clippy::too_many_arguments)]
     pub fn publish(
         &self,

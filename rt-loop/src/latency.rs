@@ -77,15 +77,13 @@ pub fn run(
     let t0 = os::now();
     std::thread::scope(|scope| -> Result<Stats, RunError> {
         let finished = &finished;
-        let rt_thread = std::thread::Builder::new()
-            .name("dnurbs-rt".into())
-            .stack_size(STACK_PREFAULT * 2)
-            .spawn_scoped(scope, move || -> Result<(Box<Interval>, i64), RtError> {
-                let result = rt_body(first, full_p, free_c, period_ns, duration_ns, rt);
-                finished.store(true, Ordering::Release);
-                result
-            })
-            .map_err(|_| RtError::Thread("could not be started"))?;
+        let rt_thread = crate::thread::spawn_rt(
+            scope,
+            rt,
+            false,
+            move |_mode| rt_body(first, full_p, free_c, period_ns, duration_ns),
+            move || finished.store(true, Ordering::Release),
+        )?;
         // This thread is the reporter: write out and total each interval, return the box.
         let mut totals = Stats::new();
         let mut report = |iv: &Interval, totals: &mut Stats| -> Result<(), RunError> {
@@ -119,25 +117,15 @@ pub fn run(
     })
 }
 
-/// The real-time thread: set-up, warm-up, loop. Returns the last interval and the minor page
-/// faults that happened during the loop.
+/// The real-time thread's work after [`crate::thread::set_up`]: warm-up, loop. Returns the
+/// last interval and the minor page faults that happened during the loop.
 fn rt_body(
     first: Box<Interval>,
     full: Producer<'_, Box<Interval>>,
     free: Consumer<'_, Box<Interval>>,
     period_ns: u64,
     duration_ns: u64,
-    rt: RtSettings,
-) -> Result<(Box<Interval>, i64), RtError> {
-    if let Some(priority) = rt.priority {
-        os::lock_memory()?;
-        os::set_fifo(priority)?;
-    }
-    if let Some(cpu) = rt.cpu {
-        os::pin_to_cpu(cpu)?;
-    }
-    os::set_timer_slack(1);
-    os::prefault_stack(STACK_PREFAULT);
+) -> (Box<Interval>, i64) {
     let mut rec = Recorder::new(first, full, free, INTERVAL_NS, os::now());
     // First calls map the vDSO data page and touch every path the loop takes: do them
     // now, then start from empty statistics.
@@ -147,11 +135,13 @@ fn rt_body(
     let faults = os::minor_faults();
     periodic(&mut rec, period_ns, duration_ns);
     let faults = os::minor_faults() - faults;
-    Ok((rec.finish(os::now()), faults))
+    (rec.finish(os::now()), faults)
 }
 
 /// The loop proper: allocation-free, bounded by `duration_ns / period_ns` iterations.
 /// Public for the allocation and page-fault test; `run` is the way to use it.
+///
+/// Real-time thread.
 pub fn periodic(rec: &mut Recorder<'_>, period_ns: u64, duration_ns: u64) {
     let period = period_ns.max(1);
     let start = os::now();

@@ -11,31 +11,7 @@ use crate::exit::Outcome;
 use serde::Serialize;
 use std::path::Path;
 
-/// How the real-time thread ran.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct RtMode {
-    pub sched_fifo: bool,
-    /// SCHED_FIFO priority, when it ran with it.
-    pub priority: Option<i32>,
-    pub memory_locked: bool,
-    /// CPU the thread was pinned to.
-    pub cpu: Option<usize>,
-    /// Why it ran without real-time privileges, if it did.
-    pub without_because: Option<String>,
-}
-
-impl RtMode {
-    pub fn text(&self) -> String {
-        let cpu = self.cpu.map_or(String::new(), |c| format!(", CPU {c}"));
-        match (&self.without_because, self.priority) {
-            (None, Some(p)) if self.sched_fifo && self.memory_locked => {
-                format!("SCHED_FIFO priority {p}, memory locked{cpu}")
-            }
-            (Some(why), _) => format!("no ({why}){cpu}"),
-            _ => format!("no{cpu}"),
-        }
-    }
-}
+pub use rt_loop::thread::RtMode;
 
 /// One drive at the end.
 #[derive(Clone, Debug, PartialEq, Serialize)]

@@ -10,7 +10,7 @@
 //!   `latency.hlog`, prints progress on stderr when that is a terminal, and at the end prints
 //!   and writes the latency report.
 
-use crate::report::{DriveEnd, Report, RtMode, AXES};
+use crate::report::{DriveEnd, Report, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
@@ -22,10 +22,11 @@ use nc::segment::build;
 use nc::stream::{chunks, Follower, HoldConfig, Queues, Start};
 use rt_loop::control::{Command, Commands, Producer};
 use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
-use rt_loop::latency::{RtSettings, INTERVAL_NS, STACK_PREFAULT};
+use rt_loop::latency::{RtSettings, INTERVAL_NS};
 use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, StopReason};
 use rt_loop::stats::Stats;
+use rt_loop::thread::RtMode;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -358,26 +359,19 @@ fn run_threads<L: CanLink + Send>(
                 .spawn_scoped(scope, move || server.serve(&mut tx, progress, done))?;
         }
         let pl = &mut *pipeline;
-        let rt_thread = std::thread::Builder::new()
-            .name("dnurbs-rt".into())
-            .stack_size(STACK_PREFAULT * 2)
-            .spawn_scoped(scope, move || {
-                let realtime = match rt_setup(rt, fallback) {
-                    Ok(mode) => mode,
-                    Err(e) => {
-                        done.store(true, Ordering::Release);
-                        return Err(e);
-                    }
-                };
-                os::set_timer_slack(1);
-                os::prefault_stack(STACK_PREFAULT);
+        let rt_thread = rt_loop::thread::spawn_rt(
+            scope,
+            rt,
+            fallback,
+            move |realtime| {
                 let mut rec = Recorder::new(first, full_p, free_c, INTERVAL_NS, os::now());
                 let faults = os::minor_faults();
                 drive_loop(&mut rec, pl, period_ns, lead, stop, progress, u64::MAX);
                 let faults = os::minor_faults() - faults;
-                done.store(true, Ordering::Release);
-                Ok((rec.finish(os::now()), faults, realtime))
-            })?;
+                (rec.finish(os::now()), faults, realtime)
+            },
+            move || done.store(true, Ordering::Release),
+        )?;
         let mut totals = Stats::new();
         let mut report = |iv: &Interval, totals: &mut Stats| -> anyhow::Result<()> {
             totals.add(&iv.stats);
@@ -441,34 +435,6 @@ fn run_threads<L: CanLink + Send>(
         r.hard_stops = c.hard_stops;
         r
     })
-}
-
-/// Lock memory, SCHED_FIFO, CPU. Without `fallback`, a missing privilege is an error;
-/// with it, the mode says what the thread runs without, and why.
-fn rt_setup(rt: RtSettings, fallback: bool) -> Result<RtMode, String> {
-    let mut mode = RtMode {
-        cpu: rt.cpu,
-        ..RtMode::default()
-    };
-    match rt.priority {
-        Some(priority) => {
-            let locked = os::lock_memory();
-            mode.memory_locked = locked.is_ok();
-            match locked.and_then(|()| os::set_fifo(priority)) {
-                Ok(()) => {
-                    mode.sched_fifo = true;
-                    mode.priority = Some(priority);
-                }
-                Err(e) if fallback => mode.without_because = Some(e.to_string()),
-                Err(e) => return Err(e.to_string()),
-            }
-        }
-        None => mode.without_because = Some("--no-rt".to_owned()),
-    }
-    if let Some(cpu) = rt.cpu {
-        os::pin_to_cpu(cpu).map_err(|e| e.to_string())?;
-    }
-    Ok(mode)
 }
 
 /// The demo's machine: the paper's machine (its drives on an in-process bus).

@@ -315,6 +315,8 @@ impl<L: CanLink> Master<L> {
     /// One cycle: receive, supervise, send RPDO1 per node (targets in counts, in the order
     /// of the nodes; ignored while a drive is not Operation enabled or after a fault) and
     /// SYNC. Returns the first fault, if any has occurred.
+    ///
+    /// Real-time thread.
     pub fn cycle(&mut self, targets: &[i32], now: f64) -> Option<DriveFault> {
         self.cycles += 1;
         for n in self.nodes.iter_mut() {

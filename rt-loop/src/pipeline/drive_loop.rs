@@ -68,6 +68,8 @@ impl Slots {
 /// latency is measured against the early wake-up time, the whole cycle from the deadline (or
 /// the wake-up, if that was later) to the last frame written: the step is done by then. The
 /// lead costs its length in CPU time per period.
+///
+/// Real-time thread.
 pub fn drive_loop<L: CanLink>(
     rec: &mut crate::interval::Recorder<'_>,
     pipeline: &mut Pipeline<'_, L>,

@@ -279,6 +279,8 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     }
 
     /// Publish where the run is (every period, allocation-free).
+    ///
+    /// Real-time thread.
     pub fn publish(&self, progress: &Progress) {
         let stage = match self.stage {
             Stage::Enabling => 0,
@@ -381,6 +383,8 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     /// where the next period will likely be ([`Follower::rehearse`]) and the result is
     /// dropped, so the timed step finds its code and data in the caches. Changes no state and
     /// sends nothing; does nothing outside the program.
+    ///
+    /// Real-time thread.
     pub fn rehearse(&self) {
         if !matches!(self.stage, Stage::Running | Stage::Stopping) {
             return;
@@ -418,6 +422,8 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     /// positions in counts. [`Pipeline::cycle`] sends what it computed; it calls this itself
     /// unless the loop did so before the deadline. Once per period: a second call does
     /// nothing.
+    ///
+    /// Real-time thread.
     pub fn prepare(&mut self) {
         if self.prepared.is_some() || !matches!(self.stage, Stage::Running | Stage::Stopping) {
             return;
@@ -435,6 +441,8 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     }
 
     /// One period at monotonic time `now_ns`. `stop` is the stop request (signal flag).
+    ///
+    /// Real-time thread.
     pub fn cycle(&mut self, now_ns: u64, stop: bool) -> CycleInfo {
         let now = now_ns as f64 * 1e-9;
         self.cycles += 1;
