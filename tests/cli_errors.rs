@@ -306,7 +306,11 @@ fn latency_writes_the_report_and_rejects_bad_durations() {
     for key in ["cycles", "overruns", "underruns"] {
         assert!(lat[key].is_u64(), "{key} missing: {json}");
     }
-    assert!(lat["cycles"].as_u64().unwrap() > 200, "{json}");
+    // At most 300 periods of 1 ms in 300 ms; fewer on a loaded machine, where missed
+    // deadlines are skipped (measured under stress-ng --cpu 4: 193, 29 overruns).
+    let cycles = lat["cycles"].as_u64().unwrap();
+    assert!((1..=301).contains(&cycles), "{json}");
+    assert_eq!(json["overruns"], lat["overruns"]);
     for h in ["wakeup_latency_ns", "compute_ns", "cycle_ns"] {
         for k in ["min", "p50", "p90", "p99", "p99_9", "p99_99", "max"] {
             assert!(lat["histograms"][h][k].is_u64(), "{h}.{k} missing: {json}");
