@@ -63,30 +63,25 @@ impl Outcome {
 }
 
 /// A failure the user can fix in their input (exit code 2). Each names the file and, where
-/// known, `line:col`.
+/// known, `line:col`. The library error is part of the message, not a separate `source`
+/// (which `{:#}` would print a second time).
 #[derive(Debug, thiserror::Error)]
 pub enum InputError {
-    #[error("{file}: cannot read the program: {source}")]
-    ReadProgram {
-        file: String,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error("{file}: cannot read the program: {error}")]
+    ReadProgram { file: String, error: std::io::Error },
     /// Not UTF-8: `line:col: ...` from [`crate::program_text`].
     #[error("{file}:{message}")]
     Encoding { file: String, message: String },
-    #[error("{file}:{source}")]
+    #[error("{file}:{error}")]
     Parse {
         file: String,
-        #[source]
-        source: nc::parse::ParseError,
+        error: nc::parse::ParseError,
     },
     /// The program does not fit the machine: geometry or plan.
-    #[error("{file}:{source}")]
+    #[error("{file}:{error}")]
     Program {
         file: String,
-        #[source]
-        source: nc::plan::ProgramError,
+        error: nc::plan::ProgramError,
     },
     #[error(transparent)]
     Machine(#[from] config::ConfigError),
@@ -106,7 +101,7 @@ impl InputError {
     pub fn program(file: &Path, source: impl Into<nc::plan::ProgramError>) -> Self {
         InputError::Program {
             file: file.display().to_string(),
-            source: source.into(),
+            error: source.into(),
         }
     }
 }

@@ -18,9 +18,9 @@ use std::path::Path;
 /// Read and parse an NC program; errors name the file, line and column.
 pub fn load_program(path: &Path) -> Result<nc::program::Program, InputError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|source| InputError::ReadProgram {
+    let bytes = std::fs::read(path).map_err(|error| InputError::ReadProgram {
         file: file.clone(),
-        source,
+        error,
     })?;
     parse_program(&bytes, &file)
 }
@@ -31,9 +31,9 @@ pub fn parse_program(bytes: &[u8], file: &str) -> Result<nc::program::Program, I
         file: file.to_owned(),
         message,
     })?;
-    nc::parse::parse(text).map_err(|source| InputError::Parse {
+    nc::parse::parse(text).map_err(|error| InputError::Parse {
         file: file.to_owned(),
-        source,
+        error,
     })
 }
 

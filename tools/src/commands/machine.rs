@@ -74,9 +74,9 @@ pub fn run(
     control: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
     let m = crate::load_machine(machine)?;
-    let src = std::fs::read(program).map_err(|source| InputError::ReadProgram {
+    let src = std::fs::read(program).map_err(|error| InputError::ReadProgram {
         file: program.display().to_string(),
-        source,
+        error,
     })?;
     let open_links = || -> anyhow::Result<Vec<drives::link::SocketLink>> {
         let mut links = Vec::new();
