@@ -333,6 +333,7 @@ pub(crate) mod tests {
             weights: Default::default(),
             knots: Default::default(),
             feed_mm_min: 400.0,
+            tooling: Default::default(),
         };
         for i in 0..5 {
             b.ctrl.push(c[i]);
@@ -352,10 +353,12 @@ pub(crate) mod tests {
                     end: c[0],
                     orientation: Orientation::Vector([dir[0] / n, dir[1] / n, dir[2] / n]),
                     feed_mm_min: 400.0,
+                    tooling: Default::default(),
                 }),
                 Block::Nurbs(b),
             ],
             end: None,
+            actions: Vec::new(),
             tilt_word: None,
         }
     }

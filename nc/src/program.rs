@@ -54,6 +54,8 @@ pub struct LinearMove {
     pub orientation: Orientation,
     /// Programmed feed, mm/min (ignored for rapid moves; may then be 0).
     pub feed_mm_min: f64,
+    /// Tool length and stops in effect for this move (see [`Tooling`]).
+    pub tooling: MoveTooling,
 }
 
 /// Which NURBS word opened the block.
@@ -87,6 +89,7 @@ pub struct NurbsBlock {
     pub knots: Vec<f64>,
     /// Programmed feed, mm/min (modal F resolved).
     pub feed_mm_min: f64,
+    pub tooling: MoveTooling,
 }
 
 /// One motion block of the program.
@@ -113,7 +116,88 @@ pub struct Program {
     pub blocks: Vec<Block>,
     /// Where `M02`/`M30` stood, if the program had one.
     pub end: Option<SrcPos>,
+    /// Program words that drive no axis (spindle, coolant, tool selection, stops and dwells),
+    /// in program order: what a run reports and, where the machine has the hardware, does.
+    pub actions: Vec<Action>,
     /// The tilting-axis letter the program's angle words use (`'A'` or `'B'`) and where it
     /// first stood; `None` if the program gives no angles. The machine must match it.
     pub tilt_word: Option<(char, SrcPos)>,
+}
+
+/// What the tool does along a move besides its geometry: the tool-length offset at the
+/// move's end and what must happen, at rest, before the move starts.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MoveTooling {
+    /// Tool length (mm along the spindle axis, machine +Z) in effect at the end of the
+    /// move: `G43 H` / `G43.4 H` from the tool table, 0 after `G49` or without either. The
+    /// machine's Z axis carries it: machine Z = the kinematics' Z + length. It changes only
+    /// along a `G00`/`G01` (the change is spread over the move).
+    pub tool_length: f64,
+    /// `G43.4` (tool-centre-point control) in effect: the programmed X Y Z are the tool tip in
+    /// the workpiece however the rotary axes stand. Without it, a move on a rotary-table
+    /// machine must keep the rotary axes at 0 (`segment::build` checks).
+    pub rtcp: bool,
+    /// The path stops before this move and waits there (`G04`, `M00`, `M01`, `M06`).
+    pub wait: Wait,
+}
+
+/// A stop before a move: a dwell, the operator's resume, or both.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Wait {
+    /// Seconds to stay at rest (sum of the `G04` dwells before the move).
+    pub dwell_s: f64,
+    /// The operator must resume (`M00`, `M01` when optional stops are on, `M06`): where the
+    /// first such word stood.
+    pub operator: Option<SrcPos>,
+}
+
+impl Wait {
+    pub fn is_some(&self) -> bool {
+        self.dwell_s > 0.0 || self.operator.is_some()
+    }
+}
+
+/// A program word that drives no axis, and where it stood.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Action {
+    pub pos: SrcPos,
+    /// Index in [`Program::blocks`] of the first motion block after the word
+    /// (`blocks.len()` when no motion follows).
+    pub before_block: usize,
+    pub kind: ActionKind,
+}
+
+/// Spindle direction (`M03` clockwise, `M04` counter-clockwise, `M05` stopped).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spindle {
+    Cw,
+    Ccw,
+    Off,
+}
+
+/// Coolant outputs (`M07` mist, `M08` flood, `M09` both off).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coolant {
+    Mist,
+    Flood,
+    Off,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ActionKind {
+    /// `M03`/`M04`/`M05` with the speed in effect (rpm, `S`).
+    Spindle { dir: Spindle, rpm: f64 },
+    /// `S` alone: the speed for the next `M03`/`M04` (or, while turning, a new speed).
+    Speed { rpm: f64 },
+    Coolant(Coolant),
+    /// `T`: the tool the next `M06` loads.
+    SelectTool { tool: u32 },
+    /// `M06`: the selected tool is loaded (the path stops for the operator).
+    ChangeTool { tool: Option<u32> },
+    /// `G04`.
+    Dwell { seconds: f64 },
+    /// `M00`.
+    Stop,
+    /// `M01`: `taken` when optional stops are on.
+    OptionalStop { taken: bool },
 }

@@ -7,6 +7,9 @@
 
 use core::fmt;
 
+use super::arc::{ARC_RADIUS_TOL_MM, MIN_ARC_RADIUS_MM};
+use super::codes::{Plane, G_LIST, M_LIST};
+use super::modal::MAX_DWELL_S;
 use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
 use super::parser::{MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH, MIN_WEIGHT};
 use crate::program::SrcPos;
@@ -29,6 +32,8 @@ pub struct ParseError {
 pub enum Motion {
     G00,
     G01,
+    G02,
+    G03,
     G062,
     G065,
 }
@@ -38,6 +43,8 @@ impl fmt::Display for Motion {
         f.write_str(match self {
             Motion::G00 => "G00",
             Motion::G01 => "G01",
+            Motion::G02 => "G02",
+            Motion::G03 => "G03",
             Motion::G062 => "G06.2",
             Motion::G065 => "G06.5",
         })
@@ -48,8 +55,12 @@ impl fmt::Display for Motion {
 /// [`ParseErrorKind::MissingWord`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Context {
-    /// A `G00` / `G01` line, or a line continuing that modal motion.
+    /// A `G00` / `G01` / `G02` / `G03` line, or a line continuing that modal motion.
     Move(Motion),
+    /// A line with `G04`.
+    Dwell,
+    /// A line with `G43` / `G43.4`.
+    LengthComp,
     /// A control-point line of a `G06.2` / `G06.5` block (including the opening line).
     ControlPoint(Motion),
     /// A line with no motion at all (only `N`, `F`, `G90`, `G21`, `M02`/`M30`).
@@ -62,6 +73,8 @@ impl fmt::Display for Context {
             Context::Move(m) => write!(f, "a {m} line"),
             Context::ControlPoint(m) => write!(f, "a {m} control-point line"),
             Context::NoMotion => f.write_str("a line without motion"),
+            Context::Dwell => f.write_str("a G04 (dwell) line"),
+            Context::LengthComp => f.write_str("a G43/G43.4 (tool length) line"),
         }
     }
 }
@@ -86,7 +99,7 @@ pub enum ParseErrorKind {
     ContinuationAtEof,
     #[error("`%` (tape marker) must stand alone on its line")]
     MisplacedTapeMark,
-    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G I J K M N P R U V W X Y Z")]
+    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P R S T U V W X Y Z")]
     UnsupportedWord { letter: char, value: f64 },
 
     // ---- line structure ----------------------------------------------------------------
@@ -104,10 +117,16 @@ pub enum ParseErrorKind {
         first: f64,
         second: f64,
     },
-    #[error("unsupported G-code {}: dnurbs accepts G00 G01 G06.2 G06.5 G21 G90", Code('G', *.code))]
+    #[error("unsupported G-code {}: dnurbs accepts {G_LIST}", Code('G', *.code))]
     UnsupportedGCode { code: f64 },
-    #[error("unsupported M-code {}: dnurbs accepts M02 M30", Code('M', *.code))]
+    #[error("unsupported M-code {}: dnurbs accepts {M_LIST}", Code('M', *.code))]
     UnsupportedMCode { code: f64 },
+    #[error("cutter radius compensation {} is not supported: post the tool-centre path (compensation in the computer) with G40", Code('G', *.code))]
+    CutterCompensation { code: f64 },
+    #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]
+    CannedCycle { code: f64 },
+    #[error("program number O{value} must stand alone on its line (after an optional N)")]
+    MisplacedProgramNumber { value: f64 },
     #[error("word {letter} after the program end at {end}: only blank lines, comments and `%` may follow M02/M30")]
     AfterProgramEnd { letter: char, end: SrcPos },
     #[error("word {letter} is not allowed on {context}")]
@@ -126,10 +145,55 @@ pub enum ParseErrorKind {
         "word {letter} moves the machine but no motion mode is in effect: start with G00 or G01"
     )]
     NoMotionMode { letter: char },
-    #[error("the first move defines the start pose and must give X, Y and Z: {axis} is missing")]
+    #[error("the first move defines the start pose and must give X, Y and Z ({axis} is missing), unless the machine file has a [reference] position to start from")]
     MissingStartAxis { axis: char },
     #[error("{motion} block before the start pose: the program must first move with a G00/G01 giving X, Y and Z")]
     NurbsBeforeStart { motion: Motion },
+
+    #[error("{letter}{value} must be a whole number from 0 to 99999")]
+    BadNumber { letter: char, value: f64 },
+    #[error("spindle speed S{value} must be from 0 to 1000000 rpm")]
+    BadSpeed { value: f64 },
+    #[error("G04 needs the dwell time: P<seconds> or X<seconds>")]
+    DwellWithoutTime,
+    #[error("dwell of {value} s must be from 0 to {MAX_DWELL_S} s (P and X are seconds here; a post that writes P in milliseconds must be set to seconds)")]
+    BadDwell { value: f64 },
+    #[error("G93 (inverse-time feed) needs F on every {motion} line: F is 1/minutes for that move")]
+    InverseTimeWithoutFeed { motion: Motion },
+    #[error("{motion} in G91 (incremental) mode: a NURBS block takes absolute coordinates, program G90 first")]
+    NurbsIncremental { motion: Motion },
+    #[error("work offset {} is not defined: define it under [work_offsets] in the machine file or in an --offsets file", Code('G', *.code))]
+    UnknownWorkOffset { code: f64 },
+    #[error("{} needs the machine's reference position: define [reference] in the machine file", Code('G', *.code))]
+    NoReference { code: f64 },
+    #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]
+    MachineMoveRotated { code: f64, axis: char },
+    #[error("{} needs G00 or G01 in effect (it is a straight move in machine coordinates)", Code('G', *.code))]
+    MachineMoveNotLinear { code: f64 },
+    #[error("tool {tool} is not in the tool table: give --tools FILE (LinuxCNC tool.tbl) with a line T{tool} ... Z<length>")]
+    UnknownTool { tool: u32 },
+    #[error("the tool length changes ({from} -> {to} mm) on a {motion} block: change it on a G00/G01 (posts write G43 Z.. H..)")]
+    LengthChangeOnCurve { motion: Motion, from: f64, to: f64 },
+    #[error("the tool length changes with the tool axis given as angles other than 0: program the change on a line with X Y Z")]
+    LengthChangeTilted,
+
+    // ---- arcs --------------------------------------------------------------------------
+    #[error("{motion} needs its centre: {} offsets, or R", .plane.offset_letters())]
+    ArcWithoutCentre { motion: Motion, plane: Plane },
+    #[error("{motion} with both R and the centre offset {letter}: give one of them")]
+    ArcCentreAndRadius { motion: Motion, letter: char },
+    #[error("centre offset {letter} is not in the {} plane: its offsets are {}", .plane.name(), .plane.offset_letters())]
+    ArcOffsetOutOfPlane { letter: char, plane: Plane },
+    #[error("the arc's radius is {start} mm at its start and {end} mm at its end: they differ by more than {ARC_RADIUS_TOL_MM} mm (check the end point and the centre)")]
+    ArcRadiusMismatch { start: f64, end: f64 },
+    #[error("arc radius R{value} is less than half the distance to the end point ({half} mm): no arc fits")]
+    ArcRadiusTooSmall { value: f64, half: f64 },
+    #[error("an arc given by R cannot end where it starts: program a full circle with its centre offsets")]
+    ArcFullCircleRadius,
+    #[error("arc radius {radius} mm is below {MIN_ARC_RADIUS_MM} mm")]
+    ArcTooSmall { radius: f64 },
+    #[error("rotary word {letter} on an arc: the tool axis stays fixed along G02/G03, turn it on a G01")]
+    ArcRotary { letter: char },
 
     // ---- tool orientation on G00/G01 ---------------------------------------------------
     #[error("angle {angle} and vector word {vector} on one line: give the orientation either as angles or as I J K")]

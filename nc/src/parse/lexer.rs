@@ -25,10 +25,12 @@ pub(super) struct Lexer<'a> {
     lines: core::iter::Enumerate<core::str::Lines<'a>>,
     /// Position just past the last character of the source (for errors at end of file).
     eof: SrcPos,
+    /// Skip lines that start with `/` (else the `/` is dropped).
+    block_delete: bool,
 }
 
 impl<'a> Lexer<'a> {
-    pub fn new(src: &'a str) -> Self {
+    pub fn new(src: &'a str, block_delete: bool) -> Self {
         let (count, last) = src.lines().enumerate().last().unwrap_or((0, ""));
         let eof = SrcPos {
             line: to_u32(count + 1),
@@ -37,6 +39,7 @@ impl<'a> Lexer<'a> {
         Lexer {
             lines: src.lines().enumerate(),
             eof,
+            block_delete,
         }
     }
 
@@ -60,6 +63,25 @@ impl<'a> Lexer<'a> {
             if continued_at.is_none() && text.trim() == "%" {
                 return Ok(true);
             }
+            // Block delete: a `/` first on a line (spaces may precede it).
+            let trimmed = text.trim_start();
+            let text = match trimmed.strip_prefix('/') {
+                Some(_) if continued_at.is_none() && self.block_delete => return Ok(true),
+                Some(rest) if continued_at.is_none() => {
+                    // Keep the columns: blank out the `/` instead of cutting it.
+                    let lead = text.len() - trimmed.len();
+                    let mut owned = String::with_capacity(text.len());
+                    owned.push_str(text.get(..lead).unwrap_or(""));
+                    owned.push(' ');
+                    owned.push_str(rest);
+                    continued_at = scan_line(line, &owned, words)?;
+                    if continued_at.is_none() {
+                        return Ok(true);
+                    }
+                    continue;
+                }
+                _ => text,
+            };
             continued_at = scan_line(line, text, words)?;
             if continued_at.is_none() {
                 return Ok(true);

@@ -1,18 +1,19 @@
 //! One logical line, classified: its sequence number, its G and M codes decoded into their
-//! modal groups, and its remaining words indexed by letter.
+//! modal groups (`codes`), and its remaining words indexed by letter.
 //!
 //! The rules that need no modal state are checked here: unknown letters, unsupported codes,
 //! two codes of one group, a misplaced or malformed `N`, a word repeated on a line.
 
+use super::codes::{g_code, m_code, Code, StopCode, GROUPS};
 use super::error::{Context, Motion, ParseError, ParseErrorKind};
 use super::lexer::Word;
 use crate::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].
-const KNOWN: &str = "ABCFGIJKMNPRUVWXYZ";
+pub(super) const KNOWN: &str = "ABCFGHIJKMNOPRSTUVWXYZ";
 
-/// Words that make a line move the machine (in the modal G00/G01 mode if no G word is given).
-pub(super) const MOVE_WORDS: &str = "XYZABCIJK";
+/// Words that make a line move the machine (in the modal motion mode if no G word is given).
+pub(super) const MOVE_WORDS: &str = "XYZABCIJKR";
 
 /// A classified, non-empty logical line.
 pub(super) struct Line<'w> {
@@ -30,6 +31,8 @@ pub(super) struct Line<'w> {
     pub has_codes: bool,
     /// `true` when the body is one or more `K` words and nothing else (trailing knots).
     pub knots_only: bool,
+    /// The decoded codes by modal group, with their position.
+    codes: [Option<(Code, SrcPos)>; GROUPS],
     /// The non-code words, indexed by letter (unused when `knots_only`).
     slots: [Option<Word>; 26],
 }
@@ -50,29 +53,19 @@ impl<'w> Line<'w> {
             end: None,
             has_codes: false,
             knots_only: !body.is_empty() && body.iter().all(|w| w.letter == 'K'),
+            codes: [None; GROUPS],
             slots: [None; 26],
         };
-        // Modal groups seen on this line: motion, distance (G90), units (G21), program end.
-        let mut groups: [Option<f64>; 4] = [None; 4];
+        let mut values: [f64; GROUPS] = [0.0; GROUPS];
         for w in body {
-            let group = match w.letter {
+            let code = match w.letter {
                 l if !KNOWN.contains(l) => Err(ParseErrorKind::UnsupportedWord {
                     letter: l,
                     value: w.value,
                 }),
                 'N' => Err(ParseErrorKind::MisplacedSequenceNumber { value: w.value }),
-                'G' => g_code(w.value).map(|g| match g {
-                    GCode::Motion(m) => {
-                        line.motion = Some((m, w.pos));
-                        0
-                    }
-                    GCode::Absolute => 1,
-                    GCode::Metric => 2,
-                }),
-                'M' => m_code(w.value).map(|()| {
-                    line.end = Some(w.pos);
-                    3
-                }),
+                'G' => g_code(w.value),
+                'M' => m_code(w.value),
                 _ => {
                     if !line.knots_only {
                         line.insert(w)?;
@@ -80,18 +73,27 @@ impl<'w> Line<'w> {
                     continue;
                 }
             };
-            let group = group.map_err(|kind| kind.at(w.pos))?;
+            let code = code.map_err(|kind| kind.at(w.pos))?;
             line.has_codes = true;
-            if let Some(Some(prev)) = groups.get(group) {
+            let group = code.group();
+            let (Some(slot), Some(value)) = (line.codes.get_mut(group), values.get_mut(group))
+            else {
+                continue; // unreachable: every group is below GROUPS
+            };
+            if slot.is_some() {
                 let kind = ParseErrorKind::ConflictingCodes {
                     letter: w.letter,
-                    first: *prev,
+                    first: *value,
                     second: w.value,
                 };
                 return Err(kind.at(w.pos));
             }
-            if let Some(slot) = groups.get_mut(group) {
-                *slot = Some(w.value);
+            *slot = Some((code, w.pos));
+            *value = w.value;
+            match code {
+                Code::Motion(m) => line.motion = Some((m, w.pos)),
+                Code::Stop(StopCode::End) => line.end = Some(w.pos),
+                _ => {}
             }
         }
         Ok(line)
@@ -110,6 +112,16 @@ impl<'w> Line<'w> {
         }
         *slot = Some(*w);
         Ok(())
+    }
+
+    /// The codes of the line, in group order.
+    pub fn codes(&self) -> impl Iterator<Item = (Code, SrcPos)> + '_ {
+        self.codes.iter().flatten().copied()
+    }
+
+    /// The code of `code`'s group, if the line has one.
+    pub fn code_of_group(&self, group: usize) -> Option<(Code, SrcPos)> {
+        self.codes.get(group).copied().flatten()
     }
 
     /// The word with this (upper-case) letter, if the line has it.
@@ -146,41 +158,6 @@ impl<'w> Line<'w> {
     pub fn require(&self, letter: char, context: Context, at: SrcPos) -> Result<Word, ParseError> {
         self.get(letter)
             .ok_or(ParseErrorKind::MissingWord { letter, context }.at(at))
-    }
-}
-
-/// Decoded G codes.
-enum GCode {
-    Motion(Motion),
-    /// G90, absolute coordinates (the only mode supported).
-    Absolute,
-    /// G21, millimetres (the only unit supported).
-    Metric,
-}
-
-fn g_code(value: f64) -> Result<GCode, ParseErrorKind> {
-    // Exact comparisons are sound: `06.5` and `6.5` parse to the same correctly-rounded f64.
-    const TABLE: [(f64, GCode); 6] = [
-        (0.0, GCode::Motion(Motion::G00)),
-        (1.0, GCode::Motion(Motion::G01)),
-        (6.2, GCode::Motion(Motion::G062)),
-        (6.5, GCode::Motion(Motion::G065)),
-        (90.0, GCode::Absolute),
-        (21.0, GCode::Metric),
-    ];
-    TABLE
-        .into_iter()
-        .find(|(v, _)| *v == value)
-        .map(|(_, g)| g)
-        .ok_or(ParseErrorKind::UnsupportedGCode { code: value })
-}
-
-/// `M02` and `M30` (program end) are the only M codes.
-fn m_code(value: f64) -> Result<(), ParseErrorKind> {
-    if value == 2.0 || value == 30.0 {
-        Ok(())
-    } else {
-        Err(ParseErrorKind::UnsupportedMCode { code: value })
     }
 }
 

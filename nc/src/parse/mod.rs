@@ -72,32 +72,90 @@
 //! that can fail, checked conversions, and every number is proved finite by the lexer. A
 //! property test feeds it arbitrary text and mutations of the paper's example.
 
+mod arc;
+pub(crate) mod codes;
 mod error;
 mod lexer;
 mod line;
+mod modal;
+mod moves;
 mod nurbs;
 mod parser;
 #[cfg(test)]
 mod tests;
 
+pub use arc::{arc, ArcNet, Centre, ARC_RADIUS_TOL_MM, HELIX_TOL_MM};
+pub use codes::Plane;
 pub use error::{Context, Motion, ParseError, ParseErrorKind};
 pub use lexer::word_limit;
+pub use modal::{Setup, MAX_DWELL_S, MAX_ERRORS, MM_PER_INCH};
 pub use parser::{MIN_FEED_MM_MIN, MIN_WEIGHT};
 
 use crate::program::Program;
 
-/// Parses a whole NC program.
+/// Every error of a program, in source order: at most [`MAX_ERRORS`], and `more` when the
+/// parse stopped there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParseErrors {
+    pub errors: Vec<ParseError>,
+    pub more: bool,
+}
+
+impl ParseErrors {
+    /// The first error (there is always one).
+    pub fn first(&self) -> Option<&ParseError> {
+        self.errors.first()
+    }
+}
+
+/// Parses a whole NC program with no shop setup (no work offsets, reference position or
+/// tools); the first error only.
 ///
 /// ```
 /// let program = nc::parse::parse("G00 X0 Y0 Z10\nG01 Z0 F500\nM30\n").unwrap();
 /// assert_eq!(program.blocks.len(), 2);
 /// ```
 pub fn parse(src: &str) -> Result<Program, ParseError> {
-    let mut lexer = lexer::Lexer::new(src);
-    let mut parser = parser::Parser::new();
+    parse_with(src, &Setup::default()).map_err(|e| {
+        e.errors.first().copied().unwrap_or(ParseError {
+            pos: crate::program::SrcPos::default(),
+            kind: ParseErrorKind::MisplacedTapeMark,
+        })
+    })
+}
+
+/// Parses a whole NC program against the shop's [`Setup`], reporting every error (up to
+/// [`MAX_ERRORS`]). After an error the line is skipped (a NURBS block with it), so later
+/// errors may follow from the first one.
+pub fn parse_with(src: &str, setup: &Setup) -> Result<Program, ParseErrors> {
+    let mut lexer = lexer::Lexer::new(src, setup.block_delete);
+    let mut parser = parser::Parser::new(setup);
     let mut words = Vec::new();
-    while lexer.next_line(&mut words)? {
-        parser.line(&words)?;
+    let mut errors = Vec::new();
+    loop {
+        if errors.len() >= MAX_ERRORS {
+            return Err(ParseErrors { errors, more: true });
+        }
+        match lexer.next_line(&mut words) {
+            Ok(false) => break,
+            Ok(true) => {
+                if let Err(e) = parser.line(&words) {
+                    errors.push(e);
+                    parser.recover();
+                }
+            }
+            Err(e) => {
+                errors.push(e);
+                parser.recover();
+            }
+        }
     }
-    parser.finish(lexer.eof())
+    match parser.finish(lexer.eof()) {
+        Ok(program) if errors.is_empty() => Ok(program),
+        Ok(_) => Err(ParseErrors { errors, more: false }),
+        Err(e) => {
+            errors.push(e);
+            Err(ParseErrors { errors, more: false })
+        }
+    }
 }

@@ -9,7 +9,7 @@
 use super::error::{Context, Motion, ParseError, ParseErrorKind};
 use super::lexer::Word;
 use super::line::Line;
-use crate::program::{NurbsBlock, NurbsKind, SrcPos, MAX_DEGREE};
+use crate::program::{MoveTooling, NurbsBlock, NurbsKind, SrcPos, MAX_DEGREE};
 use crate::split::MAX_BLOCK_CTRL;
 
 /// Tolerance of the first control point against the current position, mm per axis.
@@ -17,8 +17,26 @@ pub(super) const START_TOLERANCE_MM: f64 = 1e-3;
 /// Least distance between a cutter control point and its orientation control point, mm.
 pub(super) const MIN_TOOL_OFFSET_MM: f64 = 1e-3;
 
+/// Program coordinates to the workpiece frame: `mm = value * scale + offset`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Frame {
+    pub scale: f64,
+    pub offset: [f64; 3],
+}
+
+impl Frame {
+    fn apply(&self, p: [f64; 3]) -> [f64; 3] {
+        [
+            p[0] * self.scale + self.offset[0],
+            p[1] * self.scale + self.offset[1],
+            p[2] * self.scale + self.offset[2],
+        ]
+    }
+}
+
 pub(super) struct OpenNurbs {
     block: NurbsBlock,
+    frame: Frame,
     motion: Motion,
     /// Position of each knot's `K` word, for errors found when the block completes.
     knot_pos: Vec<SrcPos>,
@@ -34,6 +52,8 @@ impl OpenNurbs {
         (motion, pos): (Motion, SrcPos),
         here: [f64; 3],
         feed: Option<f64>,
+        frame: Frame,
+        tooling: MoveTooling,
     ) -> Result<Self, ParseError> {
         let kind = if motion == Motion::G065 {
             NurbsKind::G065
@@ -74,9 +94,11 @@ impl OpenNurbs {
             weights: Vec::new(),
             knots: Vec::new(),
             feed_mm_min,
+            tooling,
         };
         let mut open = OpenNurbs {
             block,
+            frame,
             motion,
             knot_pos: Vec::new(),
             need: None,
@@ -119,7 +141,9 @@ impl OpenNurbs {
             .first_of(self.point_letters())
             .map_or(line.first, |w| w.pos);
         let need = |letter| line.require(letter, context, pos);
-        let xyz = [need('X')?.value, need('Y')?.value, need('Z')?.value];
+        let xyz = self
+            .frame
+            .apply([need('X')?.value, need('Y')?.value, need('Z')?.value]);
         let tool = if g065 {
             Some([need('U')?, need('V')?, need('W')?])
         } else {
@@ -133,7 +157,7 @@ impl OpenNurbs {
             Some(r) => r.value,
             None => 1.0,
         };
-        let uvw = tool.map(|w| w.map(|w| w.value));
+        let uvw = tool.map(|w| self.frame.apply(w.map(|w| w.value)));
         if let (Some(uvw), Some([u, ..])) = (uvw, tool) {
             let dist = distance(xyz, uvw);
             if dist < MIN_TOOL_OFFSET_MM {

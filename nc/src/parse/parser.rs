@@ -1,9 +1,19 @@
-//! The modal state machine: classified lines in, resolved [`Block`]s out.
+//! The modal state machine: classified lines in, resolved [`Block`]s and [`Action`]s out.
+//!
+//! Per line, in the order the words take effect (LinuxCNC's order of execution): the modes
+//! (plane, units, distance, feed mode, work offset, tool length, path control), `F`, `S`,
+//! `T`, `M06`, spindle, coolant, `G04`, the motion (`moves.rs`), then `M00`/`M01` and the
+//! program end.
 
+use super::codes::{Code, LengthComp, StopCode};
 use super::error::{Context, Motion, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
-use super::nurbs::OpenNurbs;
-use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
+use super::modal::{Modal, Setup, MAX_DWELL_S};
+use super::nurbs::{Frame, OpenNurbs};
+use crate::program::{
+    Action, ActionKind, Block, MoveTooling, NurbsBlock, NurbsKind, Orientation, Program, SrcPos,
+    Wait,
+};
 
 /// Tool-vector length below which `I J K` is rejected (it has no direction).
 pub(super) const MIN_VECTOR_LENGTH: f64 = 1e-9;
@@ -13,39 +23,63 @@ pub const MIN_FEED_MM_MIN: f64 = 0.001;
 /// Smallest NURBS weight (the largest is the `R` word's bound, 1e6).
 pub const MIN_WEIGHT: f64 = 1e-6;
 /// The tool orientation until a program gives one: vertical.
-const VERTICAL: Orientation = Orientation::Vector([0.0, 0.0, 1.0]);
+pub(super) const VERTICAL: Orientation = Orientation::Vector([0.0, 0.0, 1.0]);
+/// Largest tool or spindle-speed word.
+const MAX_RPM: f64 = 1e6;
 
-pub(super) struct Parser {
-    blocks: Vec<Block>,
-    /// Modal G00/G01 mode (NURBS modes are not modal).
-    mode: Option<Motion>,
-    feed: Option<f64>,
-    /// End of the last move; `None` until the start pose.
-    here: Option<[f64; 3]>,
-    orientation: Orientation,
+pub(super) struct Parser<'s> {
+    pub setup: &'s Setup,
+    pub modal: Modal,
+    pub blocks: Vec<Block>,
+    pub actions: Vec<Action>,
+    /// Modal motion mode (G00 G01 G02 G03; NURBS modes are not modal).
+    pub mode: Option<Motion>,
+    /// Modal feed, mm/min (`G94`).
+    pub feed: Option<f64>,
+    /// End of the last move (tool tip, workpiece frame, mm); `None` until the start pose.
+    pub here: Option<[f64; 3]>,
+    pub orientation: Orientation,
     /// `false` while `orientation` is the implicit vertical default.
-    orientation_given: bool,
+    pub orientation_given: bool,
     /// The first `A` or `B` word of the program: the machine's first rotary axis.
-    rotary: Option<(char, SrcPos)>,
+    pub rotary: Option<(char, SrcPos)>,
+    /// What the next motion block waits for.
+    pub wait: Wait,
     open: Option<OpenNurbs>,
     /// The NURBS block that ended on the previous line (for a helpful extra-knot error).
     just_closed: Option<(SrcPos, usize)>,
+    /// After an error inside a NURBS block: skip its remaining control-point and knot lines.
+    skipping: bool,
     end: Option<SrcPos>,
 }
 
-impl Parser {
-    pub fn new() -> Self {
+impl<'s> Parser<'s> {
+    pub fn new(setup: &'s Setup) -> Self {
+        let mut modal = Modal::default();
+        modal.offset = setup.work_offsets[0].unwrap_or([0.0; 3]);
         Parser {
+            setup,
+            modal,
             blocks: Vec::new(),
+            actions: Vec::new(),
             mode: None,
             feed: None,
             here: None,
             orientation: VERTICAL,
             orientation_given: false,
             rotary: None,
+            wait: Wait::default(),
             open: None,
             just_closed: None,
+            skipping: false,
             end: None,
+        }
+    }
+
+    /// After an error on a line: drop an open NURBS block and skip the rest of its lines.
+    pub fn recover(&mut self) {
+        if self.open.take().is_some() {
+            self.skipping = true;
         }
     }
 
@@ -62,6 +96,12 @@ impl Parser {
             return Err(kind.at(first.pos));
         }
         let line = Line::classify(words)?;
+        if self.skipping {
+            if line.knots_only || (!line.has_codes && line.first_of("KRUVW").is_some()) {
+                return Ok(());
+            }
+            self.skipping = false;
+        }
         if let Some(open) = &mut self.open {
             if open.take_line(&line)? {
                 if let Some(open) = self.open.take() {
@@ -81,35 +121,40 @@ impl Parser {
             return Err(kind.at(k.pos));
         }
         self.just_closed = None;
-        if let Some(f) = line.get('F') {
-            if f.value < MIN_FEED_MM_MIN {
-                return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
+        if let Some(o) = line.get('O') {
+            if line.body.len() != 1 {
+                return Err(ParseErrorKind::MisplacedProgramNumber { value: o.value }.at(o.pos));
             }
-            self.feed = Some(f.value);
+            return Ok(());
         }
-        match line.motion {
-            Some((motion @ (Motion::G062 | Motion::G065), pos)) => {
-                let Some(here) = self.here else {
-                    return Err(ParseErrorKind::NurbsBeforeStart { motion }.at(pos));
-                };
-                self.open = Some(OpenNurbs::open(&line, (motion, pos), here, self.feed)?);
-            }
-            Some((motion, pos)) => {
-                self.mode = Some(motion);
-                self.linear(&line, motion, pos)?;
-            }
-            None => match line.first_of(MOVE_WORDS) {
-                Some(w) => {
-                    let Some(motion) = self.mode else {
-                        return Err(ParseErrorKind::NoMotionMode { letter: w.letter }.at(w.pos));
-                    };
-                    self.linear(&line, motion, line.first)?;
+        let motion = line.motion.map(|(m, _)| m).or_else(|| {
+            line.first_of(MOVE_WORDS)
+                .and_then(|_| self.mode.filter(|_| !self.is_dwell(&line)))
+        });
+        self.modes(&line, motion)?;
+        self.feed_word(&line)?;
+        self.machine_words(&line)?;
+        if self.is_dwell(&line) {
+            self.dwell(&line)?;
+        } else {
+            self.motion(&line)?;
+        }
+        if let Some((Code::Stop(stop), pos)) = line.code_of_group(11) {
+            match stop {
+                StopCode::Stop => self.stop(pos, ActionKind::Stop, true),
+                StopCode::Optional => {
+                    let taken = self.setup.optional_stop;
+                    self.stop(pos, ActionKind::OptionalStop { taken }, taken);
                 }
-                None => line.only("GMF", Context::NoMotion)?,
-            },
+                StopCode::ToolChange | StopCode::End => {}
+            }
         }
         self.end = line.end;
         Ok(())
+    }
+
+    fn is_dwell(&self, line: &Line<'_>) -> bool {
+        matches!(line.code_of_group(1), Some((Code::Dwell, _)))
     }
 
     /// Ends the program: fails if a NURBS block is still open at `eof`.
@@ -119,9 +164,244 @@ impl Parser {
             None => Ok(Program {
                 blocks: self.blocks,
                 end: self.end,
+                actions: self.actions,
                 tilt_word: self.rotary,
             }),
         }
+    }
+
+    /// The modal codes of a line other than motion and stops. `motion` is the line's
+    /// effective motion (its code, or the modal one when it has coordinates).
+    fn modes(&mut self, line: &Line<'_>, motion: Option<Motion>) -> Result<(), ParseError> {
+        for (code, pos) in line.codes() {
+            match code {
+                Code::Plane(p) => self.modal.plane = p,
+                Code::Inch(inch) => self.modal.inch = inch,
+                Code::Incremental(inc) => self.modal.incremental = inc,
+                Code::InverseTime(it) => self.modal.inverse_time = it,
+                Code::Blend(b) => self.modal.blend = b,
+                Code::WorkOffset(i) => {
+                    let defined = self.setup.work_offsets.get(usize::from(i)).copied().flatten();
+                    self.modal.offset = match (defined, i) {
+                        (Some(o), _) => o,
+                        (None, 0) => [0.0; 3],
+                        (None, _) => {
+                            let code = 54.0 + f64::from(i);
+                            return Err(ParseErrorKind::UnknownWorkOffset { code }.at(pos));
+                        }
+                    };
+                    self.modal.work = i;
+                }
+                Code::LengthComp(comp) => self.length_comp(line, comp, pos, motion)?,
+                _ => {}
+            }
+        }
+        if let Some(h) = line.get('H') {
+            if !matches!(line.code_of_group(7), Some((Code::LengthComp(c), _)) if c != LengthComp::Off)
+            {
+                let kind = ParseErrorKind::WordNotAllowed {
+                    letter: 'H',
+                    context: Context::NoMotion,
+                };
+                return Err(kind.at(h.pos));
+            }
+        }
+        Ok(())
+    }
+
+    /// `G43 H` / `G43.4 H` / `G49`: the new tool length. On a line without X Y Z the tool
+    /// tip's coordinates change so that the machine stays where it is.
+    fn length_comp(
+        &mut self,
+        line: &Line<'_>,
+        comp: LengthComp,
+        pos: SrcPos,
+        motion: Option<Motion>,
+    ) -> Result<(), ParseError> {
+        let length = match comp {
+            LengthComp::Off => 0.0,
+            LengthComp::Length | LengthComp::Rtcp => {
+                let tool = match (line.get('H'), self.modal.loaded) {
+                    (Some(h), _) => tool_number(h)?,
+                    (None, Some(t)) => t,
+                    (None, None) => {
+                        let kind = ParseErrorKind::MissingWord {
+                            letter: 'H',
+                            context: Context::LengthComp,
+                        };
+                        return Err(kind.at(pos));
+                    }
+                };
+                match (tool, self.setup.tools.get(&tool)) {
+                    (0, _) => 0.0,
+                    (_, Some(l)) => *l,
+                    (_, None) => return Err(ParseErrorKind::UnknownTool { tool }.at(pos)),
+                }
+            }
+        };
+        self.modal.comp = comp;
+        let from = self.modal.tool_length;
+        if length == from {
+            return Ok(());
+        }
+        if let Some(m @ (Motion::G02 | Motion::G03 | Motion::G062 | Motion::G065)) = motion {
+            let kind = ParseErrorKind::LengthChangeOnCurve {
+                motion: m,
+                from,
+                to: length,
+            };
+            return Err(kind.at(pos));
+        }
+        if let Some(here) = &mut self.here {
+            let t = match self.orientation {
+                Orientation::Vector(v) => v,
+                Orientation::Angles { r1_deg, r2_deg } if r1_deg == 0.0 && r2_deg == 0.0 => {
+                    [0.0, 0.0, 1.0]
+                }
+                Orientation::Angles { .. } => {
+                    return Err(ParseErrorKind::LengthChangeTilted.at(pos));
+                }
+            };
+            for (h, t) in here.iter_mut().zip(t) {
+                *h += (from - length) * t;
+            }
+        }
+        self.modal.tool_length = length;
+        Ok(())
+    }
+
+    /// `F`: mm/min (inch/min under G20); under G93 it belongs to its line only.
+    fn feed_word(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let Some(f) = line.get('F') else {
+            return Ok(());
+        };
+        if f.value < MIN_FEED_MM_MIN {
+            return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
+        }
+        if !self.modal.inverse_time {
+            self.feed = Some(f.value * self.modal.scale());
+        }
+        Ok(())
+    }
+
+    /// `S`, `T`, `M06`, spindle and coolant codes: recorded as actions.
+    fn machine_words(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if let Some(s) = line.get('S') {
+            if !(0.0..=MAX_RPM).contains(&s.value) {
+                return Err(ParseErrorKind::BadSpeed { value: s.value }.at(s.pos));
+            }
+            self.modal.rpm = s.value;
+            if line.code_of_group(12).is_none() {
+                self.act(s.pos, ActionKind::Speed { rpm: s.value });
+            }
+        }
+        if let Some(t) = line.get('T') {
+            let tool = tool_number(t)?;
+            self.modal.selected = Some(tool);
+            self.act(t.pos, ActionKind::SelectTool { tool });
+        }
+        for (code, pos) in line.codes() {
+            match code {
+                Code::Stop(StopCode::ToolChange) => {
+                    let tool = self.modal.selected;
+                    self.modal.loaded = tool;
+                    self.stop(pos, ActionKind::ChangeTool { tool }, true);
+                }
+                Code::Spindle(dir) => {
+                    let rpm = self.modal.rpm;
+                    self.act(pos, ActionKind::Spindle { dir, rpm });
+                }
+                Code::Coolant(c) => self.act(pos, ActionKind::Coolant(c)),
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// `G04 P<s>` / `G04 X<s>`.
+    fn dwell(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        line.only("GMFSTPX", Context::Dwell)?;
+        if let Some((m, pos)) = line.motion {
+            let kind = ParseErrorKind::ConflictingCodes {
+                letter: 'G',
+                first: 4.0,
+                second: motion_value(m),
+            };
+            return Err(kind.at(pos));
+        }
+        let pos = line.first_of("G").map_or(line.first, |w| w.pos);
+        let t = match (line.get('P'), line.get('X')) {
+            (Some(p), Some(x)) => {
+                let kind = ParseErrorKind::RepeatedWord {
+                    letter: 'X',
+                    first: p.pos,
+                };
+                return Err(kind.at(x.pos));
+            }
+            (Some(w), None) | (None, Some(w)) => w,
+            (None, None) => return Err(ParseErrorKind::DwellWithoutTime.at(pos)),
+        };
+        if !(0.0..=MAX_DWELL_S).contains(&t.value) {
+            return Err(ParseErrorKind::BadDwell { value: t.value }.at(t.pos));
+        }
+        self.wait.dwell_s += t.value;
+        self.act(pos, ActionKind::Dwell { seconds: t.value });
+        Ok(())
+    }
+
+    /// Records an action before the next motion block.
+    pub(super) fn act(&mut self, pos: SrcPos, kind: ActionKind) {
+        self.actions.push(Action {
+            pos,
+            before_block: self.blocks.len(),
+            kind,
+        });
+    }
+
+    /// Records a stop; `wait` makes the next motion block wait for the operator.
+    fn stop(&mut self, pos: SrcPos, kind: ActionKind, wait: bool) {
+        self.act(pos, kind);
+        if wait && self.wait.operator.is_none() {
+            self.wait.operator = Some(pos);
+        }
+    }
+
+    /// The next block's tooling: the tool length, RTCP and the pending wait (taken).
+    pub(super) fn tooling(&mut self) -> MoveTooling {
+        MoveTooling {
+            tool_length: self.modal.tool_length,
+            rtcp: self.modal.comp == LengthComp::Rtcp,
+            wait: core::mem::take(&mut self.wait),
+        }
+    }
+
+    /// Opens a `G06.2` / `G06.5` block on its first line.
+    pub(super) fn open_nurbs(
+        &mut self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+    ) -> Result<(), ParseError> {
+        if self.modal.incremental {
+            return Err(ParseErrorKind::NurbsIncremental { motion }.at(pos));
+        }
+        let Some(here) = self.here else {
+            return Err(ParseErrorKind::NurbsBeforeStart { motion }.at(pos));
+        };
+        let frame = Frame {
+            scale: self.modal.scale(),
+            offset: self.modal.offset,
+        };
+        let tooling = self.tooling();
+        self.open = Some(OpenNurbs::open(
+            line,
+            (motion, pos),
+            here,
+            self.feed,
+            frame,
+            tooling,
+        )?);
+        Ok(())
     }
 
     fn close(&mut self, block: NurbsBlock) {
@@ -138,124 +418,34 @@ impl Parser {
         self.just_closed = Some((block.pos, block.knots.len()));
         self.blocks.push(Block::Nurbs(block));
     }
+}
 
-    /// A G00/G01 line, or a line continuing that modal motion; `pos` is the block's position.
-    fn linear(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
-        line.only("GMFXYZABCIJK", Context::Move(motion))?;
-        if line.first_of(MOVE_WORDS).is_none() {
-            return Ok(()); // `G01 F500`: sets the mode, moves nothing
+/// A `T` or `H` word as a tool number.
+fn tool_number(w: super::lexer::Word) -> Result<u32, ParseError> {
+    match w.uint {
+        Some(t) if t <= 99_999 => Ok(t),
+        _ => Err(ParseErrorKind::BadNumber {
+            letter: w.letter,
+            value: w.value,
         }
-        let rapid = motion == Motion::G00;
-        if !rapid && self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
-        }
-        let mut end = [0.0; 3];
-        for ((slot, axis), prev) in end
-            .iter_mut()
-            .zip(['X', 'Y', 'Z'])
-            .zip(self.here.map_or([None; 3], |h| h.map(Some)))
-        {
-            *slot = match (line.value(axis), prev) {
-                (Some(v), _) | (None, Some(v)) => v,
-                (None, None) => return Err(ParseErrorKind::MissingStartAxis { axis }.at(pos)),
-            };
-        }
-        let orientation = self.orientation(line)?;
-        self.here = Some(end);
-        self.orientation_given |= line.first_of("ABCIJK").is_some();
-        self.orientation = orientation;
-        self.blocks.push(Block::Linear(LinearMove {
-            pos,
-            n: line.n,
-            rapid,
-            end,
-            orientation,
-            feed_mm_min: self.feed.unwrap_or(0.0),
-        }));
-        Ok(())
+        .at(w.pos)),
     }
+}
 
-    /// The orientation at the end of a linear move (modal values resolved).
-    fn orientation(&mut self, line: &Line<'_>) -> Result<Orientation, ParseError> {
-        let angle = line.first_of("ABC");
-        let vector = line.first_of("IJK");
-        match (angle, vector) {
-            (Some(a), Some(v)) => {
-                let later = if a.pos > v.pos { a.pos } else { v.pos };
-                let kind = ParseErrorKind::MixedOrientation {
-                    angle: a.letter,
-                    vector: v.letter,
-                };
-                Err(kind.at(later))
-            }
-            (None, Some(given)) => {
-                let mut ijk = [0.0; 3];
-                for (slot, letter) in ijk.iter_mut().zip(['I', 'J', 'K']) {
-                    let missing = ParseErrorKind::IncompleteVector {
-                        given: given.letter,
-                        missing: letter,
-                    };
-                    *slot = line.value(letter).ok_or(missing.at(given.pos))?;
-                }
-                let zero = ParseErrorKind::ZeroVector { ijk }.at(given.pos);
-                Ok(Orientation::Vector(normalise(ijk).ok_or(zero)?))
-            }
-            (Some(_), None) => self
-                .angles(line)
-                .map(|(r1_deg, r2_deg)| Orientation::Angles { r1_deg, r2_deg }),
-            (None, None) => Ok(self.orientation),
-        }
-    }
-
-    /// The rotary angles of a line with angle words.
-    fn angles(&mut self, line: &Line<'_>) -> Result<(f64, f64), ParseError> {
-        let r1 = match (line.get('A'), line.get('B')) {
-            (Some(a), Some(b)) => {
-                let kind = ParseErrorKind::MixedRotaryAxes {
-                    letter: 'B',
-                    first: 'A',
-                    first_pos: a.pos,
-                };
-                return Err(kind.at(b.pos));
-            }
-            (r1, None) | (None, r1) => r1,
-        };
-        if let Some(w) = r1 {
-            match self.rotary {
-                Some((first, first_pos)) if first != w.letter => {
-                    let kind = ParseErrorKind::MixedRotaryAxes {
-                        letter: w.letter,
-                        first,
-                        first_pos,
-                    };
-                    return Err(kind.at(w.pos));
-                }
-                Some(_) => {}
-                None => self.rotary = Some((w.letter, w.pos)),
-            }
-        }
-        let r2 = line.get('C');
-        let (prev1, prev2) = match self.orientation {
-            Orientation::Angles { r1_deg, r2_deg } => (r1_deg, r2_deg),
-            // The implicit vertical tool is A0 C0 (B0 C0) on the machines dnurbs drives.
-            Orientation::Vector(_) if !self.orientation_given => (0.0, 0.0),
-            Orientation::Vector(_) => match (r1, r2) {
-                (Some(given), None) | (None, Some(given)) => {
-                    let kind = ParseErrorKind::PartialAngles {
-                        given: given.letter,
-                    };
-                    return Err(kind.at(given.pos));
-                }
-                _ => (0.0, 0.0),
-            },
-        };
-        Ok((r1.map_or(prev1, |w| w.value), r2.map_or(prev2, |w| w.value)))
+fn motion_value(m: Motion) -> f64 {
+    match m {
+        Motion::G00 => 0.0,
+        Motion::G01 => 1.0,
+        Motion::G02 => 2.0,
+        Motion::G03 => 3.0,
+        Motion::G062 => 6.2,
+        Motion::G065 => 6.5,
     }
 }
 
 /// `v / |v|`, or `None` when `|v|` is not above [`MIN_VECTOR_LENGTH`]. Scaled first so that
 /// squaring cannot overflow for any finite input.
-fn normalise(v: [f64; 3]) -> Option<[f64; 3]> {
+pub(super) fn normalise(v: [f64; 3]) -> Option<[f64; 3]> {
     let scale = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
     if scale == 0.0 {
         return None;

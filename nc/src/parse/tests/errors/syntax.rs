@@ -75,9 +75,9 @@ fn tape_mark_not_alone() {
 #[test]
 fn unsupported_word() {
     assert_eq!(
-        fails("G00 X0 Y0 Z0 S1000", 1, 14),
+        fails("G00 X0 Y0 Z0 Q1000", 1, 14),
         E::UnsupportedWord {
-            letter: 'S',
+            letter: 'Q',
             value: 1000.0
         }
     );
@@ -145,19 +145,18 @@ fn two_codes_of_one_group() {
 #[test]
 fn unsupported_g_code() {
     assert_eq!(
-        fails("G90 G21\nG91 G00 X0 Y0 Z0", 2, 1),
-        E::UnsupportedGCode { code: 91.0 }
+        fails("G90 G21\nG68 G00 X0 Y0 Z0", 2, 1),
+        E::UnsupportedGCode { code: 68.0 }
     );
     assert_eq!(
-        message("G90 G21\nG91 G00 X0 Y0 Z0"),
-        "2:1: unsupported G-code G91: dnurbs accepts G00 G01 G06.2 G06.5 G21 G90"
+        message("G90 G21\nG68 G00 X0 Y0 Z0"),
+        format!("2:1: unsupported G-code G68: dnurbs accepts {}", crate::parse::codes::G_LIST)
     );
     for (src, name) in [
-        ("G2", "G02"),
-        ("G20", "G20"),
-        ("G17", "G17"),
-        ("G43", "G43"),
-        ("G54", "G54"),
+        ("G05.1", "G05.1"),
+        ("G43.5", "G43.5"),
+        ("G68.2", "G68.2"),
+        ("G10", "G10"),
         ("G06.3", "G06.3"),
     ] {
         let msg = message(src);
@@ -169,12 +168,20 @@ fn unsupported_g_code() {
 }
 
 #[test]
+fn cutter_compensation_and_canned_cycles_are_refused_by_name() {
+    assert_eq!(fails("G41 D1", 1, 1), E::CutterCompensation { code: 41.0 });
+    assert_eq!(fails("G00 X0 Y0 Z0\nG42", 2, 1), E::CutterCompensation { code: 42.0 });
+    assert_eq!(fails("G81 X0 Y0 Z-5 R2", 1, 1), E::CannedCycle { code: 81.0 });
+    assert!(message("G83").contains("post the cycle expanded into G00/G01 moves"));
+}
+
+#[test]
 fn unsupported_m_code() {
     assert_eq!(
-        fails("G00 X0 Y0 Z0 M03", 1, 14),
-        E::UnsupportedMCode { code: 3.0 }
+        fails("G00 X0 Y0 Z0 M98", 1, 14),
+        E::UnsupportedMCode { code: 98.0 }
     );
-    assert!(message("M3").starts_with("1:1: unsupported M-code M03:"));
+    assert!(message("M99").starts_with("1:1: unsupported M-code M99:"));
 }
 
 #[test]
@@ -218,6 +225,13 @@ fn word_not_allowed_in_context() {
         fails("G00 X0 Y0 Z0\nR1", 2, 1),
         E::WordNotAllowed {
             letter: 'R',
+            context: g00
+        }
+    );
+    assert_eq!(
+        fails("G00 X0 Y0 Z0\nG90 P1", 2, 5),
+        E::WordNotAllowed {
+            letter: 'P',
             context: Context::NoMotion
         }
     );
