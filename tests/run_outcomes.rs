@@ -57,6 +57,7 @@ fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
         report: None,
         progress: false,
         control: None,
+        shop: Default::default(),
     };
     let r = run(
         DEMO_PROGRAM.as_bytes(),

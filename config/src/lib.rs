@@ -83,6 +83,7 @@ mod error;
 mod machine;
 mod raw;
 mod source;
+pub mod tools;
 mod validate;
 
 use std::path::Path;

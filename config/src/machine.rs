@@ -28,6 +28,10 @@ pub struct Machine {
     pub bus_overload: Option<String>,
     /// `[control] socket`: where `dnurbs run` serves the operator's control socket.
     pub control_socket: Option<std::path::PathBuf>,
+    /// `[work_offsets] G54..G59`: program zero in machine coordinates (mm), by offset.
+    pub work_offsets: [Option<[f64; 3]>; 6],
+    /// `[reference] position`: the G28 position in machine coordinates (mm).
+    pub reference: Option<[f64; 3]>,
 }
 
 impl Machine {

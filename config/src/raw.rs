@@ -25,6 +25,36 @@ pub(crate) struct RawFile {
     pub bus: Vec<RawBus>,
     pub realtime: Option<RawRealtime>,
     pub control: Option<RawControl>,
+    /// `[work_offsets]`: G54..G59.
+    pub work_offsets: Option<RawWorkOffsets>,
+    /// `[reference]`: the G28 position.
+    pub reference: Option<RawReference>,
+}
+
+/// `[work_offsets]`: the program zero of each work offset, machine coordinates X Y Z, mm.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawWorkOffsets {
+    #[serde(rename = "G54")]
+    pub g54: Option<[f64; 3]>,
+    #[serde(rename = "G55")]
+    pub g55: Option<[f64; 3]>,
+    #[serde(rename = "G56")]
+    pub g56: Option<[f64; 3]>,
+    #[serde(rename = "G57")]
+    pub g57: Option<[f64; 3]>,
+    #[serde(rename = "G58")]
+    pub g58: Option<[f64; 3]>,
+    #[serde(rename = "G59")]
+    pub g59: Option<[f64; 3]>,
+}
+
+/// `[reference]`: the machine's reference (G28) position.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawReference {
+    /// Machine coordinates X Y Z, mm.
+    pub position: [f64; 3],
 }
 
 /// `[control]`: the operator's control socket of `dnurbs run`.

@@ -42,7 +42,31 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
         }
         other => other.map(std::path::PathBuf::from),
     };
+    let offsets = raw.work_offsets.unwrap_or_default();
+    let mut work_offsets = [None; 6];
+    for ((slot, name), value) in work_offsets
+        .iter_mut()
+        .zip(["G54", "G55", "G56", "G57", "G58", "G59"])
+        .zip([
+            offsets.g54,
+            offsets.g55,
+            offsets.g56,
+            offsets.g57,
+            offsets.g58,
+            offsets.g59,
+        ])
+    {
+        if let Some(v) = value {
+            *slot = Some(check.point(&["work_offsets", name], v)?);
+        }
+    }
+    let reference = match raw.reference {
+        Some(r) => Some(check.point(&["reference", "position"], r.position)?),
+        None => None,
+    };
     Ok(Machine {
+        work_offsets,
+        reference,
         name,
         period_s,
         kinematics,
@@ -98,6 +122,17 @@ impl Check<'_, '_> {
         } else {
             let rule = format!("must be in -{MAX_POSITION:e}..={MAX_POSITION:e} ({unit})");
             Err(self.invalid(path, Some(v.to_string()), rule))
+        }
+    }
+
+    /// A point a program moves to (work offset, reference): within the NC coordinate domain.
+    fn point(&self, path: &[&str], p: [f64; 3]) -> Result<[f64; 3], ConfigError> {
+        const MAX: f64 = 1e5;
+        if p.iter().all(|v| v.abs() <= MAX) {
+            Ok(p)
+        } else {
+            let rule = format!("every coordinate must be in -{MAX:e}..={MAX:e} (mm)");
+            Err(self.invalid(path, Some(format!("{p:?}")), rule))
         }
     }
 

@@ -482,7 +482,7 @@ pub fn plan(
         let phases = if st.is_empty() {
             Vec::new()
         } else {
-            schedule(&st, &starts, cfg)
+            with_dwells(schedule(&st, &starts, cfg), path, &seg_start)
         };
         if let Some((prev, checked, _)) = &last {
             if *prev == phases {
@@ -538,6 +538,46 @@ pub fn plan(
         last = Some((profile.phases, checked, trace));
         round += 1;
     }
+}
+
+/// The dwells (`G04`) as rest phases: a segment that waits starts at rest (it is a stop),
+/// and the plan stays there for the dwell before it goes on; later phases shift in time.
+fn with_dwells(phases: Vec<Phase>, path: &Path, seg_start: &[f64]) -> Vec<Phase> {
+    let mut waits = path
+        .segments
+        .iter()
+        .zip(seg_start)
+        .filter(|(seg, _)| seg.wait.dwell_s > 0.0)
+        .map(|(seg, &at)| (at, seg.wait.dwell_s))
+        .peekable();
+    if waits.peek().is_none() {
+        return phases;
+    }
+    let eps = 1e-9 * seg_start.last().copied().unwrap_or(0.0).max(1.0);
+    let mut out = Vec::with_capacity(phases.len() + path.segments.len());
+    let mut shift = 0.0;
+    for p in phases {
+        while let Some(&(at, dwell)) = waits.peek() {
+            if p.s0 < at - eps {
+                break;
+            }
+            out.push(Phase {
+                t0: p.t0 + shift,
+                dur: dwell,
+                s0: at,
+                v0: 0.0,
+                a0: 0.0,
+                j: 0.0,
+            });
+            shift += dwell;
+            waits.next();
+        }
+        out.push(Phase {
+            t0: p.t0 + shift,
+            ..p
+        });
+    }
+    out
 }
 
 /// The S-curve phases through the stations' ceilings.

@@ -54,7 +54,7 @@ pub struct LinearMove {
     pub orientation: Orientation,
     /// Programmed feed, mm/min (ignored for rapid moves; may then be 0).
     pub feed_mm_min: f64,
-    /// Tool length and stops in effect for this move (see [`Tooling`]).
+    /// Tool length and stops in effect for this move (see [`MoveTooling`]).
     pub tooling: MoveTooling,
 }
 
@@ -133,12 +133,27 @@ pub struct MoveTooling {
     /// machine's Z axis carries it: machine Z = the kinematics' Z + length. It changes only
     /// along a `G00`/`G01` (the change is spread over the move).
     pub tool_length: f64,
-    /// `G43.4` (tool-centre-point control) in effect: the programmed X Y Z are the tool tip in
-    /// the workpiece however the rotary axes stand. Without it, a move on a rotary-table
-    /// machine must keep the rotary axes at 0 (`segment::build` checks).
-    pub rtcp: bool,
+    /// Which tool-length mode is in effect. dnurbs always places the programmed X Y Z in the
+    /// workpiece frame (tool-centre-point control) on the `*-trt` machines; see
+    /// [`LengthMode`] for what each mode allows.
+    pub mode: LengthMode,
     /// The path stops before this move and waits there (`G04`, `M00`, `M01`, `M06`).
     pub wait: Wait,
+}
+
+/// The tool-length mode of a move.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LengthMode {
+    /// Neither `G43` nor `G43.4` (or `G49`): dnurbs's own reading, positions in the workpiece
+    /// frame on every machine, tool length 0.
+    #[default]
+    None,
+    /// `G43 H`: a post for a control without tool-centre-point control wrote X Y Z for the
+    /// rotary axes at 0; a move that tilts or turns a rotary table under it is refused
+    /// (`segment::build`), since its positions would be read differently.
+    Length,
+    /// `G43.4 H`: tool-centre-point control (RTCP); needs a machine with RTCP kinematics.
+    Rtcp,
 }
 
 /// A stop before a move: a dwell, the operator's resume, or both.
@@ -186,18 +201,31 @@ pub enum Coolant {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ActionKind {
     /// `M03`/`M04`/`M05` with the speed in effect (rpm, `S`).
-    Spindle { dir: Spindle, rpm: f64 },
+    Spindle {
+        dir: Spindle,
+        rpm: f64,
+    },
     /// `S` alone: the speed for the next `M03`/`M04` (or, while turning, a new speed).
-    Speed { rpm: f64 },
+    Speed {
+        rpm: f64,
+    },
     Coolant(Coolant),
     /// `T`: the tool the next `M06` loads.
-    SelectTool { tool: u32 },
+    SelectTool {
+        tool: u32,
+    },
     /// `M06`: the selected tool is loaded (the path stops for the operator).
-    ChangeTool { tool: Option<u32> },
+    ChangeTool {
+        tool: Option<u32>,
+    },
     /// `G04`.
-    Dwell { seconds: f64 },
+    Dwell {
+        seconds: f64,
+    },
     /// `M00`.
     Stop,
     /// `M01`: `taken` when optional stops are on.
-    OptionalStop { taken: bool },
+    OptionalStop {
+        taken: bool,
+    },
 }

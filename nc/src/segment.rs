@@ -14,7 +14,9 @@
 use crate::arclen::ArcTable;
 use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt};
 use crate::nurbs::DoubleNurbs;
-use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
+use crate::program::{
+    Block, LengthMode, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait,
+};
 use nalgebra::Vector3;
 
 /// Smallest allowed |CT(u) - C(u)| along a G06.5 block, mm.
@@ -69,16 +71,22 @@ pub struct Pose {
     pub p: Vector3<f64>,
     pub tool: Tool,
     pub u: Option<f64>,
+    /// Tool length carried by the machine's Z axis here, mm (`G43`/`G43.4`).
+    pub z: f64,
 }
 
 impl Pose {
     /// Machine joints for this pose; `prev` picks the rotary solution.
     pub fn joints(&self, kin: &MachineKinematics, prev: &Joints, lim: &RotaryLimits) -> Joints {
         match self.tool {
-            Tool::Axis(t) => kin.inverse(&self.p, &t, prev, lim),
+            Tool::Axis(t) => {
+                let mut j = kin.inverse(&self.p, &t, prev, lim);
+                j[2] += self.z;
+                j
+            }
             Tool::Angles(a, c) => {
                 let m = kin.place(&self.p, a, c);
-                [m.x, m.y, m.z, a, c]
+                [m.x, m.y, m.z + self.z, a, c]
             }
         }
     }
@@ -104,8 +112,14 @@ pub struct Segment {
     pub rapid: bool,
     pub rotary_only: bool,
     /// The path comes to rest where this segment starts: a kink of the cutter's tangent
-    /// inside a NURBS block (a knot of multiplicity = degree, see `crate::split`).
+    /// inside a NURBS block (a knot of multiplicity = degree, see `crate::split`), or a
+    /// [`Wait`] before it.
     pub stop: bool,
+    /// What happens at rest before the segment starts (`G04`, `M00`, `M01`, `M06`).
+    pub wait: Wait,
+    /// Tool length on the machine's Z axis at the start and end, mm; it changes linearly
+    /// along a straight move (`G43 Z.. H..`) and stays constant along a curve.
+    pub z: (f64, f64),
     pub geometry: Geometry,
     pub tooling: Tooling,
 }
@@ -124,6 +138,7 @@ impl Segment {
                 p: from + (to - from) * f,
                 tool: self.tool_at(f, None),
                 u: None,
+                z: self.z.0 + (self.z.1 - self.z.0) * f,
             },
             Geometry::Nurbs { curve, table } => self.pose_u(curve, table.u_of_s(curve, s)),
         }
@@ -140,6 +155,7 @@ impl Segment {
             p: c.p,
             tool,
             u: Some(u),
+            z: self.z.0,
         }
     }
 
@@ -187,6 +203,12 @@ pub enum BuildErrorKind {
     ZeroLength(f64),
     #[error("{0}")]
     Curve(#[from] crate::nurbs::CurveError),
+    #[error("G43.4 (tool-centre-point control) on a machine without RTCP kinematics: the paper machine places X Y Z as machine coordinates; use G43")]
+    RtcpUnsupported,
+    #[error("the rotary axes stand at tilt {tilt_deg:.4} deg, C {c_deg:.4} deg under G43 without tool-centre-point control: the post wrote X Y Z for another machine reading; program G43.4 for moves with the table tilted or turned")]
+    RotaryWithoutRtcp { tilt_deg: f64, c_deg: f64 },
+    #[error("the tool length changes from {from} to {to} mm at a curve: change it on a straight move before")]
+    LengthChangeOnCurve { from: f64, to: f64 },
 }
 
 /// A [`BuildErrorKind`] at the position of the block that broke it.
@@ -241,19 +263,43 @@ pub fn build(
         p: Vector3::from(first.end),
         tool: linear_tool(first),
         u: None,
+        z: first.tooling.tool_length,
     };
     let mut joints = pose.joints(kin, &[0.0; 5], lim);
     let start = pose;
     let mut start_joints = joints;
     let mut segments: Vec<Segment> = Vec::with_capacity(program.blocks.len());
+    // A wait before a block that moves nothing goes to the next segment.
+    let mut wait = Wait::default();
     for (i, block) in program.blocks.iter().enumerate().skip(1) {
         let index = (i + 1) as u32;
-        let segs = match block {
+        let (tooling, pos) = match block {
+            Block::Linear(m) => (m.tooling, m.pos),
+            Block::Nurbs(b) => (b.tooling, b.pos),
+        };
+        if tooling.mode == LengthMode::Rtcp && *kin == MachineKinematics::Paper {
+            return Err(err(pos, BuildErrorKind::RtcpUnsupported));
+        }
+        wait = merge(wait, tooling.wait);
+        let mut segs: Vec<Segment> = match block {
             Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?
                 .into_iter()
                 .collect(),
-            Block::Nurbs(b) => nurbs(index, b, &pose, kin, limits)?,
+            Block::Nurbs(b) => {
+                if b.tooling.tool_length != pose.z {
+                    let kind = BuildErrorKind::LengthChangeOnCurve {
+                        from: pose.z,
+                        to: b.tooling.tool_length,
+                    };
+                    return Err(err(b.pos, kind));
+                }
+                nurbs(index, b, &pose, kin, limits)?
+            }
         };
+        if let Some(first) = segs.first_mut() {
+            first.wait = core::mem::take(&mut wait);
+            first.stop |= first.wait.is_some();
+        }
         for seg in segs {
             // With a vertical tool C is free: choose it where the path leaves the vertical.
             if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
@@ -268,6 +314,19 @@ pub fn build(
             // The joints at the end are those the interpolator arrives with: follow the
             // segment, so the next block starts from the rotary branch the path really took.
             joints = follow(&seg, kin, &joints, lim);
+            if tooling.mode == LengthMode::Length && matches!(kin, MachineKinematics::Trt { .. }) {
+                let turned = |j: &Joints| j[3].abs() > 1e-9 || j[4].abs() > 1e-9;
+                let bad = [seg.pose(0.0).joints(kin, &joints, lim), joints]
+                    .into_iter()
+                    .find(turned);
+                if let Some(j) = bad {
+                    let kind = BuildErrorKind::RotaryWithoutRtcp {
+                        tilt_deg: j[3].to_degrees(),
+                        c_deg: j[4].to_degrees(),
+                    };
+                    return Err(err(seg.src, kind));
+                }
+            }
             pose = seg.pose(seg.length);
             segments.push(seg);
         }
@@ -278,6 +337,14 @@ pub fn build(
         start_joints,
         segments,
     })
+}
+
+/// Two waits in a row: the dwells add up, the first operator stop counts.
+fn merge(a: Wait, b: Wait) -> Wait {
+    Wait {
+        dwell_s: a.dwell_s + b.dwell_s,
+        operator: a.operator.or(b.operator),
+    }
 }
 
 /// Joints at the end of `seg`, reached from `prev` at its start by following the tool
@@ -311,7 +378,9 @@ fn turn_c(seg: &Segment, joints: &Joints, c: f64) -> Segment {
         feed: f64::INFINITY, // limited by the C axis alone
         rapid: false,
         rotary_only: true,
-        stop: false,
+        stop: seg.stop,
+        wait: seg.wait,
+        z: (seg.z.0, seg.z.0),
         geometry: Geometry::Line { from: p, to: p },
         tooling: Tooling::Angles {
             from: (joints[3], joints[4]),
@@ -401,11 +470,21 @@ fn linear(
             (tooling, angle.to_degrees())
         }
     };
-    let rotary_only = dist < NULL_MOVE;
-    if rotary_only && turn_deg < NULL_MOVE {
+    // A tool-length change (`G43 Z.. H..`) may move the machine's Z alone while the tip
+    // stands: then the path is measured by that Z travel.
+    let dz = (m.tooling.tool_length - pose.z).abs();
+    let still = dist < NULL_MOVE && turn_deg < NULL_MOVE;
+    if still && dz < NULL_MOVE {
         return Ok(None);
     }
-    let length = if rotary_only { turn_deg } else { dist };
+    let rotary_only = dist < NULL_MOVE && !still;
+    let length = if still {
+        dz
+    } else if rotary_only {
+        turn_deg
+    } else {
+        dist
+    };
     let feed = if m.rapid {
         limits.rapid_mm_s
     } else {
@@ -419,6 +498,8 @@ fn linear(
         rapid: m.rapid,
         rotary_only,
         stop: false,
+        wait: Wait::default(),
+        z: (pose.z, m.tooling.tool_length),
         geometry: Geometry::Line { from, to },
         tooling,
     }))
@@ -474,6 +555,8 @@ fn nurbs(
                             rapid: false,
                             rotary_only: true,
                             stop: false,
+                            wait: Wait::default(),
+                            z: (pose.z, pose.z),
                             geometry: Geometry::Line { from: c.p, to: c.p },
                             tooling: Tooling::Slerp {
                                 from: current,
@@ -494,6 +577,8 @@ fn nurbs(
             rapid: false,
             rotary_only: false,
             stop: piece.corner,
+            wait: Wait::default(),
+            z: (pose.z, pose.z),
             geometry: Geometry::Nurbs {
                 curve: Box::new(curve),
                 table: Box::new(table),

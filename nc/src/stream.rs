@@ -46,6 +46,9 @@ pub struct Chunk {
     pub phases: Vec<Phase>,
     /// Time at which the plan leaves the segment.
     pub t_end: f64,
+    /// Time at which the plan arrives at the segment's start (at rest there when the
+    /// segment is a stop; before its dwell, if it has one).
+    pub t_start: f64,
     /// Highest planned speed over `phases`.
     pub vmax: f64,
 }
@@ -100,6 +103,11 @@ pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
             .map_or(profile.duration, |p| p.t0 + p.dur)
             .min(profile.duration);
         let vmax = phases.iter().map(phase_vmax).fold(0.0, f64::max);
+        let t_start = profile
+            .phases
+            .iter()
+            .find(|p| p.end().s >= s0 - eps)
+            .map_or(0.0, |p| if p.s0 >= s0 - eps { p.t0 } else { p.t0 + p.dur });
         out.push(Box::new(Chunk {
             index,
             segment,
@@ -107,6 +115,7 @@ pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
             s1,
             phases,
             t_end,
+            t_start,
             vmax,
         }));
     }
@@ -257,6 +266,10 @@ pub struct Follower<'q> {
     /// data suffices.
     feed_override: f64,
     paused: bool,
+    /// Source line of the operator stop (`M00`, `M01`, `M06`) the path waits at.
+    awaiting: Option<u32>,
+    /// Chunks from this index on may still hold an operator stop not yet reached.
+    gate_from: usize,
     done: bool,
     pose: Pose,
     joints: Joints,
@@ -301,6 +314,8 @@ impl<'q> Follower<'q> {
             holding: false,
             feed_override: 1.0,
             paused: false,
+            awaiting: None,
+            gate_from: 1,
             done: start.chunks == 0,
             pose: start.pose,
             joints: start.joints,
@@ -332,6 +347,13 @@ impl<'q> Follower<'q> {
 
     pub fn resume(&mut self) {
         self.paused = false;
+        self.awaiting = None;
+    }
+
+    /// The line of the operator stop (`M00`, `M01`, `M06`) the path stands at, waiting for
+    /// [`Self::resume`].
+    pub fn awaiting(&self) -> Option<u32> {
+        self.awaiting
     }
 
     pub fn is_paused(&self) -> bool {
@@ -511,7 +533,24 @@ impl<'q> Follower<'q> {
         }
         let k_old = self.k;
         self.track(target, rmax, jmax);
-        let tau = self.tau + 0.5 * (k_old + self.k) * ts;
+        let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
+        // An operator stop ahead: the plan is at rest where it arrives there; hold it there
+        // (paused) until the operator resumes. Only the next boundary can hold one.
+        let gate = self
+            .local
+            .iter()
+            .take(2)
+            .find(|c| c.index >= self.gate_from && c.segment.wait.operator.is_some());
+        if let Some(c) = gate {
+            if tau >= c.t_start {
+                tau = c.t_start.max(self.tau);
+                self.k = 0.0;
+                self.r = 0.0;
+                self.paused = true;
+                self.awaiting = c.segment.wait.operator.map(|p| p.line);
+                self.gate_from = c.index + 1;
+            }
+        }
         // Find the chunk that holds tau; bounded by the look-ahead.
         let mut m = self.motion;
         for _ in 0..=LOOKAHEAD {

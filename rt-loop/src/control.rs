@@ -74,6 +74,8 @@ pub struct Progress {
     /// Index into [`STAGES`].
     pub stage: AtomicU8,
     pub paused: AtomicBool,
+    /// Source line of the operator stop (`M00`, `M01`, `M06`) the path waits at; 0: none.
+    pub awaiting: AtomicU32,
     /// Source line of the block being machined, and its N number (or index).
     pub line: AtomicU32,
     pub block: AtomicU32,
@@ -90,6 +92,8 @@ pub struct Progress {
 pub struct Snapshot {
     pub stage: &'static str,
     pub paused: bool,
+    /// The line of the operator stop the path waits at (`M00`, `M01`, `M06`).
+    pub awaiting: Option<u32>,
     pub line: u32,
     pub block: u32,
     pub axes: [f64; 5],
@@ -110,6 +114,7 @@ impl Progress {
         &self,
         stage: usize,
         paused: bool,
+        awaiting: Option<u32>,
         line: u32,
         block: u32,
         axes: &[f64; 5],
@@ -118,6 +123,7 @@ impl Progress {
     ) {
         self.stage.store(stage.min(STAGES.len() - 1) as u8, Relaxed);
         self.paused.store(paused, Relaxed);
+        self.awaiting.store(awaiting.unwrap_or(0), Relaxed);
         self.line.store(line, Relaxed);
         self.block.store(block, Relaxed);
         for (a, v) in self.axes.iter().zip(axes) {
@@ -131,6 +137,7 @@ impl Progress {
         Snapshot {
             stage: STAGES[usize::from(self.stage.load(Relaxed)).min(STAGES.len() - 1)],
             paused: self.paused.load(Relaxed),
+            awaiting: Some(self.awaiting.load(Relaxed)).filter(|&l| l != 0),
             line: self.line.load(Relaxed),
             block: self.block.load(Relaxed),
             axes: core::array::from_fn(|j| f64::from_bits(self.axes[j].load(Relaxed))),

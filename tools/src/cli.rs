@@ -105,6 +105,8 @@ pub enum Command {
         /// [control] socket). See `dnurbs ctl`.
         #[arg(long, value_name = "SOCKET")]
         control: Option<PathBuf>,
+        #[command(flatten)]
+        shop: crate::shop::ShopArgs,
     },
     /// Operate a running `dnurbs run` or `demo` through its control socket.
     ///
@@ -141,6 +143,8 @@ pub enum Command {
         /// Print the summary as one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        shop: crate::shop::ShopArgs,
     },
     /// Simulate a machine's drives on a CAN interface (tests without hardware).
     ///
@@ -227,6 +231,8 @@ pub enum Command {
         /// Machine file (TOML).
         #[arg(long, short)]
         machine: PathBuf,
+        #[command(flatten)]
+        shop: crate::shop::ShopArgs,
     },
 }
 

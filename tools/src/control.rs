@@ -42,6 +42,10 @@ pub enum Request {
 pub struct Status {
     pub stage: String,
     pub paused: bool,
+    /// The line of the operator stop (`M00`, `M01`, `M06`) the path waits at: resume
+    /// goes on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub awaiting_operator: Option<u32>,
     /// Source line and block (N number, or index) being machined.
     pub line: u32,
     pub block: u32,
@@ -72,6 +76,7 @@ impl Status {
         Status {
             stage: s.stage.to_owned(),
             paused: s.paused,
+            awaiting_operator: s.awaiting,
             line: s.line,
             block: s.block,
             axis_names: names.to_vec(),
@@ -96,7 +101,11 @@ impl Status {
         format!(
             "{}{}  line {}  block {}  {}  F {:.1} mm/min  override {} %  cycle {}  overruns {}  feed holds {}  {:.1} %",
             self.stage,
-            if self.paused { " (paused)" } else { "" },
+            match (self.awaiting_operator, self.paused) {
+                (Some(l), _) => format!(" (stopped for the operator at line {l}: resume)"),
+                (None, true) => " (paused)".to_owned(),
+                (None, false) => String::new(),
+            },
             self.line,
             self.block,
             axes.join(" "),

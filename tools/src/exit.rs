@@ -72,10 +72,11 @@ pub enum InputError {
     /// Not UTF-8: `line:col: ...` from [`crate::program_text`].
     #[error("{file}:{message}")]
     Encoding { file: String, message: String },
-    #[error("{file}:{error}")]
+    /// Every error of the program (up to 50), one per line.
+    #[error("{}", parse_errors(.file, .errors))]
     Parse {
         file: String,
-        error: nc::parse::ParseError,
+        errors: nc::parse::ParseErrors,
     },
     /// The program does not fit the machine: geometry or plan.
     #[error("{file}:{error}")]
@@ -95,6 +96,26 @@ pub enum InputError {
     /// The drives are not where the program starts (and no --approach).
     #[error(transparent)]
     Start(#[from] rt_loop::pipeline::PipelineError),
+}
+
+/// `file:line:col: message` per error, and a last line when the parse stopped early.
+fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
+    let mut out: Vec<String> = e.errors.iter().map(|x| format!("{file}:{x}")).collect();
+    if e.errors.len() > 1 || e.more {
+        out.push(format!(
+            "{} errors{}",
+            e.errors.len(),
+            if e.more {
+                format!(
+                    " (stopped at {}: fix these and run again)",
+                    nc::parse::MAX_ERRORS
+                )
+            } else {
+                String::new()
+            }
+        ));
+    }
+    out.join("\n")
 }
 
 impl InputError {

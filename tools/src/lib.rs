@@ -9,31 +9,40 @@ pub mod exit;
 pub mod report;
 pub mod run;
 pub mod setup;
+pub mod shop;
 pub mod simdrives;
 pub mod simulate;
+pub mod words;
 
 pub use exit::InputError;
 use std::path::Path;
 
 /// Read and parse an NC program; errors name the file, line and column.
-pub fn load_program(path: &Path) -> Result<nc::program::Program, InputError> {
+pub fn load_program(
+    path: &Path,
+    setup: &nc::parse::Setup,
+) -> Result<nc::program::Program, InputError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|error| InputError::ReadProgram {
         file: file.clone(),
         error,
     })?;
-    parse_program(&bytes, &file)
+    parse_program(&bytes, &file, setup)
 }
 
 /// Parse an NC program held in memory; `file` names it in errors.
-pub fn parse_program(bytes: &[u8], file: &str) -> Result<nc::program::Program, InputError> {
+pub fn parse_program(
+    bytes: &[u8],
+    file: &str,
+    setup: &nc::parse::Setup,
+) -> Result<nc::program::Program, InputError> {
     let text = program_text(bytes).map_err(|message| InputError::Encoding {
         file: file.to_owned(),
         message,
     })?;
-    nc::parse::parse(text).map_err(|error| InputError::Parse {
+    nc::parse::parse_with(text, setup).map_err(|errors| InputError::Parse {
         file: file.to_owned(),
-        error,
+        errors,
     })
 }
 

@@ -51,6 +51,9 @@ pub struct Report {
     pub hard_stops: u64,
     pub drives: Vec<DriveEnd>,
     pub latency: rt_loop::stats::Summary,
+    /// Spindle, coolant, tool, stop and dwell words of the program, one line each.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub program_words: Vec<String>,
 }
 
 /// Axis names in joint order.
@@ -84,6 +87,7 @@ impl Report {
                 d.axis, d.node, d.target_counts, d.actual_counts
             ));
         }
+        s.push_str(&crate::words::text(&self.program_words));
         let what = if self.machine.is_empty() {
             self.program.clone()
         } else {

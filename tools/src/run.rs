@@ -51,6 +51,8 @@ pub struct RunOptions {
     pub progress: bool,
     /// Serve the operator's control socket here ([`crate::control`]).
     pub control: Option<PathBuf>,
+    /// Tool table and switches for the parser.
+    pub shop: crate::shop::ShopOptions,
 }
 
 /// What a run did.
@@ -71,6 +73,8 @@ pub struct RunResult {
     pub end_counts: Vec<Option<i32>>,
     pub underruns: u64,
     pub hard_stops: u64,
+    /// Spindle, coolant, tool, stop and dwell words of the program (`crate::words`).
+    pub program_words: Vec<String>,
 }
 
 impl RunResult {
@@ -105,8 +109,35 @@ impl RunResult {
                 })
                 .collect(),
             latency: self.stats.summary(),
+            program_words: self.program_words.clone(),
         }
     }
+}
+
+/// The planner's output: the start, the chunks to stream, the end joints and the program's
+/// words without axes.
+type Planned = (
+    Start,
+    Vec<Box<nc::stream::Chunk>>,
+    nc::kinematics::Joints,
+    Vec<String>,
+);
+
+/// A program that stops for the operator (`M00`, `M01` with optional stop, `M06`) needs
+/// someone to resume it: without a control socket it is refused before anything moves.
+#[allow(clippy::vec_box)]
+fn operator_reachable(planned: Planned, name: &str, control: bool) -> Result<Planned, InputError> {
+    if !control {
+        if let Some(pos) = planned.1.iter().find_map(|c| c.segment.wait.operator) {
+            return Err(InputError::Usage(format!(
+                "{}:{pos}: the program stops here for the operator (M00, M01 or M06) and \
+                 only the control socket can resume it: run with --control SOCKET (or the \
+                 machine file's [control] socket) and resume with `dnurbs ctl SOCKET resume`",
+                name
+            )));
+        }
+    }
+    Ok(planned)
 }
 
 /// Planner output before streaming.
@@ -115,8 +146,10 @@ fn plan_program(
     src: &[u8],
     name: &str,
     setup: &MachineSetup,
-) -> Result<(Start, Vec<Box<nc::stream::Chunk>>, nc::kinematics::Joints), InputError> {
-    let program = crate::parse_program(src, name)?;
+    shop: &nc::parse::Setup,
+) -> Result<Planned, InputError> {
+    let program = crate::parse_program(src, name, shop)?;
+    let words = crate::words::describe(&program);
     let file = std::path::Path::new(name);
     let path =
         build(&program, &setup.kin, &setup.build).map_err(|e| InputError::program(file, e))?;
@@ -138,7 +171,7 @@ fn plan_program(
         None => path.start_joints,
     };
     let (start, list) = chunks(path, &profile);
-    Ok((start, list, end))
+    Ok((start, list, end, words))
 }
 
 /// Every axis must have a drive for `run`.
@@ -175,6 +208,7 @@ pub fn run<L: CanLink + Send>(
     crate::check_bus_load(machine)?;
     let started = crate::report::now_utc();
     let setup = MachineSetup::new(machine);
+    let shop = crate::shop::parse_setup(machine, &opts.shop);
     let rtc = &machine.realtime;
     let period = machine.period_s;
     let period_ns = (period * 1e9).round() as u64;
@@ -216,14 +250,16 @@ pub fn run<L: CanLink + Send>(
     std::thread::scope(|scope| -> anyhow::Result<RunResult> {
         let finished = &finished;
         let setup_ref = &setup;
+        let shop_ref = &shop;
         // The planner thread.
         let planner = std::thread::Builder::new()
             .name("dnurbs-planner".into())
             .spawn_scoped(scope, move || {
-                let planned = plan_program(src, &opts.name, setup_ref);
+                let planned = plan_program(src, &opts.name, setup_ref, shop_ref)
+                    .and_then(|p| operator_reachable(p, &opts.name, opts.control.is_some()));
                 let mut source = match planned {
-                    Ok((start, list, end)) => {
-                        let _ = ready_tx.send(Ok((start, end)));
+                    Ok((start, list, end, words)) => {
+                        let _ = ready_tx.send(Ok((start, end, words)));
                         list.into_iter()
                     }
                     Err(e) => {
@@ -238,7 +274,7 @@ pub fn run<L: CanLink + Send>(
                 feeder.feed(&mut std::iter::empty());
             })?;
         let ready = ready_rx.recv();
-        let (start, end_joints) = match ready {
+        let (start, end_joints, program_words) = match ready {
             Ok(Ok(x)) => x,
             Ok(Err(e)) => {
                 finished.store(true, Ordering::Release);
@@ -325,7 +361,11 @@ pub fn run<L: CanLink + Send>(
                 end_counts,
                 control,
             )
-            .map(|r| RunResult { started, ..r })
+            .map(|r| RunResult {
+                started,
+                program_words,
+                ..r
+            })
         })();
         finished.store(true, Ordering::Release);
         let _ = planner.join();
@@ -424,6 +464,7 @@ fn run_threads<L: CanLink + Send>(
             end_counts,
             underruns: 0,
             hard_stops: 0,
+            program_words: Vec::new(),
         })
     })
     .map(|mut r| {

@@ -95,6 +95,8 @@ pub struct Summary {
     pub axis_travel_ok: bool,
     pub tool_axis_deviation_max_deg: f64,
     pub end_position_error_mm: f64,
+    /// Spindle, coolant, tool, stop and dwell words, one line each (`crate::words`).
+    pub program_words: Vec<String>,
 }
 
 /// Arc length of the cutter curve between two parameters, integrated directly.
@@ -284,6 +286,7 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         axis_travel_ok: travel_ok,
         tool_axis_deviation_max_deg: tool_dev,
         end_position_error_mm: end_err,
+        program_words: Vec::new(),
     }
 }
 
@@ -333,7 +336,7 @@ impl Summary {
             },
             self.tool_axis_deviation_max_deg,
             self.end_position_error_mm,
-        )
+        ) + &crate::words::text(&self.program_words)
     }
 }
 

@@ -158,7 +158,9 @@ pub enum ParseErrorKind {
     DwellWithoutTime,
     #[error("dwell of {value} s must be from 0 to {MAX_DWELL_S} s (P and X are seconds here; a post that writes P in milliseconds must be set to seconds)")]
     BadDwell { value: f64 },
-    #[error("G93 (inverse-time feed) needs F on every {motion} line: F is 1/minutes for that move")]
+    #[error(
+        "G93 (inverse-time feed) needs F on every {motion} line: F is 1/minutes for that move"
+    )]
     InverseTimeWithoutFeed { motion: Motion },
     #[error("{motion} in G91 (incremental) mode: a NURBS block takes absolute coordinates, program G90 first")]
     NurbsIncremental { motion: Motion },
@@ -192,7 +194,9 @@ pub enum ParseErrorKind {
     ArcFullCircleRadius,
     #[error("arc radius {radius} mm is below {MIN_ARC_RADIUS_MM} mm")]
     ArcTooSmall { radius: f64 },
-    #[error("rotary word {letter} on an arc: the tool axis stays fixed along G02/G03, turn it on a G01")]
+    #[error(
+        "rotary word {letter} on an arc: the tool axis stays fixed along G02/G03, turn it on a G01"
+    )]
     ArcRotary { letter: char },
 
     // ---- tool orientation on G00/G01 ---------------------------------------------------

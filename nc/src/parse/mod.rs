@@ -152,10 +152,16 @@ pub fn parse_with(src: &str, setup: &Setup) -> Result<Program, ParseErrors> {
     }
     match parser.finish(lexer.eof()) {
         Ok(program) if errors.is_empty() => Ok(program),
-        Ok(_) => Err(ParseErrors { errors, more: false }),
+        Ok(_) => Err(ParseErrors {
+            errors,
+            more: false,
+        }),
         Err(e) => {
             errors.push(e);
-            Err(ParseErrors { errors, more: false })
+            Err(ParseErrors {
+                errors,
+                more: false,
+            })
         }
     }
 }

@@ -30,6 +30,10 @@ pub struct Setup {
     pub block_delete: bool,
     /// `M01` stops (optional stop on). Off: `M01` is reported and passed.
     pub optional_stop: bool,
+    /// The machine's kinematics, for `G28`/`G53` and tool-length changes with the rotary
+    /// axes away from 0 (the tool tip's workpiece coordinates then follow from the machine
+    /// coordinates only through it). Without it those are refused.
+    pub kinematics: Option<crate::kinematics::MachineKinematics>,
 }
 
 /// The modal state of the language besides motion and feed.

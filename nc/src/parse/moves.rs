@@ -45,7 +45,12 @@ impl Parser<'_> {
         }
     }
 
-    fn modal_move(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
+    fn modal_move(
+        &mut self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+    ) -> Result<(), ParseError> {
         match motion {
             Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
             _ => self.linear(line, motion, pos),
@@ -66,7 +71,13 @@ impl Parser<'_> {
 
     /// The feed of a feed move (mm/min): the modal feed, or under `G93` the line's `F` (1/min)
     /// times the move's length (mm, or degrees for a move that only turns the tool).
-    fn move_feed(&self, line: &Line<'_>, motion: Motion, pos: SrcPos, length: f64) -> Result<f64, ParseError> {
+    fn move_feed(
+        &self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+        length: f64,
+    ) -> Result<f64, ParseError> {
         if self.modal.inverse_time {
             let f = line
                 .get('F')
@@ -78,7 +89,12 @@ impl Parser<'_> {
 
     /// The current position, starting at the reference position if the program has none
     /// yet (`missing` names the axis the line left out, for the error without one).
-    fn here_or_reference(&mut self, line: &Line<'_>, pos: SrcPos, missing: char) -> Result<[f64; 3], ParseError> {
+    fn here_or_reference(
+        &mut self,
+        line: &Line<'_>,
+        pos: SrcPos,
+        missing: char,
+    ) -> Result<[f64; 3], ParseError> {
         if let Some(here) = self.here {
             return Ok(here);
         }
@@ -130,7 +146,10 @@ impl Parser<'_> {
 
     /// A G00/G01 line, or a line continuing that modal motion; `pos` is the block's position.
     fn linear(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
-        line.only(&self.extra_letters(line, "GMFSTXYZABCIJK"), Context::Move(motion))?;
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZABCIJK"),
+            Context::Move(motion),
+        )?;
         if line.first_of("XYZABCIJK").is_none() {
             return Ok(()); // `G01 F500`: sets the mode, moves nothing
         }
@@ -158,7 +177,15 @@ impl Parser<'_> {
         Ok(())
     }
 
-    fn push_linear(&mut self, line: &Line<'_>, pos: SrcPos, rapid: bool, end: [f64; 3], orientation: Orientation, feed_mm_min: f64) {
+    fn push_linear(
+        &mut self,
+        line: &Line<'_>,
+        pos: SrcPos,
+        rapid: bool,
+        end: [f64; 3],
+        orientation: Orientation,
+        feed_mm_min: f64,
+    ) {
         let tooling = self.tooling();
         self.here = Some(end);
         self.orientation = orientation;
@@ -178,7 +205,10 @@ impl Parser<'_> {
         if let Some(w) = line.first_of("ABC") {
             return Err(ParseErrorKind::ArcRotary { letter: w.letter }.at(w.pos));
         }
-        line.only(&self.extra_letters(line, "GMFSTXYZIJKR"), Context::Move(motion))?;
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZIJKR"),
+            Context::Move(motion),
+        )?;
         if line.first_of("XYZIJKR").is_none() {
             return Ok(());
         }
@@ -190,7 +220,10 @@ impl Parser<'_> {
         let centre = match line.get('R') {
             Some(r) => {
                 if let Some(w) = line.first_of("IJK") {
-                    let kind = ParseErrorKind::ArcCentreAndRadius { motion, letter: w.letter };
+                    let kind = ParseErrorKind::ArcCentreAndRadius {
+                        motion,
+                        letter: w.letter,
+                    };
                     return Err(kind.at(w.pos));
                 }
                 Centre::Radius(r.value * self.modal.scale())
@@ -199,10 +232,16 @@ impl Parser<'_> {
                 if let Some(w) = line.first_of("IJK").filter(|w| {
                     w.letter != Plane::offset_letter(a) && w.letter != Plane::offset_letter(b)
                 }) {
-                    let kind = ParseErrorKind::ArcOffsetOutOfPlane { letter: w.letter, plane };
+                    let kind = ParseErrorKind::ArcOffsetOutOfPlane {
+                        letter: w.letter,
+                        plane,
+                    };
                     return Err(kind.at(w.pos));
                 }
-                let off = |i| line.value(Plane::offset_letter(i)).map(|v| v * self.modal.scale());
+                let off = |i| {
+                    line.value(Plane::offset_letter(i))
+                        .map(|v| v * self.modal.scale())
+                };
                 match (off(a), off(b)) {
                     (None, None) => {
                         return Err(ParseErrorKind::ArcWithoutCentre { motion, plane }.at(pos));
@@ -240,7 +279,10 @@ impl Parser<'_> {
     /// line's intermediate point to the reference position). Both need the workpiece frame
     /// to be the machine's along the axes they move: see [`Parser::machine_frame`].
     fn machine_move(&mut self, line: &Line<'_>, code: Code, pos: SrcPos) -> Result<(), ParseError> {
-        line.only(&self.extra_letters(line, "GMFSTXYZ"), Context::Move(self.mode.unwrap_or(Motion::G00)))?;
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZ"),
+            Context::Move(self.mode.unwrap_or(Motion::G00)),
+        )?;
         let home = code == Code::Home;
         let value = if home { 28.0 } else { 53.0 };
         let rapid = match (home, self.mode) {
@@ -269,15 +311,41 @@ impl Parser<'_> {
             m
         };
         let here = self.here_or_reference(line, pos, 'X')?;
-        let axes: Vec<usize> = if home && given.is_empty() { vec![0, 1, 2] } else { given };
+        let axes: Vec<usize> = if home && given.is_empty() {
+            vec![0, 1, 2]
+        } else {
+            given
+        };
+        let length = self.modal.tool_length;
         let mut end = here;
-        for i in axes {
-            if !self.machine_frame(i) {
-                let kind = ParseErrorKind::MachineMoveRotated { code: value, axis: AXES[i] };
-                return Err(kind.at(pos));
+        if let (Some(kin), Orientation::Angles { r1_deg, r2_deg }) =
+            (&self.setup.kinematics, self.orientation)
+        {
+            // Through the machine's kinematics, the table standing where the angles put it:
+            // a straight move in machine coordinates is one in the workpiece frame too.
+            use crate::kinematics::Kinematics;
+            use nalgebra::Vector3;
+            let (a, c) = (r1_deg.to_radians(), r2_deg.to_radians());
+            let mut m = kin.place(&Vector3::from(here), a, c);
+            for &i in &axes {
+                m[i] = target[i] - if i == 2 { length } else { 0.0 };
             }
-            let length = if i == 2 { self.modal.tool_length } else { 0.0 };
-            end[i] = check_domain(AXES[i], target[i] - length, pos)?;
+            let p = kin.unplace(&m, a, c);
+            for (i, e) in end.iter_mut().enumerate() {
+                *e = check_domain(AXES[i], p[i], pos)?;
+            }
+        } else {
+            for &i in &axes {
+                if !self.machine_frame(i) {
+                    let kind = ParseErrorKind::MachineMoveRotated {
+                        code: value,
+                        axis: AXES[i],
+                    };
+                    return Err(kind.at(pos));
+                }
+                let l = if i == 2 { length } else { 0.0 };
+                end[i] = check_domain(AXES[i], target[i] - l, pos)?;
+            }
         }
         let feed = if rapid {
             0.0
@@ -417,9 +485,16 @@ fn turn_deg(from: Orientation, to: Orientation) -> f64 {
             let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
             dot.clamp(-1.0, 1.0).acos().to_degrees()
         }
-        (Orientation::Angles { r1_deg: a1, r2_deg: a2 }, Orientation::Angles { r1_deg: b1, r2_deg: b2 }) => {
-            (b1 - a1).abs().max((b2 - a2).abs())
-        }
+        (
+            Orientation::Angles {
+                r1_deg: a1,
+                r2_deg: a2,
+            },
+            Orientation::Angles {
+                r1_deg: b1,
+                r2_deg: b2,
+            },
+        ) => (b1 - a1).abs().max((b2 - a2).abs()),
         _ => 0.0,
     }
 }

@@ -11,8 +11,8 @@ use super::line::{Line, MOVE_WORDS};
 use super::modal::{Modal, Setup, MAX_DWELL_S};
 use super::nurbs::{Frame, OpenNurbs};
 use crate::program::{
-    Action, ActionKind, Block, MoveTooling, NurbsBlock, NurbsKind, Orientation, Program, SrcPos,
-    Wait,
+    Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation,
+    Program, SrcPos, Wait,
 };
 
 /// Tool-vector length below which `I J K` is rejected (it has no direction).
@@ -181,7 +181,12 @@ impl<'s> Parser<'s> {
                 Code::InverseTime(it) => self.modal.inverse_time = it,
                 Code::Blend(b) => self.modal.blend = b,
                 Code::WorkOffset(i) => {
-                    let defined = self.setup.work_offsets.get(usize::from(i)).copied().flatten();
+                    let defined = self
+                        .setup
+                        .work_offsets
+                        .get(usize::from(i))
+                        .copied()
+                        .flatten();
                     self.modal.offset = match (defined, i) {
                         (Some(o), _) => o,
                         (None, 0) => [0.0; 3],
@@ -258,9 +263,14 @@ impl<'s> Parser<'s> {
                 Orientation::Angles { r1_deg, r2_deg } if r1_deg == 0.0 && r2_deg == 0.0 => {
                     [0.0, 0.0, 1.0]
                 }
-                Orientation::Angles { .. } => {
-                    return Err(ParseErrorKind::LengthChangeTilted.at(pos));
-                }
+                Orientation::Angles { r1_deg, r2_deg } => match &self.setup.kinematics {
+                    Some(kin) => {
+                        use crate::kinematics::Kinematics;
+                        let t = kin.tool_axis(r1_deg.to_radians(), r2_deg.to_radians());
+                        [t.x, t.y, t.z]
+                    }
+                    None => return Err(ParseErrorKind::LengthChangeTilted.at(pos)),
+                },
             };
             for (h, t) in here.iter_mut().zip(t) {
                 *h += (from - length) * t;
@@ -370,7 +380,11 @@ impl<'s> Parser<'s> {
     pub(super) fn tooling(&mut self) -> MoveTooling {
         MoveTooling {
             tool_length: self.modal.tool_length,
-            rtcp: self.modal.comp == LengthComp::Rtcp,
+            mode: match self.modal.comp {
+                LengthComp::Off => LengthMode::None,
+                LengthComp::Length => LengthMode::Length,
+                LengthComp::Rtcp => LengthMode::Rtcp,
+            },
             wait: core::mem::take(&mut self.wait),
         }
     }

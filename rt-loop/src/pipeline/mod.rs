@@ -298,6 +298,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         progress.publish(
             stage,
             self.follower.is_paused(),
+            self.follower.awaiting(),
             self.follower.line(),
             sp.block,
             &axes,

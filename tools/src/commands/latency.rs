@@ -50,6 +50,7 @@ pub fn latency(
         started,
         program: format!("latency, {} periods of {}", duration / period, show(period)),
         machine: String::new(),
+        program_words: Vec::new(),
         outcome: outcome.name(),
         exit_code: outcome.code(),
         stop_reason: None,

@@ -42,6 +42,7 @@ pub fn demo(
         report: report.clone(),
         progress: true,
         control,
+        shop: Default::default(),
     };
     let bus = match link {
         DemoLink::Memory => "an in-memory CAN link",
@@ -72,6 +73,7 @@ pub fn run(
     approach: bool,
     no_rt: bool,
     control: Option<PathBuf>,
+    shop: &crate::shop::ShopArgs,
 ) -> anyhow::Result<Outcome> {
     let m = crate::load_machine(machine)?;
     let src = std::fs::read(program).map_err(|error| InputError::ReadProgram {
@@ -106,6 +108,7 @@ pub fn run(
         report: report.clone(),
         progress: true,
         control: control.or_else(|| m.control_socket.clone()),
+        shop: shop.load()?,
     };
     keep_off_rt_cpu(opts.rt)?;
     eprintln!(

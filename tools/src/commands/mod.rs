@@ -39,7 +39,8 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             approach,
             no_rt,
             control,
-        } => machine::run(&program, &machine, report, approach, no_rt, control),
+            shop,
+        } => machine::run(&program, &machine, report, approach, no_rt, control, &shop),
         Command::Ctl { socket, command } => ctl::ctl(&socket, command),
         Command::Simulate {
             program,
@@ -47,8 +48,20 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             method,
             trace,
             json,
-        } => offline::simulate(&program, &machine, method.map(method_of), trace, json),
-        Command::Compare { programs, machine } => offline::compare(&programs, &machine),
+            shop,
+        } => offline::simulate(
+            &program,
+            &machine,
+            method.map(method_of),
+            trace,
+            json,
+            &shop,
+        ),
+        Command::Compare {
+            programs,
+            machine,
+            shop,
+        } => offline::compare(&programs, &machine, &shop),
         Command::Busload { machine } => offline::busload(&machine),
         Command::Latency {
             period,

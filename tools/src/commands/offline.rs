@@ -2,6 +2,7 @@
 
 use crate::exit::{InputError, Outcome};
 use crate::setup::MachineSetup;
+use crate::shop::{parse_setup, ShopArgs};
 use crate::simulate::{run, summarize, write_trace};
 use crate::{load_machine, load_program};
 use anyhow::Context;
@@ -15,12 +16,13 @@ pub fn simulate(
     method: Option<Method>,
     trace: Option<PathBuf>,
     json: bool,
+    shop: &ShopArgs,
 ) -> anyhow::Result<Outcome> {
     let machine = load_machine(machine)?;
     if let Err(e) = machine.check_bus_load() {
         eprintln!("dnurbs simulate: warning (simulate uses no bus; run would refuse): {e}");
     }
-    let prog = load_program(program)?;
+    let prog = load_program(program, &parse_setup(&machine, &shop.load()?))?;
     let setup = MachineSetup::new(&machine);
     let method = method.unwrap_or(setup.method);
     let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
@@ -32,7 +34,8 @@ pub fn simulate(
             .and_then(|_| w.flush())
             .with_context(|| format!("{}: cannot write the trace", path.display()))?;
     }
-    let summary = summarize(&result, &setup, prog.blocks.len());
+    let mut summary = summarize(&result, &setup, prog.blocks.len());
+    summary.program_words = crate::words::describe(&prog);
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
@@ -41,14 +44,16 @@ pub fn simulate(
     Ok(Outcome::Completed)
 }
 
-pub fn compare(programs: &[PathBuf], machine: &Path) -> anyhow::Result<Outcome> {
-    let setup = MachineSetup::new(&load_machine(machine)?);
+pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
+    let machine = load_machine(machine)?;
+    let parse = parse_setup(&machine, &shop.load()?);
+    let setup = MachineSetup::new(&machine);
     println!(
         "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles |"
     );
     println!("|---|---|---|---|---|---|");
     for program in programs {
-        let prog = load_program(program)?;
+        let prog = load_program(program, &parse)?;
         let name = program.file_name().map_or_else(
             || program.display().to_string(),
             |n| n.to_string_lossy().into_owned(),

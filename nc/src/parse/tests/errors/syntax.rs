@@ -150,7 +150,10 @@ fn unsupported_g_code() {
     );
     assert_eq!(
         message("G90 G21\nG68 G00 X0 Y0 Z0"),
-        format!("2:1: unsupported G-code G68: dnurbs accepts {}", crate::parse::codes::G_LIST)
+        format!(
+            "2:1: unsupported G-code G68: dnurbs accepts {}",
+            crate::parse::codes::G_LIST
+        )
     );
     for (src, name) in [
         ("G05.1", "G05.1"),
@@ -170,8 +173,14 @@ fn unsupported_g_code() {
 #[test]
 fn cutter_compensation_and_canned_cycles_are_refused_by_name() {
     assert_eq!(fails("G41 D1", 1, 1), E::CutterCompensation { code: 41.0 });
-    assert_eq!(fails("G00 X0 Y0 Z0\nG42", 2, 1), E::CutterCompensation { code: 42.0 });
-    assert_eq!(fails("G81 X0 Y0 Z-5 R2", 1, 1), E::CannedCycle { code: 81.0 });
+    assert_eq!(
+        fails("G00 X0 Y0 Z0\nG42", 2, 1),
+        E::CutterCompensation { code: 42.0 }
+    );
+    assert_eq!(
+        fails("G81 X0 Y0 Z-5 R2", 1, 1),
+        E::CannedCycle { code: 81.0 }
+    );
     assert!(message("G83").contains("post the cycle expanded into G00/G01 moves"));
 }
 

@@ -1,0 +1,61 @@
+//! The shop's side of a program: the tool table and the operator's switches (`--tools`,
+//! `--block-delete`, `--optional-stop`), merged with the machine file's work offsets and
+//! reference position into the parser's [`nc::parse::Setup`].
+
+use crate::exit::InputError;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// `--tools`, `--block-delete`, `--optional-stop` of `simulate`, `run` and `compare`.
+#[derive(clap::Args, Clone, Debug, Default)]
+pub struct ShopArgs {
+    /// Tool table in LinuxCNC's tool.tbl format (`T1 P1 Z+75.0 D6.0 ;comment`): the
+    /// lengths `G43 H` / `G43.4 H` apply (Z, mm).
+    #[arg(long, value_name = "TOOL.TBL")]
+    pub tools: Option<PathBuf>,
+    /// Skip lines that start with `/` (block delete). Without it the `/` is ignored.
+    #[arg(long)]
+    pub block_delete: bool,
+    /// Stop at M01 and wait for the operator (optional stop). Without it M01 is passed.
+    #[arg(long)]
+    pub optional_stop: bool,
+}
+
+/// The shop's options as values (tool lengths loaded).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ShopOptions {
+    /// Tool number -> length, mm.
+    pub tools: BTreeMap<u32, f64>,
+    pub block_delete: bool,
+    pub optional_stop: bool,
+}
+
+impl ShopArgs {
+    /// Loads the tool table, if one is given.
+    pub fn load(&self) -> Result<ShopOptions, InputError> {
+        let tools = match &self.tools {
+            Some(path) => config::tools::load_tools(path)?
+                .into_iter()
+                .map(|(n, t)| (n, t.length_mm))
+                .collect(),
+            None => BTreeMap::new(),
+        };
+        Ok(ShopOptions {
+            tools,
+            block_delete: self.block_delete,
+            optional_stop: self.optional_stop,
+        })
+    }
+}
+
+/// The parser's setup for `machine` and the shop's options.
+pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc::parse::Setup {
+    nc::parse::Setup {
+        work_offsets: machine.work_offsets,
+        reference: machine.reference,
+        tools: shop.tools.clone(),
+        block_delete: shop.block_delete,
+        optional_stop: shop.optional_stop,
+        kinematics: Some(crate::setup::MachineSetup::new(machine).kin),
+    }
+}

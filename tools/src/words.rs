@@ -1,0 +1,65 @@
+//! The program's words that drive no axis (spindle, coolant, tools, stops, dwells), as the
+//! lines `simulate` and `run` report. The machines dnurbs drives have no spindle or coolant
+//! drive yet, so these are reported, never silently dropped.
+
+use nc::program::{ActionKind, Coolant, Program, Spindle};
+
+/// One line per action: `line:col  word  what it does`.
+pub fn describe(program: &Program) -> Vec<String> {
+    program
+        .actions
+        .iter()
+        .map(|a| {
+            let what = match a.kind {
+                ActionKind::Spindle { dir, rpm } => match dir {
+                    Spindle::Cw => format!("M03 spindle clockwise at S{rpm}"),
+                    Spindle::Ccw => format!("M04 spindle counter-clockwise at S{rpm}"),
+                    Spindle::Off => "M05 spindle stop".to_owned(),
+                },
+                ActionKind::Speed { rpm } => format!("S{rpm} spindle speed"),
+                ActionKind::Coolant(c) => match c {
+                    Coolant::Mist => "M07 mist coolant on".to_owned(),
+                    Coolant::Flood => "M08 flood coolant on".to_owned(),
+                    Coolant::Off => "M09 coolant off".to_owned(),
+                },
+                ActionKind::SelectTool { tool } => format!("T{tool} tool selected"),
+                ActionKind::ChangeTool { tool } => {
+                    let t = tool.map_or("no tool selected".to_owned(), |t| format!("T{t}"));
+                    if a.before_block == 0 {
+                        format!(
+                            "M06 tool change ({t}) before the first move: loaded at cycle start"
+                        )
+                    } else {
+                        format!("M06 tool change ({t}): the path stops for the operator")
+                    }
+                }
+                ActionKind::Dwell { seconds } => format!("G04 dwell {seconds} s"),
+                ActionKind::Stop => "M00 program stop: the path stops for the operator".to_owned(),
+                ActionKind::OptionalStop { taken: true } => {
+                    "M01 optional stop (on): the path stops for the operator".to_owned()
+                }
+                ActionKind::OptionalStop { taken: false } => {
+                    "M01 optional stop (off: passed)".to_owned()
+                }
+            };
+            format!("{}  {what}", a.pos)
+        })
+        .collect()
+}
+
+/// The report's section: a heading and the lines, or nothing.
+pub fn text(words: &[String]) -> String {
+    if words.is_empty() {
+        return String::new();
+    }
+    let mut s = format!(
+        "program words without axes: {} (this machine has no spindle or coolant drive: reported only)\n",
+        words.len()
+    );
+    for w in words {
+        s.push_str("  ");
+        s.push_str(w);
+        s.push('\n');
+    }
+    s
+}
