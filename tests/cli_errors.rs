@@ -150,10 +150,10 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
     check("capacity", &many, "100002", "MAX_BLOCK_CTRL = 100000");
 
     check(
-        "g91",
-        "G91\nG01 X0 Y0 Z0 F100\n",
+        "g41",
+        "G41 D1\nG01 X0 Y0 Z0 F100\n",
         "1:1",
-        "unsupported G-code G91",
+        "cutter radius compensation G41 is not supported",
     );
     check("g20", "G20 G01 X0 Y0 Z0 F100\n", "1:1", "G20");
     check(

@@ -315,7 +315,7 @@ impl<'q> Follower<'q> {
             feed_override: 1.0,
             paused: false,
             awaiting: None,
-            gate_from: 1,
+            gate_from: 0,
             done: start.chunks == 0,
             pose: start.pose,
             joints: start.joints,

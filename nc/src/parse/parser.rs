@@ -55,8 +55,10 @@ pub(super) struct Parser<'s> {
 
 impl<'s> Parser<'s> {
     pub fn new(setup: &'s Setup) -> Self {
-        let mut modal = Modal::default();
-        modal.offset = setup.work_offsets[0].unwrap_or([0.0; 3]);
+        let modal = Modal {
+            offset: setup.work_offsets[0].unwrap_or([0.0; 3]),
+            ..Modal::default()
+        };
         Parser {
             setup,
             modal,

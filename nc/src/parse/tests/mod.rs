@@ -3,6 +3,7 @@
 
 mod errors;
 mod fuzz;
+mod posts;
 
 use super::parse;
 use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
