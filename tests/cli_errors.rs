@@ -155,12 +155,12 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
         "1:1",
         "cutter radius compensation G41 is not supported",
     );
-    check("g20", "G20 G01 X0 Y0 Z0 F100\n", "1:1", "G20");
+    check("g81", "G81 X0 Y0 Z-5 R2 F100\n", "1:1", "canned cycle G81");
     check(
-        "m3",
-        "G01 X0 Y0 Z0 F100\nM03\n",
+        "m98",
+        "G01 X0 Y0 Z0 F100\nM98\n",
         "2:1",
-        "unsupported M-code M03",
+        "unsupported M-code M98",
     );
     check("no-feed", "G01 X0 Y0 Z0\n", "1", "F");
     check("garbage", "G01 X0 Y0 Z0 F100 Q7\n", "1:19", "Q");
