@@ -12,8 +12,6 @@ use dnurbs_tools::run::{run, RunOptions};
 use dnurbs_tools::setup::MachineSetup;
 use dnurbs_tools::shop::{parse_setup, ShopArgs};
 use drives::link::MemLink;
-use drives::sim::{SimNodeConfig, SimThread};
-use drives::wire::NodeId;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -93,41 +91,11 @@ fn run_post(name: &str) -> (Vec<u32>, dnurbs_tools::report::Report, Vec<Vec<i32>
     m.realtime.feedback_timeout_s = 2.0;
     m.realtime.heartbeat_timeout_s = 5.0;
     m.realtime.max_consecutive_overruns = 100_000;
-    let (master_end, drive_end) = MemLink::pair(1024);
-    let nodes = m
-        .drives
-        .iter()
-        .map(|d| {
-            let mut c = SimNodeConfig::new(NodeId::new(d.node).unwrap());
-            c.initial_position = d.offset;
-            c
-        })
-        .collect();
-    let sim = SimThread::start_with(
-        drive_end,
-        nodes,
-        m.period_s,
-        Duration::from_micros(200),
-        || {
-            let _ = rt_loop::os::set_fifo(79);
-        },
-    )
-    .expect("simulated drives");
+    let (master_end, sim) = common::sim_drives(&m, |_| Default::default());
     let sock = common::temp(&format!("{name}.sock"));
     let opts = RunOptions {
-        name: name.into(),
-        approach: true,
-        rt: rt_loop::latency::RtSettings {
-            priority: Some(80),
-            cpu: None,
-            idle_poll: false,
-        },
-        lead_ns: 0,
-        rt_fallback: true,
-        report: None,
-        progress: false,
-        control: Some(sock.clone()),
         shop: shop(),
+        ..common::run_options(name, Some(sock.clone()))
     };
     let src = std::fs::read(posts(name)).unwrap();
     let operator = std::thread::spawn(move || resume_every_stop(&sock));
@@ -224,19 +192,8 @@ fn a_stop_for_the_operator_without_a_control_socket_is_refused_before_motion() {
     let m = machine();
     let (master_end, _drive_end) = MemLink::pair(16);
     let opts = RunOptions {
-        name: "nx-5axis-g43-4.nc".into(),
-        approach: true,
-        rt: rt_loop::latency::RtSettings {
-            priority: None,
-            cpu: None,
-            idle_poll: false,
-        },
-        lead_ns: 0,
-        rt_fallback: true,
-        report: None,
-        progress: false,
-        control: None,
         shop: shop(),
+        ..common::run_options("nx-5axis-g43-4.nc", None)
     };
     let src = std::fs::read(posts("nx-5axis-g43-4.nc")).unwrap();
     let e = run(&src, &m, move || Ok(vec![master_end]), &opts).unwrap_err();

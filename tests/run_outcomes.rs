@@ -6,10 +6,8 @@
 mod common;
 
 use dnurbs_tools::exit;
-use dnurbs_tools::run::{run, RunOptions, DEMO_MACHINE, DEMO_PROGRAM};
-use drives::link::MemLink;
-use drives::sim::{Faults, SimNodeConfig, SimThread};
-use drives::wire::NodeId;
+use dnurbs_tools::run::{run, DEMO_MACHINE, DEMO_PROGRAM};
+use drives::sim::Faults;
 use std::time::Duration;
 
 /// The paper example on the paper's machine, its drives simulated with `faults(node)`.
@@ -23,42 +21,8 @@ fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
     machine.realtime.feedback_timeout_s = 2.0;
     machine.realtime.heartbeat_timeout_s = 5.0;
     machine.realtime.max_consecutive_overruns = 100_000;
-    let (master_end, drive_end) = MemLink::pair(1024);
-    let nodes = machine
-        .drives
-        .iter()
-        .map(|d| {
-            let mut c = SimNodeConfig::new(NodeId::new(d.node).unwrap());
-            c.initial_position = d.offset;
-            c.faults = faults(d.node);
-            c
-        })
-        .collect();
-    let sim = SimThread::start_with(
-        drive_end,
-        nodes,
-        machine.period_s,
-        Duration::from_micros(200),
-        || {
-            let _ = rt_loop::os::set_fifo(79);
-        },
-    )
-    .expect("simulated drives");
-    let opts = RunOptions {
-        name: "paper-example.nc".into(),
-        approach: true,
-        rt: rt_loop::latency::RtSettings {
-            priority: Some(80),
-            cpu: None,
-            idle_poll: false,
-        },
-        lead_ns: 0,
-        rt_fallback: true,
-        report: None,
-        progress: false,
-        control: None,
-        shop: Default::default(),
-    };
+    let (master_end, sim) = common::sim_drives(&machine, faults);
+    let opts = common::run_options("paper-example.nc", None);
     let r = run(
         DEMO_PROGRAM.as_bytes(),
         &machine,

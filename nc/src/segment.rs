@@ -313,12 +313,11 @@ pub fn build(
             }
             // The joints at the end are those the interpolator arrives with: follow the
             // segment, so the next block starts from the rotary branch the path really took.
+            let at_start = joints;
             joints = follow(&seg, kin, &joints, lim);
             if tooling.mode == LengthMode::Length && matches!(kin, MachineKinematics::Trt { .. }) {
                 let turned = |j: &Joints| j[3].abs() > 1e-9 || j[4].abs() > 1e-9;
-                let bad = [seg.pose(0.0).joints(kin, &joints, lim), joints]
-                    .into_iter()
-                    .find(turned);
+                let bad = [at_start, joints].into_iter().find(turned);
                 if let Some(j) = bad {
                     let kind = BuildErrorKind::RotaryWithoutRtcp {
                         tilt_deg: j[3].to_degrees(),

@@ -214,3 +214,54 @@ pub fn assert_completed(out: &Output) -> u64 {
     }
     overruns
 }
+
+/// Simulated CiA-402 drives for every drive of `machine` on an in-memory link, with
+/// `faults(node)`, at SCHED_FIFO 79 where the privileges allow (as in `dnurbs demo`, so a
+/// loaded machine cannot starve them). Returns the master's end of the link.
+pub fn sim_drives(
+    machine: &config::Machine,
+    faults: impl Fn(u8) -> drives::sim::Faults,
+) -> (drives::link::MemLink, drives::sim::SimThread) {
+    let (master_end, drive_end) = drives::link::MemLink::pair(1024);
+    let nodes = machine
+        .drives
+        .iter()
+        .map(|d| {
+            let mut c = drives::sim::SimNodeConfig::new(drives::wire::NodeId::new(d.node).unwrap());
+            c.initial_position = d.offset;
+            c.faults = faults(d.node);
+            c
+        })
+        .collect();
+    let sim = drives::sim::SimThread::start_with(
+        drive_end,
+        nodes,
+        machine.period_s,
+        std::time::Duration::from_micros(200),
+        || {
+            let _ = rt_loop::os::set_fifo(79);
+        },
+    )
+    .expect("simulated drives");
+    (master_end, sim)
+}
+
+/// Run options of the tests: approach, the controller at SCHED_FIFO 80 where allowed, no
+/// report, no progress line.
+pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::RunOptions {
+    dnurbs_tools::run::RunOptions {
+        name: name.into(),
+        approach: true,
+        rt: rt_loop::latency::RtSettings {
+            priority: Some(80),
+            cpu: None,
+            idle_poll: false,
+        },
+        lead_ns: 0,
+        rt_fallback: true,
+        report: None,
+        progress: false,
+        control,
+        shop: Default::default(),
+    }
+}

@@ -11,6 +11,7 @@ use super::codes::{Code, Plane};
 use super::error::{Context, Motion, ParseError, ParseErrorKind};
 use super::lexer::word_limit;
 use super::line::{Line, MOVE_WORDS};
+use super::nurbs::distance;
 use super::parser::{normalise, Parser};
 use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, SrcPos};
 
@@ -465,10 +466,6 @@ fn check_domain(letter: char, value: f64, pos: SrcPos) -> Result<f64, ParseError
     } else {
         Err(ParseErrorKind::OutsideDomain { letter, value, max }.at(pos))
     }
-}
-
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (b[0] - a[0]).hypot(b[1] - a[1]).hypot(b[2] - a[2])
 }
 
 /// The change of the normal axis along an arc.

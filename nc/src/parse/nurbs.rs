@@ -299,7 +299,8 @@ impl OpenNurbs {
     }
 }
 
-fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+/// Euclidean distance of two points, mm.
+pub(super) fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     let [dx, dy, dz] = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     dx.hypot(dy).hypot(dz)
 }
