@@ -2,6 +2,8 @@
 //! docs/canopen.md. Indices only; the SDO codec takes them with a sub-index and a value.
 #![forbid(unsafe_code)]
 
+/// Device type (u32): profile number in bits 0..15 (402 drive, 401 I/O module).
+pub const DEVICE_TYPE: u16 = 0x1000;
 /// Heartbeat consumer time (u32 per sub-index: `node << 16 | ms`).
 pub const HEARTBEAT_CONSUMER: u16 = 0x1016;
 /// Heartbeat producer time (u16, ms).
@@ -33,8 +35,29 @@ pub const POSITION_ACTUAL: u16 = 0x6064;
 pub const FOLLOWING_ERROR_WINDOW: u16 = 0x6065;
 /// Target position (i32).
 pub const TARGET_POSITION: u16 = 0x607A;
+/// Velocity actual value (i32, velocity units).
+pub const VELOCITY_ACTUAL: u16 = 0x606C;
+/// Velocity window (u16, velocity units): profile velocity mode's "target reached" band.
+pub const VELOCITY_WINDOW: u16 = 0x606D;
+/// Velocity window time (u16, ms): how long the velocity must stay in the window.
+pub const VELOCITY_WINDOW_TIME: u16 = 0x606E;
+/// Profile acceleration (u32, velocity units per second).
+pub const PROFILE_ACCELERATION: u16 = 0x6083;
+/// Profile deceleration (u32, velocity units per second).
+pub const PROFILE_DECELERATION: u16 = 0x6084;
+/// Quick stop deceleration (u32, velocity units per second).
+pub const QUICK_STOP_DECELERATION: u16 = 0x6085;
+/// Target velocity (i32, velocity units).
+pub const TARGET_VELOCITY: u16 = 0x60FF;
 /// Interpolation time period: sub 1 value (u8), sub 2 exponent (i8); period = value * 10^exp s.
 pub const INTERPOLATION_TIME_PERIOD: u16 = 0x60C2;
 
 /// Modes of operation value of cyclic synchronous position mode.
 pub const MODE_CSP: i8 = 8;
+/// Modes of operation value of profile velocity mode (the spindle).
+pub const MODE_PV: i8 = 3;
+
+/// CiA-401 digital inputs, 8 per sub-index (sub 0 count, sub 1 inputs 1..8, u8).
+pub const DIGITAL_INPUTS: u16 = 0x6000;
+/// CiA-401 digital outputs, 8 per sub-index (sub 0 count, sub 1 outputs 1..8, u8).
+pub const DIGITAL_OUTPUTS: u16 = 0x6200;

@@ -10,6 +10,15 @@
 //! TPDO1  185#37120000FFFF   statusword  0x6041 (u16) | position actual 0x6064 (i32)
 //! ```
 //!
+//! A spindle drive in profile velocity mode (0x6060 = 3) uses the same layout with target
+//! velocity 0x60FF and velocity actual 0x606C in place of the positions ([`rpdo1_csp`] and
+//! [`decode_tpdo1_csp`] serve both). A CiA-401 I/O module maps one byte each way:
+//!
+//! ```text
+//! RPDO1  207#03             digital outputs 1..8 0x6200:01 (u8)
+//! TPDO1  187#03             digital inputs  1..8 0x6000:01 (u8)
+//! ```
+//!
 //! The decoders require exactly six bytes: any other length means the drive's mapping is not
 //! the one configured, which must not be read as positions.
 
@@ -45,6 +54,14 @@ pub const fn mapping_entry(index: u16, sub: u8, bits: u8) -> u32 {
 pub const RPDO1_CSP_MAPPING: [u32; 2] = [0x6040_0010, 0x607A_0020];
 /// TPDO1 mapping for CSP: statusword 0x6041 (16 bits), position actual 0x6064 (32 bits).
 pub const TPDO1_CSP_MAPPING: [u32; 2] = [0x6041_0010, 0x6064_0020];
+/// RPDO1 mapping for a spindle in profile velocity mode: controlword, target velocity 0x60FF.
+pub const RPDO1_PV_MAPPING: [u32; 2] = [0x6040_0010, 0x60FF_0020];
+/// TPDO1 mapping for a spindle in profile velocity mode: statusword, velocity actual 0x606C.
+pub const TPDO1_PV_MAPPING: [u32; 2] = [0x6041_0010, 0x606C_0020];
+/// RPDO1 mapping of a CiA-401 I/O module: digital outputs 1..8 (0x6200:01, 8 bits).
+pub const RPDO1_IO_MAPPING: [u32; 1] = [0x6200_0108];
+/// TPDO1 mapping of a CiA-401 I/O module: digital inputs 1..8 (0x6000:01, 8 bits).
+pub const TPDO1_IO_MAPPING: [u32; 1] = [0x6000_0108];
 /// Data bytes of both CSP PDOs.
 pub const CSP_PDO_LEN: u8 = 6;
 
@@ -113,6 +130,30 @@ pub fn decode_rpdo1_csp(frame: &CanFrame) -> Result<(NodeId, CspCommand), Decode
     ))
 }
 
+/// Master side: the RPDO1 carrying an I/O module's digital outputs 1..8 (bit 0 = output 1).
+pub fn rpdo1_io(node: NodeId, outputs: u8) -> CanFrame {
+    CanFrame::from_array(node.cob_id(cob::RPDO[0]), [outputs])
+}
+
+/// Master side: an I/O module's TPDO1, its digital inputs 1..8. Exactly one byte.
+pub fn decode_tpdo1_io(frame: &CanFrame) -> Result<(NodeId, u8), DecodeError> {
+    let node = node_of(frame, cob::TPDO[0], "a TPDO1")?;
+    check_len(frame, 1, 1)?;
+    Ok((node, frame.raw_data()[0]))
+}
+
+/// Drive side: the TPDO1 of an I/O module carrying its inputs.
+pub fn tpdo1_io(node: NodeId, inputs: u8) -> CanFrame {
+    CanFrame::from_array(node.cob_id(cob::TPDO[0]), [inputs])
+}
+
+/// Drive side: an I/O module's RPDO1 from the master, its outputs. Exactly one byte.
+pub fn decode_rpdo1_io(frame: &CanFrame) -> Result<(NodeId, u8), DecodeError> {
+    let node = node_of(frame, cob::RPDO[0], "an RPDO1")?;
+    check_len(frame, 1, 1)?;
+    Ok((node, frame.raw_data()[0]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -174,6 +215,31 @@ mod tests {
             let fb = CspFeedback { statusword, actual };
             assert_eq!(decode_tpdo1_csp(&frame(s)), Ok((node(n), fb)), "{s}");
         }
+    }
+
+    #[test]
+    fn io_vectors_and_lengths() {
+        assert_eq!(rpdo1_io(node(7), 0x03).to_string(), "207#03");
+        assert_eq!(tpdo1_io(node(7), 0x81).to_string(), "187#81");
+        assert_eq!(decode_rpdo1_io(&frame("207#02")), Ok((node(7), 0x02)));
+        assert_eq!(decode_tpdo1_io(&frame("187#81")), Ok((node(7), 0x81)));
+        let len = |id, len| DecodeError::Length {
+            id,
+            len,
+            min: 1,
+            max: 1,
+        };
+        assert_eq!(decode_tpdo1_io(&frame("187#0100")), Err(len(0x187, 2)));
+        assert_eq!(decode_rpdo1_io(&frame("207#")), Err(len(0x207, 0)));
+        assert_eq!(
+            [RPDO1_PV_MAPPING, TPDO1_PV_MAPPING],
+            [
+                [mapping_entry(0x6040, 0, 16), mapping_entry(0x60FF, 0, 32)],
+                [mapping_entry(0x6041, 0, 16), mapping_entry(0x606C, 0, 32)]
+            ]
+        );
+        assert_eq!(RPDO1_IO_MAPPING, [mapping_entry(0x6200, 1, 8)]);
+        assert_eq!(TPDO1_IO_MAPPING, [mapping_entry(0x6000, 1, 8)]);
     }
 
     #[test]
