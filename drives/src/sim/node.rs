@@ -1,10 +1,14 @@
-//! One simulated drive: its NMT state, SDO server, PDOs, motor model and injected faults.
-//! The behaviour is described in the [module docs](super); [`SimBus`](super::SimBus) routes
-//! frames and time to it.
+//! One simulated node: its NMT state, SDO server, PDOs and injected faults, the same for
+//! every profile, and its application: a [`Drive`] or an [`Io`] module. The behaviour is
+//! described in the [module docs](super); [`SimBus`](super::SimBus) routes frames and time
+//! to it.
 
-use super::dictionary::{Dictionary, ERROR_REGISTER};
-use super::{Faults, NodeCounters, Record, SimNodeConfig};
-use crate::cia402::{DriveModel, State, Statusword};
+use super::dictionary::Dictionary;
+use super::drive::Drive;
+use super::io::Io;
+use super::tables::Table;
+use super::{Faults, NodeCounters, Profile, Record, SimNodeConfig};
+use crate::cia402::State;
 use crate::frame::CanFrame;
 use crate::od;
 use crate::wire::emcy::{self, Emcy};
@@ -14,28 +18,25 @@ use crate::wire::pdo::PdoKind;
 use crate::wire::sdo::{self, SdoData, SdoRequest};
 use crate::wire::{cob, AbortCode, DecodeError, NodeId};
 
-/// Error register (0x1001) while the drive is faulted: bit 0 (generic, set with any error)
-/// and bit 7 (manufacturer specific).
-pub const FAULT_ERROR_REGISTER: u8 = 0x81;
-
 /// Values received in an RPDO, split per mapped entry: `(index, sub, raw)`.
 type RpdoValues = Vec<(u16, u8, u32)>;
+
+/// What the node is beyond CiA-301.
+#[derive(Debug)]
+enum App {
+    Drive(Drive),
+    Io(Io),
+}
 
 /// One simulated node.
 #[derive(Debug)]
 pub struct SimNode {
     node: NodeId,
-    lag_s: f64,
     faults: Faults,
     /// `BootUp` while initialising (until the next poll sends the boot-up message).
     nmt: NmtState,
     dict: Dictionary,
-    drive: DriveModel,
-    /// Motor position, counts; reported rounded.
-    position: f64,
-    /// Where the motor moves during the current SYNC period.
-    demand: f64,
-    following_error: bool,
+    app: App,
     /// RPDO values received since the last SYNC (synchronous transmission types).
     pending: Option<RpdoValues>,
     heartbeat_due: Option<f64>,
@@ -53,17 +54,19 @@ pub struct SimNode {
 impl SimNode {
     /// A node at power-on: initialising, its boot-up message due at the next poll.
     pub fn new(config: SimNodeConfig) -> Self {
-        let position = f64::from(config.initial_position);
+        let mut dict = Dictionary::new(config.node, Table::of(config.profile));
+        let app = match config.profile {
+            Profile::Drive => {
+                App::Drive(Drive::new(config.lag_s, config.initial_position, &mut dict))
+            }
+            Profile::Io => App::Io(Io::default()),
+        };
         let mut node = Self {
             node: config.node,
-            lag_s: config.lag_s,
             faults: config.faults,
             nmt: NmtState::BootUp,
-            dict: Dictionary::new(config.node),
-            drive: DriveModel::new(),
-            position,
-            demand: position,
-            following_error: false,
+            dict,
+            app,
             pending: None,
             heartbeat_due: None,
             fault_fired: false,
@@ -73,8 +76,6 @@ impl SimNode {
             last_sync: 0,
             counters: NodeCounters::default(),
         };
-        node.dict
-            .set(od::TARGET_POSITION, 0, config.initial_position as u32);
         node.publish();
         node
     }
@@ -83,16 +84,28 @@ impl SimNode {
         self.node
     }
 
-    pub fn state(&self) -> (NmtState, State, i32) {
-        (self.nmt, self.drive.state(), self.actual())
+    pub fn nmt_state(&self) -> NmtState {
+        self.nmt
+    }
+
+    /// A drive's NMT state, drive state and position; `None` for an I/O module.
+    pub fn drive_state(&self) -> Option<(NmtState, State, i32)> {
+        match &self.app {
+            App::Drive(d) => Some((self.nmt, d.state(), d.position())),
+            App::Io(_) => None,
+        }
+    }
+
+    /// An I/O module's outputs in effect; `None` for a drive.
+    pub fn io_outputs(&self) -> Option<u8> {
+        match self.app {
+            App::Io(_) => Some(Io::outputs(&self.dict)),
+            App::Drive(_) => None,
+        }
     }
 
     pub fn counters(&self) -> NodeCounters {
         self.counters
-    }
-
-    fn actual(&self) -> i32 {
-        self.position.round() as i32 // saturates; the position is always finite
     }
 
     fn booted(&self) -> bool {
@@ -113,14 +126,10 @@ impl SimNode {
         }
     }
 
-    fn emit_emcy(&mut self, error_code: u16, error_register: u8, out: &mut dyn FnMut(CanFrame)) {
+    fn emit_emcy(&mut self, e: Option<Emcy>, out: &mut dyn FnMut(CanFrame)) {
         // EMCY is a pre-operational and operational service.
-        if matches!(self.nmt, NmtState::PreOperational | NmtState::Operational) {
-            let e = Emcy {
-                error_code,
-                error_register,
-                manufacturer: [0; 5],
-            };
+        let active = matches!(self.nmt, NmtState::PreOperational | NmtState::Operational);
+        if let Some(e) = e.filter(|_| active) {
             self.emit(emcy::encode(self.node, &e), out);
         }
     }
@@ -130,7 +139,9 @@ impl SimNode {
         if !self.booted() {
             if !self.faults.never_boots {
                 self.nmt = NmtState::PreOperational;
-                self.drive.tick(); // self-test done: Switch on disabled
+                if let App::Drive(d) = &mut self.app {
+                    d.boot(); // self-test done: Switch on disabled
+                }
                 self.publish();
                 self.emit(heartbeat::encode(self.node, NmtState::BootUp), out);
             }
@@ -175,18 +186,21 @@ impl SimNode {
         if self.nmt != NmtState::Operational {
             self.pending = None;
         }
+        if let App::Io(io) = &mut self.app {
+            io.nmt(self.nmt, &mut self.dict);
+            self.publish();
+        }
     }
 
     /// Back to initialising with the defaults restored; the application's too for a reset
-    /// node, which also restarts the drive state machine. The motor does not move: the
-    /// target is set to where it stands.
+    /// node, which also resets the application (see [`Drive::reset`], [`Io::reset`]).
     fn reset(&mut self, application: bool) {
         self.dict.reset(application);
         if application {
-            self.drive = DriveModel::new();
-            self.demand = self.position;
-            self.following_error = false;
-            self.dict.set(od::TARGET_POSITION, 0, self.actual() as u32);
+            match &mut self.app {
+                App::Drive(d) => d.reset(&mut self.dict),
+                App::Io(io) => io.reset(),
+            }
         }
         self.nmt = NmtState::BootUp;
         self.pending = None;
@@ -242,11 +256,8 @@ impl SimNode {
         out: &mut dyn FnMut(CanFrame),
     ) -> Result<(), AbortCode> {
         self.dict.download(index, sub, data)?;
+        self.written(index, out);
         match index {
-            od::CONTROLWORD => {
-                let cw = self.dict.get(od::CONTROLWORD, 0) as u16;
-                self.apply_controlword(cw, out);
-            }
             od::HEARTBEAT_PRODUCER => {
                 self.heartbeat_due = self.heartbeat_period().map(|p| now_s + p);
             }
@@ -282,22 +293,20 @@ impl SimNode {
         }
     }
 
-    /// Stores received process data into the mapped objects; a controlword takes effect.
+    /// Stores received process data into the mapped objects, each taking effect.
     fn store(&mut self, values: &[(u16, u8, u32)], out: &mut dyn FnMut(CanFrame)) {
         for &(index, sub, raw) in values {
             self.dict.set(index, sub, raw);
-            if index == od::CONTROLWORD {
-                self.apply_controlword(raw as u16, out);
-            }
+            self.written(index, out);
         }
     }
 
-    /// Applies a controlword; leaving Fault announces the error reset (EMCY 0x0000).
-    fn apply_controlword(&mut self, controlword: u16, out: &mut dyn FnMut(CanFrame)) {
-        let was = self.drive.state();
-        self.drive.apply(controlword);
-        if was == State::Fault && self.drive.state() != State::Fault {
-            self.emit_emcy(0x0000, 0, out);
+    /// `index` was written by SDO or RPDO: the application reacts (a drive applies a
+    /// controlword), perhaps with an EMCY.
+    fn written(&mut self, index: u16, out: &mut dyn FnMut(CanFrame)) {
+        if let App::Drive(d) = &mut self.app {
+            let e = d.written(index, &self.dict);
+            self.emit_emcy(e, out);
         }
     }
 
@@ -313,54 +322,40 @@ impl SimNode {
         if !self.booted() {
             return;
         }
-        self.advance(period_s);
-        self.drive.tick();
+        if let App::Drive(d) = &mut self.app {
+            d.advance(period_s);
+        }
         if self.faults.fault_at_sync == Some(count) && !self.fault_fired {
             self.fault_fired = true;
-            self.drive.inject_fault();
-            self.emit_emcy(emcy::FOLLOWING_ERROR, FAULT_ERROR_REGISTER, out);
+            let e = match &mut self.app {
+                App::Drive(d) => d.fault(),
+                App::Io(io) => io.fault(),
+            };
+            self.emit_emcy(Some(e), out);
         }
         let operational = self.nmt == NmtState::Operational;
         if let Some(values) = self.pending.take().filter(|_| operational) {
             self.store(&values, out);
         }
-        let target = self.dict.get(od::TARGET_POSITION, 0) as i32;
-        let csp = self.drive.state() == State::OperationEnabled && self.mode() == od::MODE_CSP;
-        self.demand = if csp {
-            f64::from(target)
-        } else {
-            self.position
-        };
-        let window = self.dict.get(od::FOLLOWING_ERROR_WINDOW, 0);
-        let error = (i64::from(target) - i64::from(self.actual())).unsigned_abs();
-        self.following_error = csp && window != 0 && error > u64::from(window);
+        if let App::Drive(d) = &mut self.app {
+            d.settle(period_s, &self.dict);
+        }
         self.publish();
         if operational {
             self.syncs_operational += 1;
             self.send_tpdo(out);
+            let (target_counts, actual_counts, statusword) = match &self.app {
+                App::Drive(d) => d.record(&self.dict),
+                App::Io(_) => Io::record(&self.dict),
+            };
             records.push(Record {
                 sync: count,
                 node: self.node.get(),
-                target_counts: target,
-                actual_counts: self.actual(),
-                statusword: self.dict.get(od::STATUSWORD, 0) as u16,
+                target_counts,
+                actual_counts,
+                statusword,
             });
         }
-    }
-
-    /// One SYNC period of the first-order lag toward the demand.
-    fn advance(&mut self, period_s: f64) {
-        let alpha = if self.lag_s > 0.0 {
-            1.0 - (-period_s / self.lag_s).exp()
-        } else {
-            1.0
-        };
-        let alpha = if alpha.is_finite() {
-            alpha.clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
-        self.position += (self.demand - self.position) * alpha;
     }
 
     /// TPDO1, if valid: every n-th SYNC for transmission types 1..=240; for 0, 0xFE and 0xFF
@@ -388,29 +383,11 @@ impl SimNode {
         }
     }
 
-    fn mode(&self) -> i8 {
-        self.dict.get(od::MODES_OF_OPERATION, 0) as u8 as i8
-    }
-
-    /// Writes the values the drive produces into the dictionary.
+    /// Writes the values the application produces into the dictionary.
     fn publish(&mut self) {
-        let mut statusword = self.drive.statusword();
-        let enabled = self.drive.state() == State::OperationEnabled;
-        if self.mode() != od::MODE_CSP {
-            statusword &= !Statusword::TARGET_FOLLOWED;
+        match &self.app {
+            App::Drive(d) => d.publish(&mut self.dict),
+            App::Io(io) => io.publish(&mut self.dict),
         }
-        if enabled && self.following_error {
-            statusword |= Statusword::FOLLOWING_ERROR;
-        }
-        let faulted = matches!(
-            self.drive.state(),
-            State::Fault | State::FaultReactionActive
-        );
-        let mode = self.dict.get(od::MODES_OF_OPERATION, 0);
-        self.dict.set(od::STATUSWORD, 0, statusword.into());
-        self.dict.set(od::POSITION_ACTUAL, 0, self.actual() as u32);
-        self.dict.set(od::MODES_OF_OPERATION_DISPLAY, 0, mode);
-        let register = if faulted { FAULT_ERROR_REGISTER } else { 0 };
-        self.dict.set(ERROR_REGISTER, 0, register.into());
     }
 }

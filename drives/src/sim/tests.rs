@@ -4,9 +4,11 @@
 
 mod bus;
 mod faults;
+mod io;
 mod robustness;
 mod sdo;
 mod session;
+mod spindle;
 
 use super::*;
 use crate::wire::heartbeat;
@@ -34,13 +36,20 @@ pub fn text(frames: &[CanFrame]) -> Vec<String> {
 pub struct Master {
     pub bus: SimBus,
     pub now: f64,
+    /// The SYNC period, [`PERIOD`] unless set otherwise.
+    pub period: f64,
 }
 
 impl Master {
     pub fn new(nodes: Vec<SimNodeConfig>) -> Self {
+        Self::with_period(nodes, PERIOD)
+    }
+
+    pub fn with_period(nodes: Vec<SimNodeConfig>, period: f64) -> Self {
         Self {
-            bus: SimBus::new(nodes, PERIOD),
+            bus: SimBus::new(nodes, period),
             now: 0.0,
+            period,
         }
     }
 
@@ -83,7 +92,7 @@ impl Master {
     /// One period: the clock advances, the bus is polled, then SYNC is sent. Returns the
     /// frames of both.
     pub fn sync(&mut self) -> Vec<CanFrame> {
-        self.now += PERIOD;
+        self.now += self.period;
         let mut got = self.poll();
         got.extend(self.send(sync::encode()));
         got
@@ -149,26 +158,21 @@ impl Master {
 
     /// docs/canopen.md's PDO mapping procedure, step by step, every step acknowledged.
     pub fn map_csp(&mut self, n: NodeId) {
+        self.map_pdos(n, &RPDO1_CSP_MAPPING, &TPDO1_CSP_MAPPING);
+    }
+
+    /// The mapping procedure for any mapping, transmission type 1 both ways.
+    pub fn map_pdos(&mut self, n: NodeId, rpdo: &[u32], tpdo: &[u32]) {
         let steps = [
-            (
-                od::RPDO1_COMMUNICATION,
-                od::RPDO1_MAPPING,
-                RPDO1_CSP_MAPPING,
-                0x200,
-            ),
-            (
-                od::TPDO1_COMMUNICATION,
-                od::TPDO1_MAPPING,
-                TPDO1_CSP_MAPPING,
-                0x180,
-            ),
+            (od::RPDO1_COMMUNICATION, od::RPDO1_MAPPING, rpdo, 0x200),
+            (od::TPDO1_COMMUNICATION, od::TPDO1_MAPPING, tpdo, 0x180),
         ];
         for (comm, map, entries, base) in steps {
             let cob_id = u32::from(n.cob_id(base));
             let invalid = cob_id | od::PDO_COB_ID_INVALID;
             self.sdo_write(n, comm, 1, SdoValue::U32(invalid)).unwrap();
             self.sdo_write(n, map, 0, SdoValue::U8(0)).unwrap();
-            for (sub, entry) in (1..).zip(entries) {
+            for (sub, &entry) in (1..).zip(entries) {
                 self.sdo_write(n, map, sub, SdoValue::U32(entry)).unwrap();
             }
             self.sdo_write(n, map, 0, SdoValue::U8(entries.len() as u8))

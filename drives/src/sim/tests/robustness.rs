@@ -109,9 +109,11 @@ fn absurd_parameters_do_not_panic() {
         })
         .collect();
     for period in [f64::NAN, -0.001, 0.0, f64::INFINITY] {
+        // The bus runs on the absurd period; the master's clock on a sane one.
         let mut m = Master {
             bus: SimBus::new(nodes.clone(), period),
             now: 0.0,
+            period: PERIOD,
         };
         let ids: Vec<u8> = (1..=6).collect();
         m.operational(&ids);
