@@ -3,8 +3,10 @@
 //!
 //! Bus load (docs/canopen.md): a standard CAN frame with n data bytes takes at most
 //! `55 + 10 n` bits on the wire with worst-case bit stuffing and the interframe space
-//! (`47 + 8 n` without stuffing). Each cycle a bus carries one SYNC (0 bytes), and per drive
-//! one RPDO (controlword + target, 6 bytes) and one TPDO (statusword + actual, 6 bytes).
+//! (`47 + 8 n` without stuffing). Each cycle a bus carries one SYNC (0 bytes), per drive
+//! (the axes' and the spindle's) one RPDO (controlword + target, 6 bytes) and one TPDO
+//! (statusword + actual, 6 bytes), and per I/O module (the coolant's) one RPDO (outputs,
+//! 1 byte) and one TPDO (inputs, 1 byte).
 //! vcan has no bit timing, so the project computes the load itself.
 
 /// Default `bitrate`, bit/s.
@@ -13,20 +15,38 @@ pub const DEFAULT_BITRATE: u32 = 1_000_000;
 pub const DEFAULT_MAX_LOAD: f64 = 0.70;
 /// Bytes of the cyclic RPDO (0x6040 + 0x607A) and TPDO (0x6041 + 0x6064).
 pub const PDO_BYTES: u32 = 6;
+/// Bytes of an I/O module's cyclic RPDO (0x6200:01) and TPDO (0x6000:01).
+pub const IO_PDO_BYTES: u32 = 1;
 
 /// Worst-case bits of one standard frame with `n` data bytes, stuffing and IFS included.
 pub const fn frame_bits(n: u32) -> u32 {
     55 + 10 * n
 }
 
-/// Worst-case bits per cycle on a bus carrying `drives` drives: SYNC + RPDO + TPDO each.
-pub const fn cycle_bits(drives: u32) -> u32 {
-    frame_bits(0) + drives * 2 * frame_bits(PDO_BYTES)
+/// What one bus carries each cycle besides the SYNC.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Nodes {
+    /// CiA-402 drives: the axes' and the spindle's.
+    pub drives: u32,
+    /// CiA-401 I/O modules.
+    pub io: u32,
+}
+
+/// Worst-case bits per cycle on a bus: SYNC, and an RPDO and a TPDO per node.
+pub const fn cycle_bits(nodes: Nodes) -> u32 {
+    frame_bits(0)
+        + nodes.drives * 2 * frame_bits(PDO_BYTES)
+        + nodes.io * 2 * frame_bits(IO_PDO_BYTES)
 }
 
 /// Fraction of the bus's capacity used per cycle.
-pub fn load(drives: u32, bitrate: u32, period_s: f64) -> f64 {
-    f64::from(cycle_bits(drives)) / (f64::from(bitrate) * period_s)
+pub fn load(nodes: Nodes, bitrate: u32, period_s: f64) -> f64 {
+    f64::from(cycle_bits(nodes)) / (f64::from(bitrate) * period_s)
+}
+
+/// `n` drives and no I/O module.
+pub const fn drives(n: u32) -> Nodes {
+    Nodes { drives: n, io: 0 }
 }
 
 /// One CAN bus.
@@ -82,9 +102,11 @@ mod tests {
         // 5 axes: one SYNC + 5 RPDO(6 B) + 5 TPDO(6 B) = 55 + 10 * 115 = 1205 bits.
         assert_eq!(frame_bits(0), 55);
         assert_eq!(frame_bits(6), 115);
-        assert_eq!(cycle_bits(5), 1205);
-        assert!((load(5, 1_000_000, 0.002) - 0.6025).abs() < 1e-12);
-        assert!((load(5, 1_000_000, 0.001) - 1.205).abs() < 1e-12);
+        assert_eq!(cycle_bits(drives(5)), 1205);
+        assert!((load(drives(5), 1_000_000, 0.002) - 0.6025).abs() < 1e-12);
+        assert!((load(drives(5), 1_000_000, 0.001) - 1.205).abs() < 1e-12);
+        // A spindle drive and a coolant I/O module: 55 + 230 + 2 * (55 + 10) = 415 bits.
+        assert_eq!(cycle_bits(Nodes { drives: 1, io: 1 }), 415);
     }
 
     #[test]

@@ -30,6 +30,8 @@
 //! | `[interpolation] path_acceleration`, `path_jerk` | mm/s^2, mm/s^3 |
 //! | `[interpolation] max_feed_mm_min`, `rapid_feed_mm_min` | mm/min |
 //! | `[realtime] *_ms` | ms (stored in s) |
+//! | `[spindle] max_rpm`, `at_speed_window_rpm` | rpm |
+//! | `[spindle] acceleration_rpm_s`, `quick_stop_rpm_s` | rpm/s |
 //!
 //! # File layout
 //!
@@ -74,6 +76,23 @@
 //!
 //! [control]                 # optional
 //! # socket = "/run/dnurbs/control.sock"   # `dnurbs ctl` talks to the run here (mode 0660)
+//!
+//! [spindle]                 # optional: a CiA-402 drive in profile velocity mode
+//! bus = "can1"              # a [[bus]] name; node unique on that bus
+//! node = 6
+//! max_rpm = 24000           # an S above it is refused with its line
+//! acceleration_rpm_s = 8000 # ramp up and down (0x6083, 0x6084)
+//! # quick_stop_rpm_s = 16000     # default twice the acceleration (0x6085)
+//! # units_per_rpm = 1.0          # drive velocity units per rpm (0x60FF, 0x606C)
+//! # sign = 1                     # drive direction against M03
+//! # at_speed_window_rpm = 240    # default 1 % of max_rpm (0x606D)
+//! # at_speed_timeout_s = 5       # default max_rpm / acceleration + 2 s
+//!
+//! [coolant]                 # optional: a CiA-401 digital-output module
+//! bus = "can1"
+//! node = 7
+//! mist_output = 1           # M07 (output 1..=8 of 0x6200:01)
+//! flood_output = 2          # M08; M09 switches both off
 //! ```
 //!
 //! Example files: `config/machines/*.toml`.
@@ -83,6 +102,7 @@ mod error;
 mod machine;
 mod raw;
 mod source;
+pub mod spindle;
 pub mod tools;
 mod validate;
 
@@ -93,6 +113,7 @@ pub use machine::{
     Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
     UnknownMethod,
 };
+pub use spindle::{Coolant, Spindle};
 
 /// Reads and validates the machine configuration file at `path`.
 pub fn load(path: &Path) -> Result<Machine, ConfigError> {

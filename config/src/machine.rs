@@ -32,6 +32,10 @@ pub struct Machine {
     pub work_offsets: [Option<[f64; 3]>; 6],
     /// `[reference] position`: the G28 position in machine coordinates (mm).
     pub reference: Option<[f64; 3]>,
+    /// `[spindle]`: the spindle drive, if the machine has one on its bus.
+    pub spindle: Option<crate::spindle::Spindle>,
+    /// `[coolant]`: the coolant valves' I/O module, if the machine has one on its bus.
+    pub coolant: Option<crate::spindle::Coolant>,
 }
 
 impl Machine {
@@ -41,6 +45,16 @@ impl Machine {
         match &self.bus_overload {
             Some(m) => Err(m),
             None => Ok(()),
+        }
+    }
+
+    /// What bus `bus` carries each cycle: the axes' drives, the spindle, the coolant module.
+    pub fn bus_nodes(&self, bus: usize) -> crate::bus::Nodes {
+        let drives = self.drives.iter().filter(|d| d.bus == bus).count()
+            + usize::from(self.spindle.as_ref().is_some_and(|s| s.bus == bus));
+        crate::bus::Nodes {
+            drives: drives as u32,
+            io: u32::from(self.coolant.as_ref().is_some_and(|c| c.bus == bus)),
         }
     }
 

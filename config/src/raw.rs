@@ -29,6 +29,44 @@ pub(crate) struct RawFile {
     pub work_offsets: Option<RawWorkOffsets>,
     /// `[reference]`: the G28 position.
     pub reference: Option<RawReference>,
+    /// `[spindle]`: the spindle drive.
+    pub spindle: Option<RawSpindle>,
+    /// `[coolant]`: the coolant valves' I/O module.
+    pub coolant: Option<RawCoolant>,
+}
+
+/// `[spindle]`: a CiA-402 drive in profile velocity mode.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSpindle {
+    pub bus: String,
+    pub node: i64,
+    /// Highest programmable speed, rpm.
+    pub max_rpm: f64,
+    /// Ramp up and down, rpm/s.
+    pub acceleration_rpm_s: f64,
+    /// Quick-stop ramp, rpm/s; default twice the acceleration.
+    pub quick_stop_rpm_s: Option<f64>,
+    /// Drive velocity units per rpm; default 1.
+    pub units_per_rpm: Option<f64>,
+    /// +1 or -1: the drive's positive direction against M03; default +1.
+    pub sign: Option<i64>,
+    /// At speed within this many rpm of the command; default 1 % of max_rpm (at least 1).
+    pub at_speed_window_rpm: Option<f64>,
+    /// Longest wait for the speed before motion, s; default the ramp from 0 to max_rpm + 2 s.
+    pub at_speed_timeout_s: Option<f64>,
+}
+
+/// `[coolant]`: a CiA-401 digital-output module switching the coolant valves.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawCoolant {
+    pub bus: String,
+    pub node: i64,
+    /// Output (1..=8 of 0x6200:01) switched by M07.
+    pub mist_output: Option<i64>,
+    /// Output switched by M08.
+    pub flood_output: Option<i64>,
 }
 
 /// `[work_offsets]`: the program zero of each work offset, machine coordinates X Y Z, mm.

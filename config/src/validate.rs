@@ -30,7 +30,29 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     let interpolation = check.interpolation(&raw.interpolation.unwrap_or_default())?;
     let buses = check.buses(&raw.bus)?;
     let drives = check.drives(&raw.axes, &axes, &buses)?;
-    let bus_overload = check.bus_load(&buses, &drives, period_s);
+    let spindle = match &raw.spindle {
+        Some(r) => Some(crate::spindle::spindle(&check, r, &buses, &drives)?),
+        None => None,
+    };
+    let coolant = match &raw.coolant {
+        Some(r) => Some(crate::spindle::coolant(
+            &check,
+            r,
+            &buses,
+            &drives,
+            spindle.as_ref(),
+        )?),
+        None => None,
+    };
+    let nodes: Vec<bus::Nodes> = (0..buses.len())
+        .map(|i| bus::Nodes {
+            drives: (drives.iter().filter(|d| d.bus == i).count()
+                + usize::from(spindle.as_ref().is_some_and(|s| s.bus == i)))
+                as u32,
+            io: u32::from(coolant.as_ref().is_some_and(|c| c.bus == i)),
+        })
+        .collect();
+    let bus_overload = check.bus_load(&buses, &nodes, period_s);
     let realtime = check.realtime(&raw.realtime.unwrap_or_default(), period_s)?;
     let control_socket = match raw.control.and_then(|c| c.socket) {
         Some(s) if s.trim().is_empty() || s.contains('\0') => {
@@ -65,6 +87,8 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
         None => None,
     };
     Ok(Machine {
+        spindle,
+        coolant,
         work_offsets,
         reference,
         name,
@@ -80,14 +104,19 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     })
 }
 
-struct Check<'s, 'a> {
+pub(crate) struct Check<'s, 'a> {
     src: &'s Source<'a>,
 }
 
 impl Check<'_, '_> {
     /// An [`ConfigError::Invalid`] for `path`; `shown` is used if the value is not in the file
     /// as a single line (or not in the file at all).
-    fn invalid(&self, path: &[&str], shown: Option<String>, rule: String) -> ConfigError {
+    pub(crate) fn invalid(
+        &self,
+        path: &[&str],
+        shown: Option<String>,
+        rule: String,
+    ) -> ConfigError {
         ConfigError::Invalid {
             at: self.src.locate(path),
             key: path.join("."),
@@ -96,7 +125,7 @@ impl Check<'_, '_> {
         }
     }
 
-    fn missing(&self, path: &[&str], rule: String) -> ConfigError {
+    pub(crate) fn missing(&self, path: &[&str], rule: String) -> ConfigError {
         ConfigError::Invalid {
             at: self.src.locate(path),
             key: path.join("."),
@@ -106,7 +135,7 @@ impl Check<'_, '_> {
     }
 
     /// `v` in `MIN_POSITIVE..=MAX_POSITIVE`: a rate, a limit or a scale.
-    fn positive(&self, path: &[&str], v: f64, unit: &str) -> Result<f64, ConfigError> {
+    pub(crate) fn positive(&self, path: &[&str], v: f64, unit: &str) -> Result<f64, ConfigError> {
         if (MIN_POSITIVE..=MAX_POSITIVE).contains(&v) {
             Ok(v)
         } else {
@@ -575,17 +604,22 @@ impl Check<'_, '_> {
 
     /// The first bus over its `max_load` at this period, as a positioned message. Not an
     /// error of the file: `dnurbs run` and `demo` refuse it, `simulate` (no bus) warns.
-    fn bus_load(&self, buses: &[Bus], drives: &[Drive], period_s: f64) -> Option<String> {
-        for (i, b) in buses.iter().enumerate() {
-            let n = drives.iter().filter(|d| d.bus == i).count() as u32;
+    fn bus_load(&self, buses: &[Bus], nodes: &[bus::Nodes], period_s: f64) -> Option<String> {
+        for (i, (b, &n)) in buses.iter().zip(nodes).enumerate() {
             let load = bus::load(n, b.bitrate, period_s);
             if load > b.max_load {
                 let idx = i.to_string();
+                let io = if n.io > 0 {
+                    format!(" and {} I/O module", n.io)
+                } else {
+                    String::new()
+                };
                 let rule = format!(
-                    "bus {:?} would carry {n} drives: {} bits per {} ms cycle = {:.1} % of {} bit/s, \
+                    "bus {:?} would carry {} drives{io}: {} bits per {} ms cycle = {:.1} % of {} bit/s, \
                      over max_load {:.1} % by {:.1} points: lengthen the period, raise the bitrate \
                      or move axes to another bus",
                     b.name,
+                    n.drives,
                     bus::cycle_bits(n),
                     period_s * 1e3,
                     load * 100.0,

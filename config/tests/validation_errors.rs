@@ -304,7 +304,10 @@ fn drives_load_and_convert_counts() {
     // The example machine carries drives too, within its bus load.
     let p = common::parse(common::PAPER).unwrap();
     assert_eq!(p.drives.len(), 5);
-    assert!(config::bus::load(5, p.buses[0].bitrate, p.period_s) <= p.buses[0].max_load);
+    assert!(
+        config::bus::load(config::bus::drives(5), p.buses[0].bitrate, p.period_s)
+            <= p.buses[0].max_load
+    );
 }
 
 #[test]
@@ -407,9 +410,13 @@ fn two_buses_split_the_load() {
     assert_eq!(m.buses.len(), 2);
     let on = |b: usize| m.drives.iter().filter(|d| d.bus == b).count() as u32;
     assert_eq!((on(0), on(1)), (3, 2));
-    assert_eq!(config::bus::cycle_bits(3), 745);
-    assert!((config::bus::load(3, 1_000_000, m.period_s) - 0.745).abs() < 1e-12);
-    assert!((config::bus::load(2, 1_000_000, m.period_s) - 0.515).abs() < 1e-12);
+    assert_eq!(config::bus::cycle_bits(config::bus::drives(3)), 745);
+    assert!(
+        (config::bus::load(config::bus::drives(3), 1_000_000, m.period_s) - 0.745).abs() < 1e-12
+    );
+    assert!(
+        (config::bus::load(config::bus::drives(2), 1_000_000, m.period_s) - 0.515).abs() < 1e-12
+    );
 }
 
 #[test]

@@ -123,6 +123,12 @@ impl Statusword {
         self.0 & Self::REMOTE != 0
     }
 
+    /// Bit 10: target reached; in profile velocity mode, the velocity has been within the
+    /// velocity window 0x606D of the target for the window time 0x606E.
+    pub const fn target_reached(self) -> bool {
+        self.0 & Self::TARGET_REACHED != 0
+    }
+
     /// Bit 12 in cyclic synchronous position mode: the drive follows the target.
     pub const fn target_followed(self) -> bool {
         self.0 & Self::TARGET_FOLLOWED != 0

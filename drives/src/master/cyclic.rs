@@ -16,13 +16,20 @@
 //! target, held: the commanded position never moves again, in particular never back to a
 //! lagging actual position (a step against the motion), while each drive stops by its own
 //! quick-stop ramp and is disabled.
+//!
+//! Besides the axes ([`NodeKind::Position`]) a bus may carry the spindle, a CiA-402 drive in
+//! profile velocity mode ([`NodeKind::Velocity`]: its target is a velocity, 0 until it is
+//! Operation enabled and from a fault on), and a CiA-401 I/O module ([`NodeKind::Io`]: its
+//! RPDO1 carries the digital outputs, all off until the goal is Enabled and from a fault on;
+//! its TPDO1 the inputs; it has no CiA-402 state machine and is supervised by heartbeat,
+//! NMT state, EMCY and feedback only).
 
 use crate::cia402::{Goal, Sequencer, State, Statusword};
 use crate::frame::CanFrame;
 use crate::link::{CanLink, LinkError};
 use crate::wire::emcy::{self, Emcy};
 use crate::wire::heartbeat::{self, NmtState};
-use crate::wire::pdo::{decode_tpdo1_csp, rpdo1_csp};
+use crate::wire::pdo::{decode_tpdo1_csp, decode_tpdo1_io, rpdo1_csp, rpdo1_io};
 use crate::wire::{classify, sync, NodeId, Received};
 use heapless::Vec as HVec;
 
@@ -33,15 +40,30 @@ pub const MAX_RX_PER_CYCLE: usize = 8 * MAX_NODES + 16;
 /// Frames received per [`CanLink::recv_all`] call.
 const RX_BATCH: usize = 32;
 
-/// What the master knows of one drive.
+/// What a node on the bus is to the master.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum NodeKind {
+    /// A CiA-402 drive in cyclic synchronous position mode: an axis.
+    #[default]
+    Position,
+    /// A CiA-402 drive in profile velocity mode: the spindle.
+    Velocity,
+    /// A CiA-401 digital I/O module: the coolant valves.
+    Io,
+}
+
+/// What the master knows of one node.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeStatus {
     pub node: NodeId,
+    pub kind: NodeKind,
+    /// CiA-402 state (`None` for an I/O module, or before the first TPDO).
     pub state: Option<State>,
     pub statusword: u16,
-    /// Position actual value, counts.
+    /// Position actual value, counts; the velocity actual value for a
+    /// [`NodeKind::Velocity`] drive; the digital inputs for an I/O module.
     pub actual: i32,
-    /// Last target sent, counts.
+    /// Last target sent: counts, velocity units, or the digital outputs.
     pub target: i32,
     pub nmt: Option<NmtState>,
     /// Time of the last heartbeat, s (the clock passed to `cycle`).
@@ -101,11 +123,28 @@ pub struct Master<L: CanLink> {
 }
 
 impl<L: CanLink> Master<L> {
-    /// `initial` holds each node's actual position from set-up, in the order of `nodes`.
-    /// Returns `None` if there are more than [`MAX_NODES`] nodes or the slices differ in length.
+    /// Axes only: `initial` holds each node's actual position from set-up, in the order of
+    /// `nodes`. Returns `None` if there are more than [`MAX_NODES`] nodes or the slices
+    /// differ in length.
     pub fn new(
         link: L,
         nodes: &[NodeId],
+        initial: &[i32],
+        sup: Supervision,
+        now: f64,
+    ) -> Option<Self> {
+        let mut kinds: HVec<(NodeId, NodeKind), MAX_NODES> = HVec::new();
+        for &n in nodes {
+            kinds.push((n, NodeKind::Position)).ok()?;
+        }
+        Self::with_kinds(link, &kinds, initial, sup, now)
+    }
+
+    /// As [`Master::new`], each node with its kind; `initial` holds what set-up read (the
+    /// actual position, velocity or inputs).
+    pub fn with_kinds(
+        link: L,
+        nodes: &[(NodeId, NodeKind)],
         initial: &[i32],
         sup: Supervision,
         now: f64,
@@ -114,13 +153,19 @@ impl<L: CanLink> Master<L> {
             return None;
         }
         let mut v = HVec::new();
-        for (&node, &actual) in nodes.iter().zip(initial) {
+        for (&(node, kind), &actual) in nodes.iter().zip(initial) {
+            let target = if kind == NodeKind::Position {
+                actual
+            } else {
+                0
+            };
             v.push(NodeStatus {
                 node,
+                kind,
                 state: None,
                 statusword: 0,
                 actual,
-                target: actual,
+                target,
                 nmt: None,
                 last_heartbeat: Some(now),
                 last_emcy: None,
@@ -159,9 +204,11 @@ impl<L: CanLink> Master<L> {
         self.fault.as_ref()
     }
 
-    /// Whether every node is in `state`.
+    /// Whether every CiA-402 drive is in `state` (I/O modules have no state).
     pub fn all_in(&self, state: State) -> bool {
-        self.nodes.iter().all(|n| n.state == Some(state))
+        self.nodes
+            .iter()
+            .all(|n| n.kind == NodeKind::Io || n.state == Some(state))
     }
 
     /// Whether the node has been silent longer than its feedback supervision allows: lost,
@@ -225,6 +272,12 @@ impl<L: CanLink> Master<L> {
         };
         let n = &mut self.nodes[i];
         match classify(frame) {
+            Received::Tpdo { n: 1, .. } if n.kind == NodeKind::Io => {
+                if let Ok((_, inputs)) = decode_tpdo1_io(frame) {
+                    n.actual = i32::from(inputs);
+                    n.cycles_without_feedback = 0;
+                }
+            }
             Received::Tpdo { n: 1, .. } => {
                 if let Ok((_, fb)) = decode_tpdo1_csp(frame) {
                     n.statusword = fb.statusword;
@@ -256,7 +309,12 @@ impl<L: CanLink> Master<L> {
         for i in 0..self.nodes.len() {
             let n = self.nodes[i];
             let node = n.node.get();
-            let cause = match n.state {
+            let state = if n.kind == NodeKind::Io {
+                None
+            } else {
+                n.state
+            };
+            let cause = match state {
                 Some(state @ (State::Fault | State::FaultReactionActive)) => {
                     Some(FaultCause::DriveFault {
                         state,
@@ -296,16 +354,18 @@ impl<L: CanLink> Master<L> {
         if self.fault.is_some()
             && self.goal == Goal::QuickStop
             && self.nodes.iter().all(|n| {
-                matches!(
-                    n.state,
-                    Some(
-                        State::QuickStopActive
-                            | State::Fault
-                            | State::SwitchOnDisabled
-                            | State::ReadyToSwitchOn
-                            | State::SwitchedOn
+                n.kind == NodeKind::Io
+                    || matches!(
+                        n.state,
+                        Some(
+                            State::QuickStopActive
+                                | State::Fault
+                                | State::SwitchOnDisabled
+                                | State::ReadyToSwitchOn
+                                | State::SwitchedOn
+                        )
                     )
-                ) || n.cycles_without_feedback > self.sup.feedback_timeout_cycles
+                    || n.cycles_without_feedback > self.sup.feedback_timeout_cycles
             })
         {
             self.goal = Goal::Disabled;
@@ -329,14 +389,25 @@ impl<L: CanLink> Master<L> {
         let mut out: HVec<CanFrame, { MAX_NODES + 1 }> = HVec::new();
         for (i, n) in self.nodes.iter_mut().enumerate() {
             let state = n.state.unwrap_or(State::SwitchOnDisabled);
+            if n.kind == NodeKind::Io {
+                // Outputs on only while the machine is meant to run and nothing faulted.
+                n.target = match targets.get(i) {
+                    Some(&t) if !hold && goal == Goal::Enabled => t & 0xFF,
+                    _ => 0,
+                };
+                let _ = out.push(rpdo1_io(n.node, n.target as u8));
+                continue;
+            }
             let cw = n.seq.step(state, goal);
-            n.target = match (state, targets.get(i)) {
+            n.target = match (n.kind, state, targets.get(i)) {
                 // After a fault: the last commanded target, whatever the state. A drive
                 // behind its target (its own lag) would otherwise see the target step back
                 // to where it is, a velocity reversal beyond any limit.
-                _ if hold => n.target,
-                (State::OperationEnabled, Some(&t)) => t,
-                _ => n.actual,
+                (NodeKind::Position, ..) if hold => n.target,
+                (_, State::OperationEnabled, Some(&t)) if !hold => t,
+                (NodeKind::Position, ..) => n.actual,
+                // A spindle stops: its drive ramps down (quick stop after a fault).
+                _ => 0,
             };
             // At most MAX_NODES nodes: there is room.
             let _ = out.push(rpdo1_csp(n.node, cw.0, n.target));

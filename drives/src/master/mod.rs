@@ -7,5 +7,7 @@
 pub mod cyclic;
 pub mod setup;
 
-pub use cyclic::{DriveFault, FaultCause, Master, NodeStatus, Supervision, MAX_NODES};
-pub use setup::{configure, SetupError, SetupErrorKind, SetupOptions};
+pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
+pub use setup::{
+    configure, configure_nodes, NodeSetup, SetupError, SetupErrorKind, SetupOptions, VelocitySetup,
+};

@@ -10,14 +10,25 @@
 //! 6. SDO: read the actual position 0x6064, so the first target equals it (no jump);
 //! 7. NMT start.
 //!
+//! A spindle ([`NodeSetup::Velocity`]) gets modes of operation 3 (profile velocity), RPDO1 =
+//! controlword + target velocity 0x60FF, TPDO1 = statusword + velocity actual 0x606C, its
+//! ramps 0x6083/0x6084/0x6085 and velocity window 0x606D/0x606E, and its velocity actual is
+//! read in step 6. An I/O module ([`NodeSetup::Io`], CiA-401) gets only the PDO mapping
+//! (RPDO1 = digital outputs 0x6200:01, TPDO1 = digital inputs 0x6000:01) and the
+//! heartbeat; its inputs are read in step 6.
+//!
 //! Every SDO transfer has a timeout and a bounded number of retries. Frames that arrive in
 //! between (heartbeats, EMCY) are not lost: they are handed to an observer.
 
 use crate::link::{CanLink, LinkError};
+use crate::master::NodeKind;
 use crate::od;
 use crate::wire::heartbeat::{self, NmtState};
 use crate::wire::nmt::{self, NmtCommand, Target};
-use crate::wire::pdo::{PdoKind, RPDO1_CSP_MAPPING, TPDO1_CSP_MAPPING};
+use crate::wire::pdo::{
+    PdoKind, RPDO1_CSP_MAPPING, RPDO1_IO_MAPPING, RPDO1_PV_MAPPING, TPDO1_CSP_MAPPING,
+    TPDO1_IO_MAPPING, TPDO1_PV_MAPPING,
+};
 use crate::wire::sdo::{self, SdoResponse, SdoValue};
 use crate::wire::{classify, AbortCode, NodeId, Received};
 use crate::CanFrame;
@@ -46,6 +57,46 @@ impl SetupOptions {
             sdo_retries: 2,
             boot_timeout: Duration::from_secs(3),
             heartbeat_ms: 100,
+        }
+    }
+}
+
+/// The profile-velocity parameters of a spindle drive, in drive velocity units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VelocitySetup {
+    /// Profile acceleration 0x6083 and deceleration 0x6084, units/s.
+    pub ramp: u32,
+    /// Quick stop deceleration 0x6085, units/s.
+    pub quick_stop: u32,
+    /// Velocity window 0x606D, units.
+    pub window: u16,
+    /// Velocity window time 0x606E, ms.
+    pub window_ms: u16,
+}
+
+/// One node to configure, with what it is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NodeSetup {
+    /// An axis drive, cyclic synchronous position.
+    Position(NodeId),
+    /// The spindle drive, profile velocity.
+    Velocity(NodeId, VelocitySetup),
+    /// A CiA-401 digital I/O module.
+    Io(NodeId),
+}
+
+impl NodeSetup {
+    pub fn node(&self) -> NodeId {
+        match *self {
+            NodeSetup::Position(n) | NodeSetup::Velocity(n, _) | NodeSetup::Io(n) => n,
+        }
+    }
+
+    pub fn kind(&self) -> NodeKind {
+        match self {
+            NodeSetup::Position(_) => NodeKind::Position,
+            NodeSetup::Velocity(..) => NodeKind::Velocity,
+            NodeSetup::Io(_) => NodeKind::Io,
         }
     }
 }
@@ -206,18 +257,10 @@ impl<L: CanLink> Session<'_, L> {
         }
     }
 
-    fn map_pdo(&mut self, node: NodeId, kind: PdoKind) -> Result<(), SetupError> {
-        let (comm, map, entries) = match kind {
-            PdoKind::Rpdo => (
-                od::RPDO1_COMMUNICATION,
-                od::RPDO1_MAPPING,
-                RPDO1_CSP_MAPPING,
-            ),
-            PdoKind::Tpdo => (
-                od::TPDO1_COMMUNICATION,
-                od::TPDO1_MAPPING,
-                TPDO1_CSP_MAPPING,
-            ),
+    fn map_pdo(&mut self, node: NodeId, kind: PdoKind, entries: &[u32]) -> Result<(), SetupError> {
+        let (comm, map) = match kind {
+            PdoKind::Rpdo => (od::RPDO1_COMMUNICATION, od::RPDO1_MAPPING),
+            PdoKind::Tpdo => (od::TPDO1_COMMUNICATION, od::TPDO1_MAPPING),
         };
         let cob = u32::from(crate::wire::pdo::pdo_cob_id(kind, 1, node).unwrap_or(0));
         self.write(node, comm, 1, SdoValue::U32(cob | od::PDO_COB_ID_INVALID))?;
@@ -229,17 +272,109 @@ impl<L: CanLink> Session<'_, L> {
         self.write(node, comm, 2, SdoValue::U8(od::TRANSMISSION_EVERY_SYNC))?;
         self.write(node, comm, 1, SdoValue::U32(cob))
     }
+
+    /// Modes of operation, written and read back.
+    fn mode(&mut self, node: NodeId, mode: i8) -> Result<(), SetupError> {
+        self.write(node, od::MODES_OF_OPERATION, 0, SdoValue::I8(mode))?;
+        let shown = self.read_i32(node, od::MODES_OF_OPERATION_DISPLAY, 0)?;
+        if shown != i32::from(mode) {
+            let kind = SetupErrorKind::Mismatch {
+                expected: i64::from(mode),
+                got: i64::from(shown),
+            };
+            return Err(SetupError {
+                node: node.get(),
+                object: Some((od::MODES_OF_OPERATION_DISPLAY, 0)),
+                kind,
+            });
+        }
+        Ok(())
+    }
+
+    /// Steps 2 to 6 for one node; returns what the first cyclic target starts from.
+    fn node(&mut self, setup: &NodeSetup, period: (u8, i8)) -> Result<i32, SetupError> {
+        let node = setup.node();
+        let (rpdo, tpdo): (&[u32], &[u32]) = match setup {
+            NodeSetup::Position(_) => (&RPDO1_CSP_MAPPING, &TPDO1_CSP_MAPPING),
+            NodeSetup::Velocity(..) => (&RPDO1_PV_MAPPING, &TPDO1_PV_MAPPING),
+            NodeSetup::Io(_) => (&RPDO1_IO_MAPPING, &TPDO1_IO_MAPPING),
+        };
+        match setup {
+            NodeSetup::Position(_) => {
+                self.mode(node, od::MODE_CSP)?;
+                self.write(
+                    node,
+                    od::INTERPOLATION_TIME_PERIOD,
+                    1,
+                    SdoValue::U8(period.0),
+                )?;
+                self.write(
+                    node,
+                    od::INTERPOLATION_TIME_PERIOD,
+                    2,
+                    SdoValue::I8(period.1),
+                )?;
+            }
+            NodeSetup::Velocity(_, v) => {
+                self.mode(node, od::MODE_PV)?;
+                self.write(node, od::PROFILE_ACCELERATION, 0, SdoValue::U32(v.ramp))?;
+                self.write(node, od::PROFILE_DECELERATION, 0, SdoValue::U32(v.ramp))?;
+                self.write(
+                    node,
+                    od::QUICK_STOP_DECELERATION,
+                    0,
+                    SdoValue::U32(v.quick_stop),
+                )?;
+                self.write(node, od::VELOCITY_WINDOW, 0, SdoValue::U16(v.window))?;
+                self.write(
+                    node,
+                    od::VELOCITY_WINDOW_TIME,
+                    0,
+                    SdoValue::U16(v.window_ms),
+                )?;
+            }
+            NodeSetup::Io(_) => {}
+        }
+        self.map_pdo(node, PdoKind::Rpdo, rpdo)?;
+        self.map_pdo(node, PdoKind::Tpdo, tpdo)?;
+        self.write(
+            node,
+            od::HEARTBEAT_PRODUCER,
+            0,
+            SdoValue::U16(self.opts.heartbeat_ms),
+        )?;
+        match setup {
+            NodeSetup::Position(_) => self.read_i32(node, od::POSITION_ACTUAL, 0),
+            NodeSetup::Velocity(..) => self.read_i32(node, od::VELOCITY_ACTUAL, 0),
+            NodeSetup::Io(_) => Ok(self.read_i32(node, od::DIGITAL_INPUTS, 1)? & 0xFF),
+        }
+    }
 }
 
-/// Configure every node on one bus and start them. Returns each node's actual position
-/// (counts), in the order of `nodes`, for the first cyclic targets. `observe` sees every
-/// frame that is not the answer being waited for (heartbeats, EMCY, stray PDOs).
+/// Configure every node on one bus, all axis drives, and start them. Returns each node's
+/// actual position (counts), in the order of `nodes`, for the first cyclic targets.
+/// `observe` sees every frame that is not the answer being waited for (heartbeats, EMCY,
+/// stray PDOs).
 pub fn configure<L: CanLink>(
     link: &mut L,
     nodes: &[NodeId],
     opts: &SetupOptions,
     observe: &mut dyn FnMut(&CanFrame),
 ) -> Result<Vec<i32>, SetupError> {
+    let setups: Vec<NodeSetup> = nodes.iter().map(|&n| NodeSetup::Position(n)).collect();
+    configure_nodes(link, &setups, opts, observe)
+}
+
+/// As [`configure`], each node as what it is (axis, spindle, I/O module). Returns what each
+/// node's first cyclic target starts from: actual position, velocity actual, inputs.
+pub fn configure_nodes<L: CanLink>(
+    link: &mut L,
+    setups: &[NodeSetup],
+    opts: &SetupOptions,
+    observe: &mut dyn FnMut(&CanFrame),
+) -> Result<Vec<i32>, SetupError> {
+    let nodes: Vec<NodeId> = setups.iter().map(NodeSetup::node).collect();
+    let nodes = &nodes[..];
     let first = nodes.first().map_or(0, |n| n.get());
     let mut s = Session {
         link,
@@ -293,31 +428,8 @@ pub fn configure<L: CanLink>(
 
     // 2.-6. Per node, over SDO.
     let mut actual = Vec::with_capacity(nodes.len());
-    for &node in nodes {
-        s.write(node, od::MODES_OF_OPERATION, 0, SdoValue::I8(od::MODE_CSP))?;
-        let shown = s.read_i32(node, od::MODES_OF_OPERATION_DISPLAY, 0)?;
-        if shown != i32::from(od::MODE_CSP) {
-            let kind = SetupErrorKind::Mismatch {
-                expected: i64::from(od::MODE_CSP),
-                got: i64::from(shown),
-            };
-            return Err(SetupError {
-                node: node.get(),
-                object: Some((od::MODES_OF_OPERATION_DISPLAY, 0)),
-                kind,
-            });
-        }
-        s.write(node, od::INTERPOLATION_TIME_PERIOD, 1, SdoValue::U8(value))?;
-        s.write(node, od::INTERPOLATION_TIME_PERIOD, 2, SdoValue::I8(exp))?;
-        s.map_pdo(node, PdoKind::Rpdo)?;
-        s.map_pdo(node, PdoKind::Tpdo)?;
-        s.write(
-            node,
-            od::HEARTBEAT_PRODUCER,
-            0,
-            SdoValue::U16(opts.heartbeat_ms),
-        )?;
-        actual.push(s.read_i32(node, od::POSITION_ACTUAL, 0)?);
+    for setup in setups {
+        actual.push(s.node(setup, (value, exp))?);
     }
 
     // 7. Start.
