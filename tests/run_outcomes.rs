@@ -21,15 +21,10 @@ fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
     machine.realtime.feedback_timeout_s = 2.0;
     machine.realtime.heartbeat_timeout_s = 5.0;
     machine.realtime.max_consecutive_overruns = 100_000;
-    let (master_end, sim) = common::sim_drives(&machine, faults);
+    let (links, sim) = common::sim_drives(&machine, faults);
     let opts = common::run_options("paper-example.nc", None);
-    let r = run(
-        DEMO_PROGRAM.as_bytes(),
-        &machine,
-        move || Ok(vec![master_end]),
-        &opts,
-    )
-    .expect("the run starts");
+    let r =
+        run(DEMO_PROGRAM.as_bytes(), &machine, move || Ok(links), &opts).expect("the run starts");
     sim.finish();
     r
 }

@@ -68,6 +68,8 @@ pub struct Setpoint {
     pub joints: Joints,
     /// The program's end point has been reached; this is the last setpoint.
     pub done: bool,
+    /// Spindle and coolant commanded in this period.
+    pub aux: crate::program::Aux,
 }
 
 /// Parameter increment over one period by a Taylor method (paper eq. 9 / eq. 10 with the
@@ -233,6 +235,11 @@ impl<'a> Interpolator<'a> {
             feed: if self.done { 0.0 } else { motion.v },
             joints: self.joints,
             done: self.done,
+            aux: self
+                .path
+                .segments
+                .get(self.seg)
+                .map_or_else(Default::default, |s| s.aux),
         };
         self.cycle += 1;
         sp

@@ -164,11 +164,53 @@ pub struct Wait {
     /// The operator must resume (`M00`, `M01` when optional stops are on, `M06`): where the
     /// first such word stood.
     pub operator: Option<SrcPos>,
+    /// The spindle must be at its commanded speed: the first feed move after `M03`/`M04`
+    /// or a new `S` while turning (set by the segment builder, not the parser).
+    pub spindle: bool,
 }
 
 impl Wait {
     pub fn is_some(&self) -> bool {
-        self.dwell_s > 0.0 || self.operator.is_some()
+        self.dwell_s > 0.0 || self.operator.is_some() || self.spindle
+    }
+}
+
+/// The spindle and coolant commanded while a segment runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Aux {
+    /// rpm, signed: positive after `M03` (clockwise), negative after `M04`, 0 stopped.
+    pub spindle_rpm: f64,
+    /// `M07` until `M09`.
+    pub mist: bool,
+    /// `M08` until `M09`.
+    pub flood: bool,
+}
+
+impl Aux {
+    /// The state after `action`; `true` if the spindle must now reach a new, non-zero
+    /// speed (a start, a reversal, a new `S` while turning).
+    pub fn apply(&mut self, action: &ActionKind) -> bool {
+        let before = self.spindle_rpm;
+        match *action {
+            ActionKind::Spindle { dir, rpm } => {
+                self.spindle_rpm = match dir {
+                    Spindle::Cw => rpm,
+                    Spindle::Ccw => -rpm,
+                    Spindle::Off => 0.0,
+                }
+            }
+            ActionKind::Speed { rpm } if self.spindle_rpm != 0.0 => {
+                self.spindle_rpm = rpm.copysign(self.spindle_rpm);
+            }
+            ActionKind::Coolant(Coolant::Mist) => self.mist = true,
+            ActionKind::Coolant(Coolant::Flood) => self.flood = true,
+            ActionKind::Coolant(Coolant::Off) => {
+                self.mist = false;
+                self.flood = false;
+            }
+            _ => {}
+        }
+        self.spindle_rpm != before && self.spindle_rpm != 0.0
     }
 }
 

@@ -15,7 +15,7 @@ use crate::arclen::ArcTable;
 use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt};
 use crate::nurbs::DoubleNurbs;
 use crate::program::{
-    Block, LengthMode, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait,
+    Aux, Block, LengthMode, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait,
 };
 use nalgebra::Vector3;
 
@@ -120,6 +120,8 @@ pub struct Segment {
     /// Tool length on the machine's Z axis at the start and end, mm; it changes linearly
     /// along a straight move (`G43 Z.. H..`) and stays constant along a curve.
     pub z: (f64, f64),
+    /// Spindle and coolant commanded along the segment (the program's words before it).
+    pub aux: Aux,
     pub geometry: Geometry,
     pub tooling: Tooling,
 }
@@ -271,7 +273,18 @@ pub fn build(
     let mut segments: Vec<Segment> = Vec::with_capacity(program.blocks.len());
     // A wait before a block that moves nothing goes to the next segment.
     let mut wait = Wait::default();
-    for (i, block) in program.blocks.iter().enumerate().skip(1) {
+    // Spindle and coolant: the words up to each block apply along it; the first feed move
+    // after the spindle is started or changes speed waits for it to be at speed.
+    let mut aux = Aux::default();
+    let mut spindle_wait = false;
+    let mut actions = program.actions.iter().peekable();
+    for (i, block) in program.blocks.iter().enumerate() {
+        while let Some(a) = actions.next_if(|a| a.before_block <= i) {
+            spindle_wait = aux.apply(&a.kind) || (spindle_wait && aux.spindle_rpm != 0.0);
+        }
+        if i == 0 {
+            continue;
+        }
         let index = (i + 1) as u32;
         let (tooling, pos) = match block {
             Block::Linear(m) => (m.tooling, m.pos),
@@ -300,7 +313,13 @@ pub fn build(
             first.wait = core::mem::take(&mut wait);
             first.stop |= first.wait.is_some();
         }
-        for seg in segs {
+        for mut seg in segs {
+            seg.aux = aux;
+            if spindle_wait && !seg.rapid {
+                seg.wait.spindle = true;
+                seg.stop = true;
+                spindle_wait = false;
+            }
             // With a vertical tool C is free: choose it where the path leaves the vertical.
             if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
                 if segments.is_empty() {
@@ -309,6 +328,8 @@ pub fn build(
                 } else if (c - joints[4]).abs() > 1e-9 {
                     segments.push(turn_c(&seg, &joints, c));
                     joints[4] = c;
+                    // The turn waits where the segment would have: not a second time.
+                    seg.wait = Wait::default();
                 }
             }
             // The joints at the end are those the interpolator arrives with: follow the
@@ -343,6 +364,7 @@ fn merge(a: Wait, b: Wait) -> Wait {
     Wait {
         dwell_s: a.dwell_s + b.dwell_s,
         operator: a.operator.or(b.operator),
+        spindle: a.spindle || b.spindle,
     }
 }
 
@@ -380,6 +402,7 @@ fn turn_c(seg: &Segment, joints: &Joints, c: f64) -> Segment {
         stop: seg.stop,
         wait: seg.wait,
         z: (seg.z.0, seg.z.0),
+        aux: seg.aux,
         geometry: Geometry::Line { from: p, to: p },
         tooling: Tooling::Angles {
             from: (joints[3], joints[4]),
@@ -499,6 +522,7 @@ fn linear(
         stop: false,
         wait: Wait::default(),
         z: (pose.z, m.tooling.tool_length),
+        aux: Aux::default(),
         geometry: Geometry::Line { from, to },
         tooling,
     }))
@@ -556,6 +580,7 @@ fn nurbs(
                             stop: false,
                             wait: Wait::default(),
                             z: (pose.z, pose.z),
+                            aux: Aux::default(),
                             geometry: Geometry::Line { from: c.p, to: c.p },
                             tooling: Tooling::Slerp {
                                 from: current,
@@ -578,6 +603,7 @@ fn nurbs(
             stop: piece.corner,
             wait: Wait::default(),
             z: (pose.z, pose.z),
+            aux: Aux::default(),
             geometry: Geometry::Nurbs {
                 curve: Box::new(curve),
                 table: Box::new(table),

@@ -21,6 +21,7 @@
 use crate::interp::Setpoint;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::plan::FeedProfile;
+use crate::program::Aux;
 use crate::scurve::{Motion, Phase};
 use crate::segment::{Path, Pose, Segment};
 use heapless::spsc::{Consumer, Producer, Queue};
@@ -270,6 +271,17 @@ pub struct Follower<'q> {
     awaiting: Option<u32>,
     /// Chunks from this index on may still hold an operator stop not yet reached.
     gate_from: usize,
+    /// Hold at the spindle waits ([`Wait::spindle`](crate::program::Wait)) until the
+    /// spindle is at speed; off without a spindle (dry runs).
+    spindle_gates: bool,
+    /// The speed (rpm, signed) the spindle has reached, as last reported.
+    spindle_at: Option<f64>,
+    /// Chunks from this index on may still hold a spindle wait not yet passed.
+    spindle_gate_from: usize,
+    /// Source line of the move that waits for the spindle, while it waits.
+    awaiting_spindle: Option<u32>,
+    /// Spindle and coolant commanded now.
+    aux: Aux,
     done: bool,
     pose: Pose,
     joints: Joints,
@@ -316,6 +328,11 @@ impl<'q> Follower<'q> {
             paused: false,
             awaiting: None,
             gate_from: 0,
+            spindle_gates: false,
+            spindle_at: None,
+            spindle_gate_from: 0,
+            awaiting_spindle: None,
+            aux: Aux::default(),
             done: start.chunks == 0,
             pose: start.pose,
             joints: start.joints,
@@ -354,6 +371,31 @@ impl<'q> Follower<'q> {
     /// [`Self::resume`].
     pub fn awaiting(&self) -> Option<u32> {
         self.awaiting
+    }
+
+    /// Hold at every move that needs the spindle at speed until [`Self::spindle_at_speed`]
+    /// reports that speed (a machine with a spindle drive). Off by default: the spindle
+    /// words then change [`Setpoint::aux`] and nothing waits.
+    pub fn wait_for_spindle(&mut self, on: bool) {
+        self.spindle_gates = on;
+    }
+
+    /// The speed (rpm, signed as [`Aux::spindle_rpm`]) the spindle drive reports it has
+    /// reached, or `None` while it is not at the speed it was sent. Every period, before
+    /// [`Self::advance`].
+    pub fn spindle_at_speed(&mut self, rpm: Option<f64>) {
+        self.spindle_at = rpm;
+    }
+
+    /// The line of the move that waits for the spindle to reach its speed, while it waits.
+    pub fn awaiting_spindle(&self) -> Option<u32> {
+        self.awaiting_spindle
+    }
+
+    /// Spindle and coolant as commanded now: those of the segment being machined, or of
+    /// the one waiting for the spindle.
+    pub fn aux(&self) -> Aux {
+        self.aux
     }
 
     pub fn is_paused(&self) -> bool {
@@ -551,6 +593,28 @@ impl<'q> Follower<'q> {
                 self.gate_from = c.index + 1;
             }
         }
+        // A move that needs the spindle at speed ahead: the plan is at rest where it starts;
+        // command that move's speed there and hold until the drive reports it.
+        self.awaiting_spindle = None;
+        let mut gate_aux = None;
+        let spindle = self
+            .local
+            .iter()
+            .take(2)
+            .find(|c| c.index >= self.spindle_gate_from && c.segment.wait.spindle);
+        if let Some(c) = spindle {
+            if tau >= c.t_start && !self.paused {
+                gate_aux = Some(c.segment.aux);
+                if !self.spindle_gates || self.spindle_at == Some(c.segment.aux.spindle_rpm) {
+                    self.spindle_gate_from = c.index + 1;
+                } else {
+                    tau = c.t_start.max(self.tau);
+                    self.k = 0.0;
+                    self.r = 0.0;
+                    self.awaiting_spindle = Some(c.segment.src.line);
+                }
+            }
+        }
         // Find the chunk that holds tau; bounded by the look-ahead.
         let mut m = self.motion;
         for _ in 0..=LOOKAHEAD {
@@ -588,6 +652,11 @@ impl<'q> Follower<'q> {
         self.tau = tau;
         m.v *= self.k;
         self.motion = m;
+        self.aux = match (gate_aux, self.local.front()) {
+            (Some(a), _) => a,
+            (None, Some(c)) => c.segment.aux,
+            (None, None) => self.aux,
+        };
         self.pending = Pending::Pose(cycle);
     }
 
@@ -656,6 +725,7 @@ impl<'q> Follower<'q> {
             feed: if self.done { 0.0 } else { feed },
             joints: self.joints,
             done: self.done,
+            aux: self.aux,
         }
     }
 }

@@ -215,35 +215,46 @@ pub fn assert_completed(out: &Output) -> u64 {
     overruns
 }
 
-/// Simulated CiA-402 drives for every drive of `machine` on an in-memory link, with
+/// Simulated nodes for every bus of `machine` (its axes' drives, spindle drive and coolant
+/// I/O module, as `dnurbs sim-drives` plays them), each bus on an in-memory link, with
 /// `faults(node)`, at SCHED_FIFO 79 where the privileges allow (as in `dnurbs demo`, so a
-/// loaded machine cannot starve them). Returns the master's end of the link.
+/// loaded machine cannot starve them). Returns the master's ends of the links, bus by bus.
 pub fn sim_drives(
     machine: &config::Machine,
     faults: impl Fn(u8) -> drives::sim::Faults,
-) -> (drives::link::MemLink, drives::sim::SimThread) {
-    let (master_end, drive_end) = drives::link::MemLink::pair(1024);
-    let nodes = machine
-        .drives
-        .iter()
-        .map(|d| {
-            let mut c = drives::sim::SimNodeConfig::new(drives::wire::NodeId::new(d.node).unwrap());
-            c.initial_position = d.offset;
-            c.faults = faults(d.node);
-            c
-        })
-        .collect();
-    let sim = drives::sim::SimThread::start_with(
-        drive_end,
-        nodes,
-        machine.period_s,
-        std::time::Duration::from_micros(200),
-        || {
-            let _ = rt_loop::os::set_fifo(79);
-        },
-    )
-    .expect("simulated drives");
-    (master_end, sim)
+) -> (Vec<drives::link::MemLink>, Sims) {
+    let mut links = Vec::new();
+    let mut sims = Vec::new();
+    for bus in 0..machine.buses.len() {
+        let (master_end, drive_end) = drives::link::MemLink::pair(1024);
+        let mut nodes = dnurbs_tools::simdrives::sim_nodes(machine, bus, 0.0, &Default::default());
+        for n in nodes.iter_mut() {
+            n.faults = faults(n.node.get());
+        }
+        let sim = drives::sim::SimThread::start_with(
+            drive_end,
+            nodes,
+            machine.period_s,
+            std::time::Duration::from_micros(200),
+            || {
+                let _ = rt_loop::os::set_fifo(79);
+            },
+        )
+        .expect("simulated drives");
+        links.push(master_end);
+        sims.push(sim);
+    }
+    (links, Sims(sims))
+}
+
+/// The simulated buses of [`sim_drives`].
+pub struct Sims(Vec<drives::sim::SimThread>);
+
+impl Sims {
+    /// Stops every bus; what every node recorded, bus by bus.
+    pub fn finish(self) -> Vec<drives::sim::Record> {
+        self.0.into_iter().flat_map(|s| s.finish()).collect()
+    }
 }
 
 /// Run options of the tests: approach, the controller at SCHED_FIFO 80 where allowed, no

@@ -15,7 +15,9 @@ use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
 use drives::link::{CanLink, MemLink, SocketLink};
-use drives::master::{configure, Master, SetupOptions, Supervision};
+use drives::master::{
+    configure_nodes, Master, NodeSetup, SetupOptions, Supervision, VelocitySetup,
+};
 use drives::wire::NodeId;
 use nc::plan::plan;
 use nc::segment::build;
@@ -195,6 +197,36 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
     Ok(())
 }
 
+/// How long the spindle's velocity must stay in its window before the drive reports the
+/// speed reached (0x606E), ms.
+pub const AT_SPEED_WINDOW_MS: u16 = 100;
+
+/// The nodes of bus `bus` in the master's order: the axes' drives (X Y Z tilt C), then the
+/// spindle drive, then the coolant I/O module.
+pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
+    let mut v: Vec<NodeSetup> = machine
+        .drives
+        .iter()
+        .filter(|d| d.bus == bus)
+        .filter_map(|d| NodeId::new(d.node).map(NodeSetup::Position))
+        .collect();
+    if let Some(s) = machine.spindle.as_ref().filter(|s| s.bus == bus) {
+        if let Some(n) = NodeId::new(s.node) {
+            let setup = VelocitySetup {
+                ramp: s.ramp_units(s.acceleration_rpm_s),
+                quick_stop: s.ramp_units(s.quick_stop_rpm_s),
+                window: s.window_units(),
+                window_ms: AT_SPEED_WINDOW_MS,
+            };
+            v.push(NodeSetup::Velocity(n, setup));
+        }
+    }
+    if let Some(c) = machine.coolant.as_ref().filter(|c| c.bus == bus) {
+        v.extend(NodeId::new(c.node).map(NodeSetup::Io));
+    }
+    v
+}
+
 /// Run `src` on `machine`. `open_links` gives one link per `[[bus]]` (in the machine file's
 /// order); it is called once the program has been parsed, built and planned, so a bad
 /// program is reported before anything touches the bus.
@@ -303,17 +335,23 @@ pub fn run<L: CanLink + Send>(
                     .filter(|d| d.bus == bi)
                     .cloned()
                     .collect();
-                let nodes: Vec<NodeId> =
-                    drives.iter().filter_map(|d| NodeId::new(d.node)).collect();
+                let setups = node_setups(machine, bi);
                 let bus_name = &machine.buses[bi].interface;
-                let initial = configure(&mut link, &nodes, &sopts, &mut |_| {})
+                let initial = configure_nodes(&mut link, &setups, &sopts, &mut |_| {})
                     .map_err(|e| anyhow::anyhow!("drive set-up on {bus_name}: {e}"))?;
-                let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9)
+                let kinds: Vec<_> = setups.iter().map(|s| (s.node(), s.kind())).collect();
+                let now = os::now() as f64 * 1e-9;
+                let master = Master::with_kinds(link, &kinds, &initial, sup, now)
                     .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives on one bus"))?;
-                buses.push(
-                    BusDrives::new(master, &drives)
-                        .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives"))?,
-                );
+                let mut bus = BusDrives::new(master, &drives)
+                    .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives"))?;
+                if let Some(s) = machine.spindle.as_ref().filter(|s| s.bus == bi) {
+                    bus = bus.with_spindle(s.clone());
+                }
+                if let Some(c) = machine.coolant.as_ref().filter(|c| c.bus == bi) {
+                    bus = bus.with_coolant(c.clone());
+                }
+                buses.push(bus);
             }
             let end_counts: Vec<Option<i32>> = buses
                 .iter()
@@ -521,16 +559,7 @@ fn demo_on<L: CanLink + Send + 'static>(
     let mut sims = Vec::new();
     for bi in 0..machine.buses.len() {
         let (master_end, drive_end) = pair()?;
-        let nodes = machine
-            .drives
-            .iter()
-            .filter(|d| d.bus == bi)
-            .filter_map(|d| {
-                let mut c = drives::sim::SimNodeConfig::new(NodeId::new(d.node)?);
-                c.initial_position = d.offset;
-                Some(c)
-            })
-            .collect();
+        let nodes = crate::simdrives::sim_nodes(machine, bi, 0.0, &Default::default());
         // The drives answer within their cycle: with real-time privileges their thread runs
         // SCHED_FIFO one priority below the controller's, so a loaded host cannot starve it.
         let below = opts.rt.priority.map(|p| (p - 1).max(1));

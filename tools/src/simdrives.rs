@@ -1,6 +1,8 @@
 //! `dnurbs sim-drives`: one process that plays every drive of a machine's bus on a CAN
 //! interface (boot-up, NMT slave, SDO server, PDO mapping, CiA-402 state machine, CSP motor
-//! model, heartbeats), with fault injection, recording every target it receives.
+//! model, heartbeats), with fault injection, recording every target it receives; and the
+//! spindle drive (profile velocity: speed ramp, at-speed bit) and the coolant I/O module
+//! (CiA-401 outputs) where the machine file puts them on that bus.
 //!
 //! Records are flushed to the `--record` file every 100 ms, so the file is complete up to
 //! the last flush whenever the process is stopped (Ctrl-C or SIGTERM need no handler).
@@ -55,6 +57,43 @@ pub fn node_value<T: std::str::FromStr>(s: &str) -> Result<(u8, T), String> {
     Ok((node, value))
 }
 
+/// The simulated nodes of bus `bus`: the axes' drives (at their `offset`), the spindle
+/// drive, the coolant I/O module.
+pub fn sim_nodes(
+    m: &config::Machine,
+    bus: usize,
+    lag_s: f64,
+    faults: &FaultArgs,
+) -> Vec<SimNodeConfig> {
+    let mut nodes: Vec<SimNodeConfig> = m
+        .drives
+        .iter()
+        .filter(|d| d.bus == bus)
+        .filter_map(|d| {
+            let mut c = SimNodeConfig::new(NodeId::new(d.node)?);
+            c.initial_position = d.offset;
+            c.lag_s = lag_s;
+            c.faults = faults.for_node(d.node);
+            Some(c)
+        })
+        .collect();
+    if let Some(s) = m.spindle.as_ref().filter(|s| s.bus == bus) {
+        if let Some(n) = NodeId::new(s.node) {
+            let mut c = SimNodeConfig::new(n);
+            c.faults = faults.for_node(s.node);
+            nodes.push(c);
+        }
+    }
+    if let Some(io) = m.coolant.as_ref().filter(|c| c.bus == bus) {
+        if let Some(n) = NodeId::new(io.node) {
+            let mut c = SimNodeConfig::io(n);
+            c.faults = faults.for_node(io.node);
+            nodes.push(c);
+        }
+    }
+    nodes
+}
+
 pub struct SimArgs {
     pub iface: String,
     pub machine: config::Machine,
@@ -81,18 +120,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
                 args.iface
             ))
         })?;
-    let nodes: Vec<SimNodeConfig> = m
-        .drives
-        .iter()
-        .filter(|d| d.bus == bus)
-        .filter_map(|d| {
-            let mut c = SimNodeConfig::new(NodeId::new(d.node)?);
-            c.initial_position = d.offset;
-            c.lag_s = args.lag_ns as f64 * 1e-9;
-            c.faults = args.faults.for_node(d.node);
-            Some(c)
-        })
-        .collect();
+    let nodes = sim_nodes(m, bus, args.lag_ns as f64 * 1e-9, &args.faults);
     let mut link = SocketLink::open(&args.iface)
         .map_err(|e| anyhow::anyhow!("cannot open CAN interface {:?}: {e}", args.iface))?;
     let mut record = match &args.record {

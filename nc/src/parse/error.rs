@@ -154,6 +154,10 @@ pub enum ParseErrorKind {
     BadNumber { letter: char, value: f64 },
     #[error("spindle speed S{value} must be from 0 to 1000000 rpm")]
     BadSpeed { value: f64 },
+    #[error(
+        "spindle speed S{value} is above the spindle's maximum of {max} rpm ([spindle] max_rpm)"
+    )]
+    SpeedAboveMax { value: f64, max: f64 },
     #[error("G04 needs the dwell time: P<seconds> or X<seconds>")]
     DwellWithoutTime,
     #[error("dwell of {value} s must be from 0 to {MAX_DWELL_S} s (P and X are seconds here; a post that writes P in milliseconds must be set to seconds)")]

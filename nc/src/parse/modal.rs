@@ -34,6 +34,9 @@ pub struct Setup {
     /// axes away from 0 (the tool tip's workpiece coordinates then follow from the machine
     /// coordinates only through it). Without it those are refused.
     pub kinematics: Option<crate::kinematics::MachineKinematics>,
+    /// The spindle's highest speed (rpm), where the machine has a spindle drive: an `S`
+    /// above it is an error. `None`: any speed up to the language's range is reported only.
+    pub max_rpm: Option<f64>,
 }
 
 /// The modal state of the language besides motion and feed.

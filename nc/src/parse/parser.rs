@@ -302,6 +302,13 @@ impl<'s> Parser<'s> {
             if !(0.0..=MAX_RPM).contains(&s.value) {
                 return Err(ParseErrorKind::BadSpeed { value: s.value }.at(s.pos));
             }
+            if let Some(max) = self.setup.max_rpm.filter(|&m| s.value > m) {
+                return Err(ParseErrorKind::SpeedAboveMax {
+                    value: s.value,
+                    max,
+                }
+                .at(s.pos));
+            }
             self.modal.rpm = s.value;
             if line.code_of_group(12).is_none() {
                 self.act(s.pos, ActionKind::Speed { rpm: s.value });

@@ -18,6 +18,14 @@
 //! 5. **Disabling**: the CiA-402 disable sequence; the run ends when every drive has left
 //!    Operation enabled.
 //!
+//! **Spindle and coolant**: where a bus carries them ([`BusDrives::with_spindle`],
+//! [`BusDrives::with_coolant`]) the spindle drive is sent the speed and the I/O module the
+//! coolant outputs the interpolator commands ([`nc::interp::Setpoint::aux`]); both are off
+//! outside the program and once it is at rest (end or stop), and the drives are disabled
+//! only after the spindle has stopped. A move that needs the spindle at speed waits for the
+//! drive to report it (target reached, bit 10, and its velocity within the window) and the
+//! run stops there if it does not within `[spindle] at_speed_timeout_s`.
+//!
 //! A drive fault is handled by the master itself (quick stop, then disable, every target
 //! held at the last one commanded); the pipeline stops interpolating and waits for that to
 //! end. A drive lost to its supervision does not hold the run up.
@@ -35,11 +43,12 @@ use approach::Approach;
 pub use approach::ApproachLimits;
 use config::bus::Drive;
 pub use drive_loop::{drive_loop, GAP_NS};
-use drives::cia402::{Goal, State};
+use drives::cia402::{Goal, State, Statusword};
 use drives::link::CanLink;
-use drives::master::{DriveFault, Master, MAX_NODES};
+use drives::master::{DriveFault, Master, NodeKind, NodeStatus, MAX_NODES};
 use heapless::Vec as HVec;
 use nc::kinematics::Joints;
+use nc::program::Aux;
 use nc::stream::Follower;
 
 /// A drive within this distance of the program's start (mm or degrees) is at the start.
@@ -77,6 +86,17 @@ pub enum StopReason {
          stopped along the path, drives disabled"
     )]
     Overruns(u64),
+    #[error(
+        "line {line}: the spindle did not reach {rpm:.0} rpm within {timeout_s} s ([spindle] \
+         at_speed_timeout_s; it turns at {actual_rpm:.0} rpm); stopped before the move, \
+         drives disabled"
+    )]
+    SpindleNotAtSpeed {
+        line: u32,
+        rpm: f64,
+        actual_rpm: f64,
+        timeout_s: f64,
+    },
 }
 
 impl StopReason {
@@ -97,8 +117,12 @@ impl StopReason {
 /// The drives of one bus and the master driving them.
 pub struct BusDrives<L: CanLink> {
     pub master: Master<L>,
-    /// In the master's node order.
+    /// The axes' drives, first in the master's node order.
     pub drives: HVec<Drive, MAX_NODES>,
+    /// The spindle drive and its index in the master's node order (after the axes).
+    pub spindle: Option<(usize, config::Spindle)>,
+    /// The coolant I/O module and its index in the master's node order (last).
+    pub coolant: Option<(usize, config::Coolant)>,
     targets: [i32; MAX_NODES],
 }
 
@@ -116,8 +140,37 @@ impl<L: CanLink> BusDrives<L> {
         Some(BusDrives {
             master,
             drives: v,
+            spindle: None,
+            coolant: None,
             targets,
         })
+    }
+
+    /// The spindle drive is the master's node after the axes' drives.
+    pub fn with_spindle(mut self, spindle: config::Spindle) -> Self {
+        self.spindle = Some((self.drives.len(), spindle));
+        self
+    }
+
+    /// The coolant I/O module is the master's node after the drives (and the spindle).
+    pub fn with_coolant(mut self, coolant: config::Coolant) -> Self {
+        let i = self.drives.len() + usize::from(self.spindle.is_some());
+        self.coolant = Some((i, coolant));
+        self
+    }
+
+    /// Spindle speed and coolant outputs as targets.
+    fn set_aux(&mut self, aux: &Aux) {
+        if let Some((i, s)) = &self.spindle {
+            if let Some(t) = self.targets.get_mut(*i) {
+                *t = s.velocity(aux.spindle_rpm);
+            }
+        }
+        if let Some((i, c)) = &self.coolant {
+            if let Some(t) = self.targets.get_mut(*i) {
+                *t = i32::from(c.outputs(aux.mist, aux.flood));
+            }
+        }
     }
 }
 
@@ -174,6 +227,12 @@ pub struct Pipeline<'q, L: CanLink> {
     max_overruns: u64,
     /// The operator's commands, if a control socket serves them.
     commands: Option<Consumer<'q, Command>>,
+    /// Spindle and coolant sent this period.
+    aux: Aux,
+    /// Periods a move has waited for the spindle.
+    spindle_wait: u64,
+    /// Most periods at rest at the end for the drives (and the spindle) to settle.
+    settle_limit: u64,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
@@ -234,7 +293,20 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 None
             }
         };
+        let spindle = buses
+            .iter()
+            .find_map(|b| b.spindle.as_ref().map(|s| s.1.clone()));
+        let mut follower = follower;
+        follower.wait_for_spindle(spindle.is_some());
+        // Stopping the spindle from full speed bounds the wait at the end.
+        let settle_limit = spindle.map_or(SETTLE_CYCLES, |s| {
+            let stop_s = s.max_rpm / s.acceleration_rpm_s + 1.0;
+            SETTLE_CYCLES.max((stop_s / period).ceil() as u64)
+        });
         Ok(Pipeline {
+            aux: Aux::default(),
+            spindle_wait: 0,
+            settle_limit,
             follower,
             buses,
             stage: Stage::Enabling,
@@ -400,21 +472,60 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         }
     }
 
-    /// Every drive within one count of its target.
+    /// Every axis within one count of its target, the spindle at its speed.
     fn settled(&self) -> bool {
         self.buses.iter().all(|b| {
             b.master
                 .status()
                 .iter()
                 .zip(&b.targets)
-                .all(|(s, t)| (s.actual.wrapping_sub(*t)).abs() <= 1)
+                .all(|(s, t)| match (s.kind, &b.spindle) {
+                    (NodeKind::Position, _) => (s.actual.wrapping_sub(*t)).abs() <= 1,
+                    (NodeKind::Velocity, Some((_, sp))) => {
+                        i64::from(s.actual).abs_diff(i64::from(*t)) <= u64::from(sp.window_units())
+                    }
+                    _ => true,
+                })
         })
     }
 
+    /// Every CiA-402 drive's state satisfies `f` (I/O modules have none).
     fn all_in(&self, f: impl Fn(State) -> bool) -> bool {
-        self.buses
-            .iter()
-            .all(|b| b.master.status().iter().all(|s| s.state.is_some_and(&f)))
+        self.buses.iter().all(|b| {
+            b.master
+                .status()
+                .iter()
+                .all(|s| s.kind == NodeKind::Io || s.state.is_some_and(&f))
+        })
+    }
+
+    /// The spindle drive's status and configuration, if the machine has one.
+    fn spindle(&self) -> Option<(&NodeStatus, &config::Spindle)> {
+        self.buses.iter().find_map(|b| {
+            let (i, s) = b.spindle.as_ref()?;
+            Some((b.master.status().get(*i)?, s))
+        })
+    }
+
+    /// The speed the spindle has reached, if it is the one sent: Operation enabled, target
+    /// reached (bit 10) and the velocity actual within the window of it.
+    fn spindle_at_speed(&self) -> Option<f64> {
+        let (st, sp) = self.spindle()?;
+        let want = sp.velocity(self.aux.spindle_rpm);
+        let within = i64::from(st.actual).abs_diff(i64::from(want)) <= u64::from(sp.window_units());
+        (st.state == Some(State::OperationEnabled)
+            && st.target == want
+            && Statusword(st.statusword).target_reached()
+            && within)
+            .then_some(self.aux.spindle_rpm)
+    }
+
+    /// Send `aux` from this period on.
+    fn command_aux(&mut self, aux: Aux) {
+        self.aux = aux;
+        for b in self.buses.iter_mut() {
+            b.set_aux(&aux);
+        }
     }
 
     /// The interpolation step of the coming period, while the program runs: feed, override
@@ -429,14 +540,20 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         if self.prepared.is_some() || !matches!(self.stage, Stage::Running | Stage::Stopping) {
             return;
         }
+        let at_speed = self.spindle_at_speed();
+        self.follower.spindle_at_speed(at_speed);
         self.follower.advance();
         let t0 = os::now();
         let sp = self.follower.evaluate();
         let axes = self.joints_to_axes(&sp.joints);
         let overflow = self.set_targets(&axes).err();
+        let compute_ns = os::now().saturating_sub(t0);
+        let at_rest = sp.done || self.follower.is_stopped();
+        // At the end, or stopped: spindle and coolant off.
+        self.command_aux(if at_rest { Aux::default() } else { sp.aux });
         self.prepared = Some(Prepared {
-            compute_ns: os::now().saturating_sub(t0),
-            at_rest: sp.done || self.follower.is_stopped(),
+            compute_ns,
+            at_rest,
             overflow,
         });
     }
@@ -494,14 +611,16 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                     if let Some(r) = p.overflow {
                         self.stop(r);
                     }
+                    self.spindle_timeout();
                     if self.reason.is_some() && self.stage == Stage::Running {
                         self.enter(Stage::Stopping);
                     }
-                    // At rest: let the drives reach the last target (their own lag) before
-                    // disabling, so they stop where the path ends; bounded by SETTLE_CYCLES.
+                    // At rest: let the drives reach the last target (their own lag) and the
+                    // spindle stop before disabling, so they stop where the path ends;
+                    // bounded by SETTLE_CYCLES (longer with a spindle: its ramp down).
                     if p.at_rest {
                         self.settle += 1;
-                        if self.settled() || self.settle > SETTLE_CYCLES {
+                        if self.settled() || self.settle > self.settle_limit {
                             self.enter(Stage::Disabling);
                         }
                     }
@@ -544,6 +663,9 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             }
             Stage::Finished => {}
         }
+        if !matches!(self.stage, Stage::Running | Stage::Stopping) {
+            self.command_aux(Aux::default());
+        }
         if self.stage == Stage::Enabling && self.cycles == 1 {
             for b in self.buses.iter_mut() {
                 b.master.set_goal(Goal::Enabled);
@@ -572,6 +694,29 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         CycleInfo {
             compute_ns,
             finished: self.stage == Stage::Finished,
+        }
+    }
+
+    /// A move waiting for the spindle longer than `[spindle] at_speed_timeout_s` stops the
+    /// run (the path is at rest there).
+    fn spindle_timeout(&mut self) {
+        let Some(line) = self.follower.awaiting_spindle() else {
+            self.spindle_wait = 0;
+            return;
+        };
+        self.spindle_wait += 1;
+        let Some((st, sp)) = self.spindle() else {
+            return;
+        };
+        let timeout_s = sp.at_speed_timeout_s;
+        if self.spindle_wait as f64 * self.period > timeout_s && self.reason.is_none() {
+            let reason = StopReason::SpindleNotAtSpeed {
+                line,
+                rpm: self.aux.spindle_rpm,
+                actual_rpm: sp.rpm(st.actual),
+                timeout_s,
+            };
+            self.stop(reason);
         }
     }
 

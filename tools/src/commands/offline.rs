@@ -92,13 +92,21 @@ pub fn busload(machine: &Path) -> anyhow::Result<Outcome> {
             .filter(|d| d.bus == i)
             .map(|d| format!("{}=node {}", m.axes.all()[d.axis].0, d.node))
             .collect();
-        let n = drives.len() as u32;
+        let mut drives = drives;
+        if let Some(s) = m.spindle.as_ref().filter(|s| s.bus == i) {
+            drives.push(format!("spindle=node {}", s.node));
+        }
+        if let Some(c) = m.coolant.as_ref().filter(|c| c.bus == i) {
+            drives.push(format!("coolant I/O=node {}", c.node));
+        }
+        let n = m.bus_nodes(i);
         println!(
-            "bus {} ({}, {} bit/s): {} drives [{}]: {} bits per cycle, load {:.2} % (max {:.0} %)",
+            "bus {} ({}, {} bit/s): {} drives{} [{}]: {} bits per cycle, load {:.2} % (max {:.0} %)",
             b.name,
             b.interface,
             b.bitrate,
-            n,
+            n.drives,
+            if n.io > 0 { " + 1 I/O module" } else { "" },
             drives.join(", "),
             config::bus::cycle_bits(n),
             config::bus::load(n, b.bitrate, m.period_s) * 100.0,

@@ -335,3 +335,54 @@ fn every_error_of_a_program_is_reported_with_its_line() {
     assert_eq!(e.errors.len(), super::super::MAX_ERRORS);
     assert!(e.more);
 }
+
+#[test]
+fn a_speed_above_the_spindles_maximum_is_an_error_with_its_line() {
+    let setup = Setup {
+        max_rpm: Some(24000.0),
+        ..Setup::default()
+    };
+    let src = "G00 X0 Y0 Z0\nS24000 M03\nS30000\nG01 X1 F100\nM04 S25000\n";
+    let e = parse_with(src, &setup).unwrap_err();
+    let at: Vec<String> = e.errors.iter().map(|x| x.pos.to_string()).collect();
+    assert_eq!(at, ["3:1", "5:5"], "{:?}", e.errors);
+    assert!(
+        e.errors[0]
+            .to_string()
+            .contains("S30000 is above the spindle's maximum of 24000 rpm ([spindle] max_rpm)"),
+        "{}",
+        e.errors[0]
+    );
+    // Without a spindle on the machine the speed is only reported.
+    assert!(parse_with(src, &Setup::default()).is_ok());
+}
+
+/// Spindle and coolant along the segments: the words before each block apply along it; the
+/// first feed move after a start, a reversal or a new speed waits for the spindle (rapids
+/// before it do not), and a stop clears the wait.
+#[test]
+fn segments_carry_spindle_and_coolant_and_the_first_feed_move_waits() {
+    let (kin, _, limits) = crate::interp::tests::machine();
+    let src = "G00 X0 Y0 Z50\nS8000 M03 M08\nG00 X10\nG01 X20 F600\nG01 X30\n\
+               S9000\nG01 X40\nM05 M09\nS100 M03\nM05\nG01 X50\nM04\nG00 X60\nG01 X70\n";
+    let p = parse_with(src, &Setup::default()).unwrap();
+    let path = crate::segment::build(&p, &kin, &limits).unwrap();
+    let seen: Vec<(u32, f64, bool, bool)> = path
+        .segments
+        .iter()
+        .map(|s| (s.src.line, s.aux.spindle_rpm, s.aux.flood, s.wait.spindle))
+        .collect();
+    assert_eq!(
+        seen,
+        [
+            (3, 8000.0, true, false),
+            (4, 8000.0, true, true),
+            (5, 8000.0, true, false),
+            (7, 9000.0, true, true),
+            (11, 0.0, false, false),
+            (13, -100.0, false, false),
+            (14, -100.0, false, true),
+        ]
+    );
+    assert!(path.segments.iter().all(|s| s.stop || !s.wait.spindle));
+}
