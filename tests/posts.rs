@@ -240,14 +240,7 @@ fn spindle_at_speed_before_the_first_feed_move(
     records: &PerNode,
 ) -> usize {
     let spindle = m.spindle.as_ref().unwrap();
-    let rpm = prog
-        .actions
-        .iter()
-        .find_map(|a| match a.kind {
-            nc::program::ActionKind::Spindle { rpm, .. } if rpm > 0.0 => Some(rpm),
-            _ => None,
-        })
-        .unwrap();
+    let rpm = common::first_spindle_rpm(prog).unwrap();
     let at = first_feed_start(m, prog);
     let axis = |k: usize| -> Vec<i32> {
         m.drives

@@ -171,13 +171,7 @@ fn run_on_vcan(program: &str) {
         );
     }
     // The actual positions at the end, as printed by `run`.
-    for line in stdout.lines().filter(|l| l.starts_with("axis ")) {
-        let n: Vec<i64> = line
-            .split_whitespace()
-            .filter_map(|w| w.trim_end_matches(':').parse().ok())
-            .collect();
-        assert!((n[2] - n[3]).abs() <= 1, "{line}");
-    }
+    common::assert_axes_settled(&stdout);
     println!(
         "{program}: {checked} targets checked against {} trace rows, all within 2 counts",
         path.len()
@@ -194,4 +188,130 @@ fn vcan_run_paper_example_follows_the_interpolated_path() {
 #[ignore = "needs a SocketCAN interface: run by tests/vcan/run in the PREEMPT_RT guest"]
 fn vcan_run_multi_block_program_follows_the_interpolated_path() {
     run_on_vcan("two-blocks-g2.nc");
+}
+
+/// A CAM post (hyperMILL style, 5-axis, G93, RTCP) on the posts machine: axis drives on
+/// vcan0, the spindle drive and the coolant I/O module on vcan1, each bus played by its own
+/// `dnurbs sim-drives` process. The spindle drive is commanded the program's speed and
+/// stopped at the end, the coolant valves are switched on and off again, and the axes end
+/// at the program's end.
+#[test]
+#[ignore = "needs vcan0 and vcan1: run by tests/vcan/run in the PREEMPT_RT guest"]
+fn vcan_run_cam_post_with_spindle_and_coolant_on_the_bus() {
+    let out = out_dir();
+    let posts = common::root().join("tests/data/posts");
+    // The posts machine with the vcan guest's supervision: the guest is emulated (10-50x
+    // slower), so feedback and heartbeats may be late by far more than on a real bus.
+    let text = std::fs::read_to_string(posts.join("machine.toml")).unwrap();
+    let text = text
+        .replace("heartbeat_timeout_ms = 300", "heartbeat_timeout_ms = 3000")
+        .replace("feedback_timeout_ms = 20 ", "feedback_timeout_ms = 3000 ")
+        .replace("boot_timeout_ms = 3000", "boot_timeout_ms = 10000")
+        .replace("sdo_timeout_ms = 200", "sdo_timeout_ms = 2000")
+        .replace(
+            "[realtime]\n",
+            "[realtime]\nmax_consecutive_overruns = 1000  # the emulated guest: exit 5\n",
+        );
+    let machine_file = out.join("posts-machine-vcan.toml");
+    std::fs::write(&machine_file, &text).unwrap();
+    let machine = config::load(&machine_file).expect("posts machine file");
+    assert_eq!(
+        machine.realtime.feedback_timeout_s, 3.0,
+        "the guest's timeouts apply"
+    );
+    let program = posts.join("hypermill-5axis-g93.nc");
+    let bin = env!("CARGO_BIN_EXE_dnurbs");
+    let mut sims = Vec::new();
+    for (iface, file) in [
+        ("vcan0", "post-axes.csv"),
+        ("vcan1", "post-spindle-coolant.csv"),
+    ] {
+        let sim = Command::new(bin)
+            .args(["sim-drives", "--iface", iface, "--machine"])
+            .arg(&machine_file)
+            .arg("--record")
+            .arg(out.join(file))
+            .spawn()
+            .expect("start dnurbs sim-drives");
+        sims.push(sim);
+    }
+    std::thread::sleep(Duration::from_millis(500));
+    let report = out.join("run-post-report");
+    let run = Command::new(bin)
+        .arg("run")
+        .arg(&program)
+        .arg("--machine")
+        .arg(&machine_file)
+        .arg("--tools")
+        .arg(posts.join("tool.tbl"))
+        .arg("--approach")
+        .arg("--report")
+        .arg(&report)
+        .output()
+        .expect("dnurbs run");
+    std::thread::sleep(Duration::from_millis(400));
+    for mut sim in sims {
+        let _ = Command::new("kill").arg(sim.id().to_string()).status();
+        let _ = sim.wait();
+    }
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    println!("dnurbs run {}:\n{stdout}{stderr}", program.display());
+    common::assert_completed(&run);
+    assert!(stdout.contains("outcome: completed"), "{stdout}");
+
+    // The program's first speed, from its own words.
+    let parse = dnurbs_tools::shop::parse_setup(
+        &machine,
+        &dnurbs_tools::shop::ShopArgs {
+            tools: Some(posts.join("tool.tbl")),
+            ..Default::default()
+        }
+        .load()
+        .unwrap(),
+    );
+    let prog = dnurbs_tools::load_program(&program, &parse).unwrap();
+    let rpm = common::first_spindle_rpm(&prog).expect("the post starts the spindle");
+    let spindle = machine.spindle.as_ref().unwrap();
+    let coolant = machine.coolant.as_ref().unwrap();
+    // sync, node, target, actual, statusword per line.
+    let text = std::fs::read_to_string(out.join("post-spindle-coolant.csv")).unwrap();
+    let rows: Vec<[i64; 5]> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<i64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            [f[0], f[1], f[2], f[3], f[4]]
+        })
+        .collect();
+    let of = |node: u8| -> Vec<[i64; 5]> {
+        rows.iter()
+            .filter(|r| r[1] == i64::from(node))
+            .copied()
+            .collect()
+    };
+    let (sp, io) = (of(spindle.node), of(coolant.node));
+    let want = i64::from(spindle.velocity(rpm));
+    assert!(
+        sp.iter().any(|r| r[2] == want && (r[3] - want).abs() <= 1),
+        "the spindle never ran at {want}"
+    );
+    assert!(
+        sp.iter().any(|r| r[2] == want && r[4] & (1 << 10) != 0),
+        "the spindle drive never reported the speed reached"
+    );
+    let last = sp.last().unwrap();
+    assert_eq!((last[2], last[3]), (0, 0), "the spindle ends stopped");
+    assert!(
+        io.iter().any(|r| r[2] != 0 && r[3] == r[2]),
+        "the coolant outputs were never switched on"
+    );
+    assert_eq!(io.last().unwrap()[2], 0, "the coolant ends off");
+    // The axes end where they were sent (the run prints target and actual per axis).
+    common::assert_axes_settled(&stdout);
+    println!(
+        "post: spindle {} SYNCs recorded (at {want} units), coolant {} SYNCs",
+        sp.len(),
+        io.len()
+    );
 }

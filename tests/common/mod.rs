@@ -276,3 +276,22 @@ pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::R
         shop: Default::default(),
     }
 }
+
+/// The first spindle speed a program starts (`M03`/`M04` with a speed above 0), rpm.
+pub fn first_spindle_rpm(prog: &nc::program::Program) -> Option<f64> {
+    prog.actions.iter().find_map(|a| match a.kind {
+        nc::program::ActionKind::Spindle { rpm, .. } if rpm > 0.0 => Some(rpm),
+        _ => None,
+    })
+}
+
+/// Every `axis ... target T actual A ...` line `dnurbs run` printed has |T - A| <= 1 count.
+pub fn assert_axes_settled(stdout: &str) {
+    for line in stdout.lines().filter(|l| l.starts_with("axis ")) {
+        let n: Vec<i64> = line
+            .split_whitespace()
+            .filter_map(|w| w.trim_end_matches(':').parse().ok())
+            .collect();
+        assert!((n[2] - n[3]).abs() <= 1, "{line}");
+    }
+}

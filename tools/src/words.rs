@@ -53,7 +53,8 @@ pub fn text(words: &[String]) -> String {
         return String::new();
     }
     let mut s = format!(
-        "program words without axes: {} (this machine has no spindle or coolant drive: reported only)\n",
+        "program words without axes: {} (spindle and coolant words drive the machine's [spindle] \
+         and [coolant] where it has them, and are only reported where it has not)\n",
         words.len()
     );
     for w in words {
