@@ -602,16 +602,24 @@ impl<'q> Follower<'q> {
             .iter()
             .take(2)
             .find(|c| c.index >= self.spindle_gate_from && c.segment.wait.spindle);
+        // Paused (the operator's stop at the same place, or a pause on the way there) it
+        // holds there too, but the spindle keeps its command until the run resumes: it never
+        // starts while the operator changes the tool.
         if let Some(c) = spindle {
-            if tau >= c.t_start && !self.paused {
-                gate_aux = Some(c.segment.aux);
-                if !self.spindle_gates || self.spindle_at == Some(c.segment.aux.spindle_rpm) {
+            if tau >= c.t_start {
+                let rpm = c.segment.aux.spindle_rpm;
+                if !self.paused {
+                    gate_aux = Some(c.segment.aux);
+                }
+                if !self.paused && (!self.spindle_gates || self.spindle_at == Some(rpm)) {
                     self.spindle_gate_from = c.index + 1;
                 } else {
                     tau = c.t_start.max(self.tau);
                     self.k = 0.0;
                     self.r = 0.0;
-                    self.awaiting_spindle = Some(c.segment.src.line);
+                    if !self.paused {
+                        self.awaiting_spindle = Some(c.segment.src.line);
+                    }
                 }
             }
         }
@@ -971,5 +979,58 @@ mod tests {
             assert!((c.p - sp.p).norm() < 1e-9);
         }
         check_smooth(&sps, &hold, 400.0 / 60.0, 1.5 * cfg.path_acc + hold.acc);
+    }
+
+    /// A tool change and a spindle start before the same feed move: the path waits for the
+    /// operator with the spindle still stopped, then for the spindle at its speed, then
+    /// goes on; nothing moves while it waits.
+    #[test]
+    fn the_spindle_starts_only_after_the_tool_change_and_the_move_waits_for_its_speed() {
+        let src = "G00 X0 Y0 Z50\nG01 X5 F600\nT2 M06\nS8000 M03 M08\nG01 X20 F600\nM05 M09\n";
+        let (path, profile, hold) = planned(Some(src));
+        let (kin, cfg, _) = machine();
+        let (start, all) = chunks(path, &profile);
+        let mut source = all.into_iter();
+        let mut q = Queues::new();
+        let (mut feeder, inlet) = q.split(16);
+        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+        f.wait_for_spindle(true);
+        feeder.feed(&mut source);
+        let (mut for_operator, mut for_spindle) = (0, 0);
+        let mut last = f.step();
+        for i in 0..20_000u64 {
+            if f.awaiting().is_some() {
+                for_operator += 1;
+                assert_eq!(
+                    last.aux.spindle_rpm, 0.0,
+                    "the spindle started during the tool change"
+                );
+                if for_operator == 100 {
+                    f.resume();
+                }
+            }
+            if let Some(line) = f.awaiting_spindle() {
+                assert_eq!(line, 5);
+                assert_eq!((last.aux.spindle_rpm, last.aux.flood), (8000.0, true));
+                for_spindle += 1;
+                // The drive reports the speed after 200 periods.
+                f.spindle_at_speed((for_spindle >= 200).then_some(8000.0));
+            }
+            let waiting =
+                |f: &Follower<'_>| f.awaiting().is_some() || f.awaiting_spindle().is_some();
+            let before = waiting(&f);
+            let sp = f.step();
+            if before && waiting(&f) {
+                assert_eq!(sp.p, last.p, "moved while waiting at {i}");
+            }
+            last = sp;
+            if sp.done {
+                break;
+            }
+        }
+        feeder.feed(&mut std::iter::empty());
+        assert!(last.done);
+        assert_eq!((for_operator, for_spindle), (100, 200));
+        assert_eq!(last.p.x, 20.0);
     }
 }
