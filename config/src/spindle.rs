@@ -77,10 +77,11 @@ pub struct Coolant {
 }
 
 impl Coolant {
-    /// The byte written to 0x6200:01 (bit 0 = output 1).
+    /// The byte written to 0x6200:01 (bit 0 = output 1). Real-time thread: an output
+    /// outside 1..=8 (which the machine file refuses) switches nothing, it does not panic.
     pub fn outputs(&self, mist: bool, flood: bool) -> u8 {
         let bit = |on: bool, out: Option<u8>| match out {
-            Some(n) if on => 1u8 << (n - 1),
+            Some(n) if on => 1u8.checked_shl(u32::from(n).wrapping_sub(1)).unwrap_or(0),
             _ => 0,
         };
         bit(mist, self.mist_output) | bit(flood, self.flood_output)
