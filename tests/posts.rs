@@ -1,11 +1,13 @@
 //! Programs as CAM post-processors write them (`tests/data/posts`, see its README): each is
 //! accepted unchanged, plans within every limit of the machine, and reports its spindle,
-//! coolant and tool words. Two run against simulated CiA-402 drives on the in-memory link
-//! (the code path of `dnurbs run`); an operator resumes their tool-change stop through the
-//! control socket, and the targets the drives received are checked: within the travel and
-//! the velocity limits by finite differences at the period, ending at the program's end;
-//! the spindle drive at its speed before the first feed move leaves, the coolant valves on
-//! during the cut and off at the end.
+//! coolant and tool words. All five run against simulated CiA-402 drives, spindle drive and
+//! coolant I/O module on the in-memory link (the code path of `dnurbs run`, in real time, at
+//! once); an operator resumes their tool-change stops through the control socket, and what
+//! the nodes received is checked: the axes' targets follow the path `dnurbs simulate`
+//! interpolates to the drives' rounding, within the velocity and acceleration limits by
+//! finite differences at the period, ending at the program's end; the spindle drive at its
+//! speed before the first feed move leaves; the spindle speeds and coolant valves in the
+//! order the program commands them, on during the cut and off at the end.
 
 mod common;
 
@@ -14,6 +16,7 @@ use dnurbs_tools::run::{run, RunOptions};
 use dnurbs_tools::setup::MachineSetup;
 use dnurbs_tools::shop::{parse_setup, ShopArgs};
 use drives::link::MemLink;
+
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -138,7 +141,7 @@ fn resume_every_stop(sock: &Path) -> Vec<u32> {
 }
 
 #[test]
-fn five_axis_posts_run_on_simulated_drives_with_the_operator_resuming_the_tool_change() {
+fn every_post_runs_on_simulated_drives_as_simulated_with_the_spindle_and_coolant_it_commands() {
     let mut m = machine();
     // A spindle slower to reach its speed (6 s to 12000 rpm) than the rapid moves between
     // M03 and the first feed move take: the move must wait for it.
@@ -146,62 +149,285 @@ fn five_axis_posts_run_on_simulated_drives_with_the_operator_resuming_the_tool_c
         s.acceleration_rpm_s = 2000.0;
         s.at_speed_timeout_s = 20.0;
     }
-    let setup = MachineSetup::new(&m);
-    let parse = parse_setup(&m, &shop());
-    for name in ["nx-5axis-g43-4.nc", "hypermill-5axis-g93.nc"] {
-        let prog = dnurbs_tools::load_program(&posts(name), &parse).unwrap();
-        let stops: Vec<u32> = prog
-            .blocks
-            .iter()
-            .filter_map(|b| match b {
-                nc::program::Block::Linear(l) => l.tooling.wait.operator,
-                nc::program::Block::Nurbs(n) => n.tooling.wait.operator,
-            })
-            .map(|p| p.line)
-            .collect();
-        let (resumed, rep, records) = run_post(name, &m);
-        let targets: Vec<Vec<i32>> = records
-            .iter()
-            .map(|r| r.iter().map(|r| r.target_counts).collect())
-            .collect();
-        assert!(
-            rep.exit_code == 0 || rep.exit_code == 5,
-            "{name}: {}",
-            rep.text()
-        );
-        // The first block's wait (a tool change before the first move) is not a stop.
-        let expected: Vec<u32> = match prog.blocks.first() {
-            Some(nc::program::Block::Linear(l)) if l.tooling.wait.operator.is_some() => {
-                stops[1..].to_vec()
-            }
-            _ => stops,
-        };
-        assert_eq!(resumed, expected, "{name}: {}", rep.text());
-        for d in &rep.drives {
-            assert_eq!(Some(d.target_counts), d.program_end_counts, "{name}: {d:?}");
+    // The five run at once (each in real time: the longest takes its 158 s of machining);
+    // every failure is reported, post by post. `DNURBS_POSTS=nx` runs only the posts whose
+    // file name starts with it.
+    let only = std::env::var("DNURBS_POSTS").unwrap_or_default();
+    let runs: Vec<_> = POSTS
+        .into_iter()
+        .filter(|n| n.starts_with(&only))
+        .map(|name| {
+            let m = m.clone();
+            std::thread::Builder::new()
+                .name(name.into())
+                .spawn(move || check_run(name, &m))
+                .unwrap()
+        })
+        .collect();
+    let failed: Vec<String> = runs
+        .into_iter()
+        .filter_map(|h| h.join().err().map(|e| panic_text(&*e)))
+        .collect();
+    assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// The message of a check that panicked (each names its post).
+fn panic_text(e: &(dyn std::any::Any + Send)) -> String {
+    e.downcast_ref::<String>()
+        .cloned()
+        .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+        .unwrap_or_default()
+}
+
+/// One post on simulated drives: the operator resumes every stop, the axes' targets are the
+/// offline interpolation's setpoints, within the velocity and acceleration limits, and the
+/// spindle and coolant follow the program.
+fn check_run(name: &str, m: &config::Machine) {
+    let setup = MachineSetup::new(m);
+    let parse = parse_setup(m, &shop());
+    let prog = dnurbs_tools::load_program(&posts(name), &parse).unwrap();
+    let stops: Vec<u32> = prog
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            nc::program::Block::Linear(l) => l.tooling.wait.operator,
+            nc::program::Block::Nurbs(n) => n.tooling.wait.operator,
+        })
+        .map(|p| p.line)
+        .collect();
+    let (resumed, rep, records) = run_post(name, m);
+    assert!(
+        rep.exit_code == 0 || rep.exit_code == 5,
+        "{name}: {}",
+        rep.text()
+    );
+    // The first block's wait (a tool change before the first move) is not a stop.
+    let expected: Vec<u32> = match prog.blocks.first() {
+        Some(nc::program::Block::Linear(l)) if l.tooling.wait.operator.is_some() => {
+            stops[1..].to_vec()
         }
-        // Velocity by finite differences at the period, in counts, against each axis limit.
-        for (j, d) in m.drives.iter().enumerate() {
-            let t = &targets[usize::from(d.node)];
-            let lim = setup.limits[j].velocity * d.counts_per_unit * m.period_s;
-            let worst = t
-                .windows(2)
-                .map(|w| (w[1] - w[0]).unsigned_abs())
-                .max()
-                .unwrap_or(0);
-            assert!(
-                f64::from(worst) <= lim * (1.0 + 1e-6) + 1.0,
-                "{name}: node {} stepped {worst} counts in a period, limit {lim}",
-                d.node
-            );
-        }
-        assert!(
-            !resumed.is_empty() || name.starts_with("hyper"),
-            "{name}: no stop resumed"
-        );
-        let leave = spindle_at_speed_before_the_first_feed_move(name, &m, &prog, &records);
-        coolant_on_for_the_cut_and_off_at_the_end(name, &m, &prog, &records, leave);
+        _ => stops,
+    };
+    assert_eq!(resumed, expected, "{name}: {}", rep.text());
+    for d in &rep.drives {
+        assert_eq!(Some(d.target_counts), d.program_end_counts, "{name}: {d:?}");
     }
+    let axes: Vec<Vec<i32>> = (0..records[usize::from(m.drives[0].node)].len())
+        .map(|k| {
+            m.drives
+                .iter()
+                .map(|d| records[usize::from(d.node)][k].target_counts)
+                .collect()
+        })
+        .collect();
+    within_the_limits_at_the_period(name, m, &setup, &axes);
+    the_offline_interpolation(name, m, &setup, &prog, &axes);
+    let leave = spindle_at_speed_before_the_first_feed_move(name, m, &prog, &records);
+    coolant_on_for_the_cut_and_off_at_the_end(name, m, &prog, &records, leave);
+    spindle_and_coolant_as_programmed(name, m, &prog, &records);
+}
+
+/// Velocity and acceleration of every axis by finite differences of the targets at the
+/// period, in counts, against its limits (quantization: 1 and 2 counts).
+fn within_the_limits_at_the_period(
+    name: &str,
+    m: &config::Machine,
+    setup: &MachineSetup,
+    axes: &[Vec<i32>],
+) {
+    for (j, d) in m.drives.iter().enumerate() {
+        let t: Vec<f64> = axes.iter().map(|a| f64::from(a[j])).collect();
+        let lim = &setup.limits[d.axis];
+        let vlim = lim.velocity * d.counts_per_unit * m.period_s;
+        let alim = lim.acceleration * d.counts_per_unit * m.period_s * m.period_s;
+        let v = t
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        let a = t
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            v <= vlim * (1.0 + 1e-6) + 1.0,
+            "{name}: node {} stepped {v} counts in a period, limit {vlim}",
+            d.node
+        );
+        assert!(
+            a <= alim * (1.0 + 1e-6) + 2.0,
+            "{name}: node {} changed its step by {a} counts, limit {alim}",
+            d.node
+        );
+    }
+}
+
+/// The path the drives received is the path `dnurbs simulate` interpolates (whose chord
+/// error and limits the planner proves), from the program's start to its end: after the
+/// approach move, every target lies within [`ROUNDING`] counts (the drives' rounding of five
+/// axes) of the polyline of the setpoints simulated at a quarter of the period with every block's start inserted, in
+/// drive counts, and the targets pass along all of it in order.
+fn the_offline_interpolation(
+    name: &str,
+    m: &config::Machine,
+    setup: &MachineSetup,
+    prog: &nc::program::Program,
+    axes: &[Vec<i32>],
+) {
+    // Sampled at a quarter of the period: the same path, its polyline 16 times closer to
+    // the curve the joints trace (what the drives received lies on that curve).
+    let mut fine = setup.clone();
+    fine.period /= FINER;
+    fine.plan.period /= FINER;
+    let sim = dnurbs_tools::simulate::run(prog, &fine, setup.method).unwrap();
+    let counts = |j: &nc::kinematics::Joints| -> Vec5 {
+        Vec5::from_iterator(m.drives.iter().map(|d| {
+            let v = if d.axis >= 3 {
+                j[d.axis].to_degrees()
+            } else {
+                j[d.axis]
+            };
+            v * d.counts_per_unit * f64::from(d.sign) + f64::from(d.offset)
+        }))
+    };
+    // The samples cut across a corner, the path does not: the start of every block the path
+    // entered since the last setpoint goes in before it, in order (inside a block the
+    // path is tangent-continuous, or comes to rest where it is not).
+    let segs = &sim.path.segments;
+    let mut path: Vec<Vec5> = Vec::new();
+    let mut next = 0;
+    for sp in &sim.setpoints {
+        while next < segs.len() && segs[next].block <= sp.block {
+            if next == 0 || segs[next - 1].block != segs[next].block {
+                let start = segs[next].pose(0.0);
+                let j = start.joints(&setup.kin, &sp.joints, &setup.plan.rotary);
+                path.push(counts(&j));
+            }
+            next += 1;
+        }
+        path.push(counts(&sp.joints));
+    }
+    path.dedup();
+    let mut got = axes.to_vec();
+    got.dedup();
+    let first = joint_counts(m, &sim.setpoints[0].joints);
+    let close = |a: &[i32]| a.iter().zip(&first).all(|(x, y)| (x - y).abs() <= 1);
+    // The approach move ends at the program's start: the last target within a count of it
+    // before the path leaves.
+    let start = (0..got.len().saturating_sub(1))
+        .find(|&k| close(&got[k]) && !close(&got[k + 1]))
+        .unwrap_or_else(|| panic!("{name}: never at the program's start {first:?}"));
+    let mut at = 0;
+    let mut worst = 0.0f64;
+    let mut prev = Vec5::from_iterator(got[start].iter().map(|&x| f64::from(x)));
+    for (i, c) in got[start..].iter().enumerate() {
+        let q = Vec5::from_iterator(c.iter().map(|&x| f64::from(x)));
+        // A target is one period's travel on from the last: along the path at most twice
+        // its chord (an arc of up to 180 degrees is at most pi/2 times its chord), plus
+        // rounding.
+        let (k, d) = nearest(&path, at, &q, 2.0 * (q - prev).norm() + 4.0 * ROUNDING);
+        prev = q;
+        at = k;
+        worst = worst.max(d);
+        assert!(
+            d <= ROUNDING,
+            "{name}: target {i} {c:?} is {d:.2} counts from the simulated path near {:?}",
+            path[k].as_slice()
+        );
+    }
+    // They followed it to its end: what is left after the last match is within rounding.
+    let left: f64 = path[at..].windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    assert!(
+        left <= ROUNDING,
+        "{name}: the targets followed the simulated path to point {at} of {}, {left:.1} counts short",
+        path.len()
+    );
+    eprintln!(
+        "{name}: {} targets on the simulated path, at most {worst:.3} counts off",
+        got.len() - start
+    );
+}
+
+type Vec5 = nalgebra::SVector<f64, 5>;
+
+/// How many times finer than the period the reference path is sampled.
+const FINER: f64 = 4.0;
+
+/// Half a count on each of five drives, Euclidean: how far rounding moves a target.
+const ROUNDING: f64 = 1.118_034;
+
+/// The segment of the polyline `pts` nearest to `q`, searched from segment `from` on, at
+/// most `ahead` counts of path further: its index and the distance.
+fn nearest(pts: &[Vec5], from: usize, q: &Vec5, ahead: f64) -> (usize, f64) {
+    let last = pts.len() - 1;
+    let mut best = (from, f64::INFINITY);
+    let mut walked = 0.0;
+    for k in from..last.max(from + 1) {
+        let (a, b) = (pts[k], pts[(k + 1).min(last)]);
+        let ab = b - a;
+        let s = if ab.norm_squared() > 0.0 {
+            ((q - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d = (a + ab * s - q).norm();
+        if d < best.1 {
+            best = (k, d);
+        }
+        walked += ab.norm();
+        if walked > ahead {
+            break;
+        }
+    }
+    best
+}
+
+/// Drive counts of a setpoint's joints, in drive order.
+fn joint_counts(m: &config::Machine, j: &nc::kinematics::Joints) -> Vec<i32> {
+    m.drives
+        .iter()
+        .map(|d| {
+            let v = if d.axis >= 3 {
+                j[d.axis].to_degrees()
+            } else {
+                j[d.axis]
+            };
+            d.counts(v).unwrap()
+        })
+        .collect()
+}
+
+/// The spindle drive's targets and the module's outputs, consecutive repeats removed, are
+/// the program's spindle speeds and valves in the order it commands them, ending off.
+fn spindle_and_coolant_as_programmed(
+    name: &str,
+    m: &config::Machine,
+    prog: &nc::program::Program,
+    records: &PerNode,
+) {
+    let (spindle, coolant) = (m.spindle.as_ref().unwrap(), m.coolant.as_ref().unwrap());
+    let mut aux = nc::program::Aux::default();
+    let (mut speeds, mut valves) = (vec![0], vec![0]);
+    for b in 0..prog.blocks.len() {
+        for a in prog.actions.iter().filter(|a| a.before_block == b) {
+            aux.apply(&a.kind);
+        }
+        speeds.push(spindle.velocity(aux.spindle_rpm));
+        valves.push(i32::from(coolant.outputs(aux.mist, aux.flood)));
+    }
+    speeds.push(0);
+    valves.push(0);
+    speeds.dedup();
+    valves.dedup();
+    let sent = |node: u8| {
+        let mut v: Vec<i32> = records[usize::from(node)]
+            .iter()
+            .map(|r| r.target_counts)
+            .collect();
+        v.dedup();
+        v
+    };
+    assert_eq!(sent(spindle.node), speeds, "{name}: spindle targets");
+    assert_eq!(sent(coolant.node), valves, "{name}: coolant outputs");
 }
 
 /// The axes' targets (counts, in node order) where the program's first feed move starts,
@@ -343,4 +569,70 @@ fn a_stop_for_the_operator_without_a_control_socket_is_refused_before_motion() {
         msg.contains("only the control socket can resume it"),
         "{msg}"
     );
+}
+
+#[test]
+fn work_offsets_from_a_linuxcnc_parameter_file_move_the_program_and_errors_name_their_line() {
+    let m = machine();
+    let var = common::temp("linuxcnc.var");
+    // G54 as LinuxCNC writes it (tabs, six decimals), among parameters dnurbs ignores.
+    std::fs::write(
+        &var,
+        "5161\t0.000000\n5220\t1.000000\n5221\t10.000000\n5222\t-20.000000\n5223\t5.000000\n\
+         5224\t0.000000\n5230\t0.000000\n5241\t0.000000\n5242\t0.000000\n5243\t0.000000\n",
+    )
+    .unwrap();
+    let with = ShopArgs {
+        tools: Some(posts("tool.tbl")),
+        offsets: Some(var.clone()),
+        ..ShopArgs::default()
+    }
+    .load()
+    .unwrap();
+    let end = |b: &nc::program::Block| match b {
+        nc::program::Block::Linear(l) => l.end,
+        nc::program::Block::Nurbs(n) => *n.ctrl.last().unwrap(),
+    };
+    for name in ["fusion-fanuc-3axis.nc", "mastercam-fanuc-3axis.nc"] {
+        let plain = dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &shop())).unwrap();
+        let moved = dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &with)).unwrap();
+        assert_eq!(plain.blocks.len(), moved.blocks.len());
+        let mut shifted = 0;
+        for (a, b) in plain.blocks.iter().zip(&moved.blocks) {
+            let d: Vec<f64> = (0..3).map(|i| end(b)[i] - end(a)[i]).collect();
+            let by_offset = d
+                .iter()
+                .zip([10.0, -20.0, 5.0])
+                .all(|(x, o)| (x - o).abs() < 1e-9);
+            // G28 / G53 move their axes in machine coordinates: the offset does not move
+            // those (`G28 G91 Z0` sends Z to the reference, X and Y stay where they were).
+            let each = d
+                .iter()
+                .zip([10.0, -20.0, 5.0])
+                .all(|(x, o)| (x - o).abs() < 1e-9 || x.abs() < 1e-9);
+            assert!(each, "{name}: moved by {d:?}");
+            shifted += usize::from(by_offset);
+        }
+        assert!(
+            shifted * 10 >= plain.blocks.len() * 8,
+            "{name}: {shifted} moved"
+        );
+    }
+    // A rotary offset dnurbs cannot apply: exit 2 naming the file, line and value.
+    std::fs::write(&var, "5221\t1.0\n5222\t2.0\n5223\t3.0\n5226\t90.000000\n").unwrap();
+    let out = common::dnurbs(&[
+        "simulate",
+        posts("fusion-fanuc-3axis.nc").to_str().unwrap(),
+        "--machine",
+        posts("machine.toml").to_str().unwrap(),
+        "--offsets",
+        var.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("{}:4:1:", var.display())) && stderr.contains("G54 C is 90"),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_file(&var);
 }
