@@ -2,7 +2,8 @@
 //! generates adversarial NC programs (degrees 1..=5, weights 1e-3..1e3 within a block,
 //! clustered and repeated knots, cusps, sharp turns at high feed, tool axes within 1e-6 of
 //! the vertical, I J K and A C blocks mixed, 180-degree tool turns, moves to and beyond the
-//! travel, coordinates up to 1e300). Each program is either refused with a positioned error
+//! travel, coordinates up to 1e300, arcs `G02`/`G03` in all three planes by centre or `R`,
+//! helical, full circles, radii from 1 um to 500 mm). Each program is either refused with a positioned error
 //! (parse, build or plan), or its setpoints, produced by the same interpolator as the
 //! real-time thread's, hold every limit. The check below is written from the setpoints alone
 //! (finite differences at the period, the curve sampled between setpoints), independently
@@ -79,6 +80,20 @@ enum Move {
         len: f64,
         feed: f64,
     },
+    /// `G02`/`G03` in the plane `G17`/`G18`/`G19` (index 0..3) from the current point, by
+    /// centre offsets or by `R`, helical when `rise` is not 0; a sweep of a whole turn is a
+    /// full circle.
+    Arc {
+        plane: usize,
+        clockwise: bool,
+        radius: f64,
+        /// Angle of the start seen from the centre, and the sweep (0 .. 2 pi), rad.
+        start: f64,
+        sweep: f64,
+        by_r: bool,
+        rise: f64,
+        feed: f64,
+    },
     /// A coordinate far outside every travel (up to 1e300).
     Huge { exp: i32 },
 }
@@ -120,7 +135,13 @@ fn move_strategy() -> impl Strategy<Value = Move> {
             feed,
             rapid,
         });
-    let nurbs = (1usize..=5, any::<bool>(), 0usize..6, feed, 0.5..20.0f64)
+    let nurbs = (
+        1usize..=5,
+        any::<bool>(),
+        0usize..6,
+        feed.clone(),
+        0.5..20.0f64,
+    )
         .prop_flat_map(|(degree, g065, extra, feed, len)| {
             let n = degree + 1 + extra;
             let off = prop_oneof![
@@ -149,9 +170,41 @@ fn move_strategy() -> impl Strategy<Value = Move> {
                 feed,
             },
         );
+    let arc = (
+        (0usize..3, any::<bool>(), any::<bool>()),
+        prop_oneof![
+            1 => 0.001..0.05f64,
+            6 => 0.5..50.0f64,
+            1 => 50.0..500.0f64,
+        ],
+        0.0..std::f64::consts::TAU,
+        prop_oneof![
+            4 => 0.01..std::f64::consts::TAU,
+            1 => Just(std::f64::consts::TAU),
+        ],
+        prop_oneof![
+            3 => Just(0.0),
+            2 => -5.0..5.0f64,
+            1 => -100.0..100.0f64,
+        ],
+        feed.clone(),
+    )
+        .prop_map(
+            |((plane, clockwise, by_r), radius, start, sweep, rise, feed)| Move::Arc {
+                plane,
+                clockwise,
+                radius,
+                start,
+                sweep,
+                by_r,
+                rise,
+                feed,
+            },
+        );
     prop_oneof![
         10 => line,
         9 => nurbs,
+        5 => arc,
         1 => (3i32..300).prop_map(|exp| Move::Huge { exp }),
     ]
 }
@@ -212,6 +265,69 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
             }
             Move::Huge { exp } => {
                 let _ = writeln!(s, "N{n} G01 X1{}", "0".repeat(*exp as usize));
+            }
+            Move::Arc {
+                plane,
+                clockwise,
+                radius,
+                start,
+                sweep,
+                by_r,
+                rise,
+                feed,
+            } => {
+                // The plane's first, second and normal axis, as the parser orders them.
+                let (a, b, nrm) = [(0, 1, 2), (2, 0, 1), (1, 2, 0)][*plane];
+                let centre = [
+                    here[a] - radius * start.cos(),
+                    here[b] - radius * start.sin(),
+                ];
+                let end_angle = if *clockwise {
+                    start - sweep
+                } else {
+                    start + sweep
+                };
+                let mut to = here;
+                to[a] = centre[0] + radius * end_angle.cos();
+                to[b] = centre[1] + radius * end_angle.sin();
+                to[nrm] += rise;
+                let full = *sweep >= std::f64::consts::TAU;
+                if full {
+                    to[a] = here[a];
+                    to[b] = here[b];
+                }
+                let letters = ['I', 'J', 'K'];
+                let centre_words = if *by_r && !full {
+                    let r = if *sweep > std::f64::consts::PI {
+                        -radius
+                    } else {
+                        *radius
+                    };
+                    format!(" R{}", num(r))
+                } else {
+                    format!(
+                        " {}{} {}{}",
+                        letters[a],
+                        num(centre[0] - here[a]),
+                        letters[b],
+                        num(centre[1] - here[b])
+                    )
+                };
+                let _ = writeln!(
+                    s,
+                    "N{n} G{} G0{} X{} Y{} Z{}{centre_words} F{}",
+                    17 + plane,
+                    if *clockwise { 2 } else { 3 },
+                    num(to[0]),
+                    num(to[1]),
+                    num(to[2]),
+                    num(*feed)
+                );
+                here = [
+                    num(to[0]).parse().unwrap(),
+                    num(to[1]).parse().unwrap(),
+                    num(to[2]).parse().unwrap(),
+                ];
             }
             Move::Nurbs {
                 degree,
@@ -292,6 +408,8 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
 #[derive(Default)]
 struct Counts {
     accepted: AtomicU64,
+    /// Accepted programs with at least one arc.
+    arcs: AtomicU64,
     refused: AtomicU64,
     long: AtomicU64,
 }
@@ -362,6 +480,9 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
         return Ok(());
     }
     counts.accepted.fetch_add(1, Ordering::Relaxed);
+    if src.contains(" G02 ") || src.contains(" G03 ") {
+        counts.arcs.fetch_add(1, Ordering::Relaxed);
+    }
     let mut ip = Interpolator::new(
         &path,
         &profile,
@@ -496,12 +617,13 @@ fn run_half(half: u64, cases: u32) {
         }
         r
     });
-    let (acc, refd, long) = (
+    let (acc, arcs, refd, long) = (
         counts.accepted.load(Ordering::Relaxed),
+        counts.arcs.load(Ordering::Relaxed),
         counts.refused.load(Ordering::Relaxed),
         counts.long.load(Ordering::Relaxed),
     );
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc}, refused with a position {refd}, too long to interpolate here {long}");
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs), refused with a position {refd}, too long to interpolate here {long}");
     if let Err(e) = result {
         panic!("{e}");
     }
@@ -509,6 +631,10 @@ fn run_half(half: u64, cases: u32) {
     assert!(
         acc * 5 >= u64::from(cases),
         "only {acc} of {cases} accepted"
+    );
+    assert!(
+        arcs * 20 >= u64::from(cases),
+        "only {arcs} of {cases} accepted with arcs"
     );
     assert!(
         long * 100 <= u64::from(cases),

@@ -7,7 +7,7 @@
 
 use core::fmt;
 
-use super::arc::{ARC_RADIUS_TOL_MM, MIN_ARC_RADIUS_MM};
+use super::arc::{ARC_RADIUS_TOL_MM, HELIX_TOL_MM, MIN_ARC_RADIUS_MM};
 use super::codes::{Plane, G_LIST, M_LIST};
 use super::modal::MAX_DWELL_S;
 use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
@@ -198,6 +198,12 @@ pub enum ParseErrorKind {
     ArcFullCircleRadius,
     #[error("arc radius {radius} mm is below {MIN_ARC_RADIUS_MM} mm")]
     ArcTooSmall { radius: f64 },
+    #[error("a helix rising {rise} mm over {sweep_deg:.3} deg needs {pieces} pieces to stay within {HELIX_TOL_MM} mm of the true helix, more than one block holds: program it as several arcs")]
+    HelixTooSteep {
+        rise: f64,
+        sweep_deg: f64,
+        pieces: f64,
+    },
     #[error(
         "rotary word {letter} on an arc: the tool axis stays fixed along G02/G03, turn it on a G01"
     )]

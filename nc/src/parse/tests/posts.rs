@@ -93,7 +93,7 @@ fn full_circle_is_the_circle_to_a_nanometre() {
 }
 
 #[test]
-fn helix_is_on_the_helix_within_its_bound() {
+fn helix_is_on_the_true_helix_within_its_bound() {
     // Two turns of radius 5 rising 2 mm (G03, counter-clockwise), as a helical ramp.
     let src = "G00 X5 Y0 Z2\nG03 X5 Y0 Z1 I-5 J0 F600\nG03 X5 Y0 Z0 I-5 J0\n";
     let p = parse(src).unwrap();
@@ -115,13 +115,70 @@ fn helix_is_on_the_helix_within_its_bound() {
             // The true helix at this angle: z falls 1 mm per turn.
             let z = z0 - phi / (2.0 * PI);
             assert!(
-                (q[2] - z).abs() <= super::super::HELIX_TOL_MM * 1.01,
+                (q[2] - z).abs() <= super::super::HELIX_TOL_MM,
                 "z {} vs helix {z} at phi {phi}",
                 q[2]
             );
         }
         assert!((phi - 2.0 * PI).abs() < 1e-9);
     }
+}
+
+#[test]
+fn steep_helices_are_on_the_true_helix_or_an_error() {
+    // Rising 50 mm in a quarter turn of radius 2 (a ramp seen from the side), and a whole
+    // turn of radius 0.5 rising 100 mm: the steepest pitches a post writes.
+    for (src, r, z1, sweep) in [
+        (
+            "G00 X2 Y0 Z0\nG03 X0 Y2 Z50 I-2 J0 F600\n",
+            2.0,
+            50.0,
+            PI / 2.0,
+        ),
+        (
+            "G00 X0.5 Y0 Z0\nG03 X0.5 Y0 Z100 I-0.5 J0 F600\n",
+            0.5,
+            100.0,
+            2.0 * PI,
+        ),
+    ] {
+        let p = parse(src).unwrap();
+        let b = nurbs(&p.blocks[1]);
+        let mut phi = 0.0f64;
+        let mut prev = 0.0f64;
+        for q in curve_points(b, 20_000) {
+            assert!((q[0].hypot(q[1]) - r).abs() < 1e-9);
+            let ang = q[1].atan2(q[0]);
+            let mut d = ang - prev;
+            if d < -PI {
+                d += 2.0 * PI;
+            }
+            phi += d;
+            prev = ang;
+            let z = z1 * phi / sweep;
+            let tol = super::super::HELIX_TOL_MM;
+            assert!((q[2] - z).abs() <= tol, "{src}: z {} vs {z}", q[2]);
+        }
+    }
+    // The steepest helix the coordinate range allows (a whole turn from Z-100000 to
+    // Z100000) still fits one block; beyond it the arc is an error with the numbers, not a
+    // looser helix.
+    let arc = |rise: f64| {
+        super::super::arc(
+            [0.01, 0.0, -rise / 2.0],
+            [0.01, 0.0, rise / 2.0],
+            super::super::codes::Plane::Xy,
+            false,
+            super::super::Centre::Offsets(-0.01, 0.0),
+        )
+    };
+    assert!(arc(2e5).unwrap().ctrl.len() < crate::split::MAX_BLOCK_CTRL);
+    let e = arc(1e10).unwrap_err();
+    assert!(
+        matches!(e, E::HelixTooSteep { pieces, .. } if pieces > 49_999.0),
+        "{e}"
+    );
+    assert!(e.to_string().contains("program it as several arcs"), "{e}");
 }
 
 #[test]
