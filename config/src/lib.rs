@@ -100,6 +100,7 @@
 pub mod bus;
 mod error;
 mod machine;
+pub mod offsets;
 mod raw;
 mod source;
 pub mod spindle;

@@ -1,18 +1,25 @@
-//! The shop's side of a program: the tool table and the operator's switches (`--tools`,
-//! `--block-delete`, `--optional-stop`), merged with the machine file's work offsets and
-//! reference position into the parser's [`nc::parse::Setup`].
+//! The shop's side of a program: the tool table, the work offsets and the operator's
+//! switches (`--tools`, `--offsets`, `--block-delete`, `--optional-stop`), merged with the
+//! machine file's work offsets and reference position into the parser's
+//! [`nc::parse::Setup`].
 
 use crate::exit::InputError;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-/// `--tools`, `--block-delete`, `--optional-stop` of `simulate`, `run` and `compare`.
+/// `--tools`, `--offsets`, `--block-delete`, `--optional-stop` of `simulate`, `run` and
+/// `compare`.
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct ShopArgs {
     /// Tool table in LinuxCNC's tool.tbl format (`T1 P1 Z+75.0 D6.0 ;comment`): the
     /// lengths `G43 H` / `G43.4 H` apply (Z, mm).
     #[arg(long, value_name = "TOOL.TBL")]
     pub tools: Option<PathBuf>,
+    /// Work offsets in LinuxCNC's parameter-file format (`linuxcnc.var`: `5221 120.5` is G54
+    /// X): each of G54..G59 the file gives (parameters 5221..5223 + 20 per offset, mm)
+    /// replaces the machine file's `[work_offsets]` entry.
+    #[arg(long, value_name = "LINUXCNC.VAR")]
+    pub offsets: Option<PathBuf>,
     /// Skip lines that start with `/` (block delete). Without it the `/` is ignored.
     #[arg(long)]
     pub block_delete: bool,
@@ -26,6 +33,8 @@ pub struct ShopArgs {
 pub struct ShopOptions {
     /// Tool number -> length, mm.
     pub tools: BTreeMap<u32, f64>,
+    /// G54..G59 from `--offsets`, over the machine file's.
+    pub work_offsets: config::offsets::WorkOffsets,
     pub block_delete: bool,
     pub optional_stop: bool,
 }
@@ -40,8 +49,13 @@ impl ShopArgs {
                 .collect(),
             None => BTreeMap::new(),
         };
+        let work_offsets = match &self.offsets {
+            Some(path) => config::offsets::load_offsets(path)?,
+            None => [None; 6],
+        };
         Ok(ShopOptions {
             tools,
+            work_offsets,
             block_delete: self.block_delete,
             optional_stop: self.optional_stop,
         })
@@ -51,7 +65,7 @@ impl ShopArgs {
 /// The parser's setup for `machine` and the shop's options.
 pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc::parse::Setup {
     nc::parse::Setup {
-        work_offsets: machine.work_offsets,
+        work_offsets: std::array::from_fn(|k| shop.work_offsets[k].or(machine.work_offsets[k])),
         reference: machine.reference,
         tools: shop.tools.clone(),
         block_delete: shop.block_delete,
