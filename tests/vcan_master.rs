@@ -22,18 +22,20 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
     let machine_file = data("vcan-machine.toml");
     let machine = config::load(&machine_file).expect("vcan machine file");
     let period = machine.period_s;
-    let mut sim = std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
-        .args([
-            "sim-drives",
-            "--iface",
-            &iface,
-            "--machine",
-            machine_file.to_str().unwrap(),
-            "--record",
-            record.to_str().unwrap(),
-        ])
-        .spawn()
-        .expect("start dnurbs sim-drives");
+    let sim = KillOnDrop(
+        std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+            .args([
+                "sim-drives",
+                "--iface",
+                &iface,
+                "--machine",
+                machine_file.to_str().unwrap(),
+                "--record",
+                record.to_str().unwrap(),
+            ])
+            .spawn()
+            .expect("start dnurbs sim-drives"),
+    );
     std::thread::sleep(Duration::from_millis(500));
 
     let nodes: Vec<NodeId> = machine
@@ -48,14 +50,12 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
     let setup = configure(&mut link, &nodes, &opts, &mut |_| {});
     let initial = match setup {
         Ok(i) => i,
-        Err(e) => {
-            let _ = sim.kill();
-            panic!("set-up failed: {e}");
-        }
+        Err(e) => panic!("set-up failed: {e}"),
     };
     let t0 = Instant::now();
     // Software emulation runs 10-50x slower and three processes share two virtual CPUs:
-    // supervise generously here (three seconds), the function is what this test checks.
+    // supervise generously here (three seconds) and give enabling 15 s, the function is
+    // what this test checks.
     let sup = Supervision {
         heartbeat_timeout_s: 3.0,
         feedback_timeout_cycles: (3.0 / period) as u32,
@@ -70,7 +70,7 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
         }
     };
     m.set_goal(Goal::Enabled);
-    for _ in 0..500 {
+    for _ in 0..(15.0 / period) as u32 {
         tick(&mut m, &initial);
         if m.all_in(State::OperationEnabled) {
             break;
@@ -102,8 +102,7 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
         m.status()
     );
     std::thread::sleep(Duration::from_millis(400)); // let sim-drives flush its records
-    let _ = sim.kill();
-    let _ = sim.wait();
+    drop(sim);
 
     let text = std::fs::read_to_string(&record).expect("sim-drives wrote its record");
     let mut lines = text.lines();

@@ -295,3 +295,14 @@ pub fn assert_axes_settled(stdout: &str) {
         assert!((n[2] - n[3]).abs() <= 1, "{line}");
     }
 }
+
+/// A child process (a `dnurbs sim-drives` on a CAN interface) killed when the guard drops,
+/// also when a test panics: a process left on the bus answers the next test's SDOs too.
+pub struct KillOnDrop(pub std::process::Child);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
