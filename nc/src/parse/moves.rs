@@ -264,7 +264,7 @@ impl Parser<'_> {
             pos,
             n: line.n,
             kind: NurbsKind::G062,
-            degree: 2,
+            degree: net.degree,
             ctrl: net.ctrl,
             tool_ctrl: Vec::new(),
             ctrl_pos: vec![pos; count],

@@ -173,9 +173,9 @@ fn steep_helices_are_on_the_true_helix_or_an_error() {
         )
     };
     assert!(arc(2e5).unwrap().ctrl.len() < crate::split::MAX_BLOCK_CTRL);
-    let e = arc(1e10).unwrap_err();
+    let e = arc(1e15).unwrap_err();
     assert!(
-        matches!(e, E::HelixTooSteep { pieces, .. } if pieces > 49_999.0),
+        matches!(e, E::HelixTooSteep { pieces, .. } if pieces > 24_999.0),
         "{e}"
     );
     assert!(e.to_string().contains("program it as several arcs"), "{e}");
