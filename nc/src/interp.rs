@@ -309,7 +309,7 @@ impl<'a> Interpolator<'a> {
         }
         let seg = &segs[self.seg];
         match &seg.geometry {
-            Geometry::Nurbs { curve, .. } => seg.pose_u(curve, self.u),
+            Geometry::Nurbs { curve, table } => seg.pose_u(curve, table, self.u),
             Geometry::Line { .. } => seg.pose(self.line_s),
         }
     }
@@ -341,6 +341,7 @@ pub(crate) mod tests {
             knots: Default::default(),
             feed_mm_min: 400.0,
             tooling: Default::default(),
+            turn_to: None,
         };
         for i in 0..5 {
             b.ctrl.push(c[i]);

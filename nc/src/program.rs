@@ -90,6 +90,10 @@ pub struct NurbsBlock {
     /// Programmed feed, mm/min (modal F resolved).
     pub feed_mm_min: f64,
     pub tooling: MoveTooling,
+    /// Rotary angles (degrees) at the end of an arc that turns the tool (`G02 .. A_ C_`):
+    /// they change linearly in path length along the arc, as along a `G01`. `None`: the
+    /// tool axis stays as it was (every G06.2, G06.5 and arc without angle words).
+    pub turn_to: Option<(f64, f64)>,
 }
 
 /// One motion block of the program.

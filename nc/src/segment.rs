@@ -31,7 +31,8 @@ pub const NULL_MOVE_MM: f64 = 1e-6;
 /// How a segment's tool orientation varies.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Tooling {
-    /// Rotary angles (radians) interpolated linearly (`G01 A_ C_`).
+    /// Rotary angles (radians) interpolated linearly in path length (`G01 A_ C_`, and an
+    /// arc with angle words, each of its segments over its share of the arc).
     Angles { from: (f64, f64), to: (f64, f64) },
     /// Unit tool axis along the great circle (`G01 I_ J_ K_`), `angle` between the ends.
     Slerp {
@@ -142,15 +143,28 @@ impl Segment {
                 u: None,
                 z: self.z.0 + (self.z.1 - self.z.0) * f,
             },
-            Geometry::Nurbs { curve, table } => self.pose_u(curve, table.u_of_s(curve, s)),
+            Geometry::Nurbs { curve, table } => self.pose_at(curve, table.u_of_s(curve, s), || f),
         }
     }
 
     /// Pose of a NURBS segment at curve parameter `u` (for the Taylor methods).
-    pub fn pose_u(&self, curve: &DoubleNurbs, u: f64) -> Pose {
+    pub fn pose_u(&self, curve: &DoubleNurbs, table: &ArcTable, u: f64) -> Pose {
+        self.pose_at(curve, u, || {
+            if self.length > 0.0 {
+                (table.s_of_u(curve, u) / self.length).clamp(0.0, 1.0)
+            } else {
+                1.0
+            }
+        })
+    }
+
+    /// Pose at `u`; `fraction` gives the fraction of the segment's length there, needed
+    /// only by an arc that turns the tool ([`Tooling::Angles`]).
+    fn pose_at(&self, curve: &DoubleNurbs, u: f64, fraction: impl FnOnce() -> f64) -> Pose {
         let (c, ct) = curve.both(u, 0);
         let tool = match self.tooling {
             Tooling::Curve => self.tool_at(0.0, Some((ct.p - c.p).normalize())),
+            Tooling::Angles { .. } => self.tool_at(fraction(), None),
             _ => self.tool_at(0.0, None),
         };
         Pose {
@@ -306,7 +320,7 @@ pub fn build(
                     };
                     return Err(err(b.pos, kind));
                 }
-                nurbs(index, b, &pose, kin, limits)?
+                nurbs(index, b, &pose, &joints, kin, limits)?
             }
         };
         if let Some(first) = segs.first_mut() {
@@ -532,6 +546,7 @@ fn nurbs(
     block: u32,
     b: &NurbsBlock,
     pose: &Pose,
+    joints: &Joints,
     kin: &MachineKinematics,
     limits: &BuildLimits,
 ) -> Result<Vec<Segment>, BuildError> {
@@ -630,7 +645,31 @@ fn nurbs(
             }
         });
     }
+    if let Some((r1, r2)) = b.turn_to {
+        turn_along(
+            &mut out,
+            (joints[3], joints[4]),
+            (r1.to_radians(), r2.to_radians()),
+        );
+    }
     Ok(out)
+}
+
+/// An arc that turns the tool: its rotary angles go from `from` to `to` linearly in the
+/// arc's length, each segment over its own share, so they are continuous at every joint.
+fn turn_along(segments: &mut [Segment], from: (f64, f64), to: (f64, f64)) {
+    let total: f64 = segments.iter().map(|s| s.length).sum();
+    let at = |f: f64| (from.0 + (to.0 - from.0) * f, from.1 + (to.1 - from.1) * f);
+    let mut done = 0.0;
+    for s in segments.iter_mut() {
+        let f0 = done / total;
+        done += s.length;
+        let f1 = if done >= total { 1.0 } else { done / total };
+        s.tooling = Tooling::Angles {
+            from: at(f0),
+            to: at(f1),
+        };
+    }
 }
 
 /// The orientation curve must stay clear of the cutter curve everywhere, not only at the

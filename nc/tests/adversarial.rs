@@ -92,6 +92,8 @@ enum Move {
         sweep: f64,
         by_r: bool,
         rise: f64,
+        /// `A C` words: the tool turns along the arc.
+        turn: Option<(f64, f64)>,
         feed: f64,
     },
     /// A coordinate far outside every travel (up to 1e300).
@@ -188,9 +190,13 @@ fn move_strategy() -> impl Strategy<Value = Move> {
             1 => -100.0..100.0f64,
         ],
         feed.clone(),
+        prop_oneof![
+            2 => Just(None),
+            1 => (-95.0..95.0f64, -400.0..400.0f64).prop_map(Some),
+        ],
     )
         .prop_map(
-            |((plane, clockwise, by_r), radius, start, sweep, rise, feed)| Move::Arc {
+            |((plane, clockwise, by_r), radius, start, sweep, rise, feed, turn)| Move::Arc {
                 plane,
                 clockwise,
                 radius,
@@ -198,6 +204,7 @@ fn move_strategy() -> impl Strategy<Value = Move> {
                 sweep,
                 by_r,
                 rise,
+                turn,
                 feed,
             },
         );
@@ -274,6 +281,7 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
                 sweep,
                 by_r,
                 rise,
+                turn,
                 feed,
             } => {
                 // The plane's first, second and normal axis, as the parser orders them.
@@ -313,9 +321,13 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
                         num(centre[1] - here[b])
                     )
                 };
+                let turn_words = match turn {
+                    Some((a, c)) => tool_words(&Tool::Angles(*a, *c), &mut axis),
+                    None => String::new(),
+                };
                 let _ = writeln!(
                     s,
-                    "N{n} G{} G0{} X{} Y{} Z{}{centre_words} F{}",
+                    "N{n} G{} G0{} X{} Y{} Z{}{centre_words}{turn_words} F{}",
                     17 + plane,
                     if *clockwise { 2 } else { 3 },
                     num(to[0]),
@@ -410,6 +422,8 @@ struct Counts {
     accepted: AtomicU64,
     /// Accepted programs with at least one arc.
     arcs: AtomicU64,
+    /// Accepted programs with an arc that turns the tool (`A C` words).
+    turning_arcs: AtomicU64,
     refused: AtomicU64,
     long: AtomicU64,
 }
@@ -482,6 +496,10 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
     counts.accepted.fetch_add(1, Ordering::Relaxed);
     if src.contains(" G02 ") || src.contains(" G03 ") {
         counts.arcs.fetch_add(1, Ordering::Relaxed);
+    }
+    let turning = |l: &str| (l.contains(" G02 ") || l.contains(" G03 ")) && l.contains(" A");
+    if src.lines().any(turning) {
+        counts.turning_arcs.fetch_add(1, Ordering::Relaxed);
     }
     let mut ip = Interpolator::new(
         &path,
@@ -617,13 +635,14 @@ fn run_half(half: u64, cases: u32) {
         }
         r
     });
-    let (acc, arcs, refd, long) = (
+    let (acc, arcs, turning, refd, long) = (
         counts.accepted.load(Ordering::Relaxed),
         counts.arcs.load(Ordering::Relaxed),
+        counts.turning_arcs.load(Ordering::Relaxed),
         counts.refused.load(Ordering::Relaxed),
         counts.long.load(Ordering::Relaxed),
     );
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs), refused with a position {refd}, too long to interpolate here {long}");
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool), refused with a position {refd}, too long to interpolate here {long}");
     if let Err(e) = result {
         panic!("{e}");
     }
@@ -635,6 +654,10 @@ fn run_half(half: u64, cases: u32) {
     assert!(
         arcs * 20 >= u64::from(cases),
         "only {arcs} of {cases} accepted with arcs"
+    );
+    assert!(
+        turning * 50 >= u64::from(cases),
+        "only {turning} of {cases} accepted with an arc turning the tool"
     );
     assert!(
         long * 100 <= u64::from(cases),

@@ -204,10 +204,6 @@ pub enum ParseErrorKind {
         sweep_deg: f64,
         pieces: f64,
     },
-    #[error(
-        "rotary word {letter} on an arc: the tool axis stays fixed along G02/G03, turn it on a G01"
-    )]
-    ArcRotary { letter: char },
 
     // ---- tool orientation on G00/G01 ---------------------------------------------------
     #[error("angle {angle} and vector word {vector} on one line: give the orientation either as angles or as I J K")]

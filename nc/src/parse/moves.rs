@@ -203,14 +203,11 @@ impl Parser<'_> {
 
     /// A `G02`/`G03` line (or its modal continuation): a rational quadratic NURBS block.
     fn arc(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
-        if let Some(w) = line.first_of("ABC") {
-            return Err(ParseErrorKind::ArcRotary { letter: w.letter }.at(w.pos));
-        }
         line.only(
-            &self.extra_letters(line, "GMFSTXYZIJKR"),
+            &self.extra_letters(line, "GMFSTXYZIJKRABC"),
             Context::Move(motion),
         )?;
-        if line.first_of("XYZIJKR").is_none() {
+        if line.first_of("XYZIJKRABC").is_none() {
             return Ok(());
         }
         if !self.modal.inverse_time && self.feed.is_none() {
@@ -252,6 +249,12 @@ impl Parser<'_> {
             }
         };
         let end = self.end_point(line, pos)?;
+        // Angle words turn the tool along the arc (I J K are the centre here, never a
+        // tool axis).
+        let turn_to = match line.first_of("ABC") {
+            Some(_) => Some(self.angles(line)?),
+            None => None,
+        };
         let start = self.here.unwrap_or(end);
         let net = arc::arc(start, end, plane, motion == Motion::G02, centre)
             .map_err(|kind| kind.at(pos))?;
@@ -260,6 +263,10 @@ impl Parser<'_> {
         let tooling = self.tooling();
         let count = net.ctrl.len();
         self.here = Some(end);
+        if let Some((r1_deg, r2_deg)) = turn_to {
+            self.orientation = Orientation::Angles { r1_deg, r2_deg };
+            self.orientation_given = true;
+        }
         self.blocks.push(Block::Nurbs(NurbsBlock {
             pos,
             n: line.n,
@@ -272,6 +279,7 @@ impl Parser<'_> {
             knots: net.knots,
             feed_mm_min,
             tooling,
+            turn_to,
         }));
         Ok(())
     }

@@ -95,6 +95,7 @@ impl OpenNurbs {
             knots: Vec::new(),
             feed_mm_min,
             tooling,
+            turn_to: None,
         };
         let mut open = OpenNurbs {
             block,

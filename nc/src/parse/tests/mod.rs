@@ -88,6 +88,7 @@ fn paper_example_parses_into_the_expected_program() {
         knots: hvec(&[0.0, 0.0, 0.0, 0.0, 0.5046, 1.0, 1.0, 1.0, 1.0]),
         feed_mm_min: 400.0,
         tooling: Default::default(),
+        turn_to: None,
     };
     assert_eq!(nurbs(&program.blocks[1]), &expected);
 }

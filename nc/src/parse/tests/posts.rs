@@ -250,8 +250,8 @@ fn arc_errors_name_what_is_wrong() {
         E::ArcCentreAndRadius { .. }
     ));
     assert!(matches!(
-        f("G00 X0 Y0 Z0\nG02 X10 Y0 I5 C10 F500"),
-        E::ArcRotary { letter: 'C' }
+        f("G00 X0 Y0 Z0\nG02 X10 Y0 C10 F500"),
+        E::ArcWithoutCentre { .. }
     ));
     // Rounded posts: 0.0014 mm apart is accepted and ends exactly at the programmed point.
     let p = parse("G00 X0 Y0 Z0\nG02 X10.001 Y0 I5 J0.001 F500").unwrap();
