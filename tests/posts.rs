@@ -441,18 +441,7 @@ fn first_feed_start(m: &config::Machine, prog: &nc::program::Program) -> Vec<i32
         .iter()
         .position(|sp| sp.block == seg.block)
         .unwrap();
-    let j = sim.setpoints[first - 1].joints;
-    m.drives
-        .iter()
-        .map(|d| {
-            let v = if d.axis >= 3 {
-                j[d.axis].to_degrees()
-            } else {
-                j[d.axis]
-            };
-            d.counts(v).unwrap()
-        })
-        .collect()
+    joint_counts(m, &sim.setpoints[first - 1].joints)
 }
 
 /// The drives received the first feed move only once the spindle drive reported the
