@@ -217,3 +217,56 @@ fn c_turns_at_rest_where_the_tool_leaves_the_vertical_in_a_new_direction() {
     let last = rows.last().unwrap();
     assert!(dist(last.p, [40.0, 20.0, 10.0]) < 1e-9);
 }
+
+/// On a machine with a `[spindle]`, the summary gives the feed moves that wait for the
+/// spindle's speed and the time its ramps take there (not in the machining time): here
+/// 0 -> 12 000 rpm and 12 000 -> 6 000 rpm at the posts machine's 8 000 rpm/s, 1.5 s +
+/// 0.75 s. A machine without one says nothing about it.
+#[test]
+fn simulate_reports_the_spindle_waits_beside_the_machining_time() {
+    let prog = temp("spindle-waits.nc");
+    std::fs::write(
+        &prog,
+        "G90 G21\nG00 X0 Y0 Z5\nS12000 M03\nG01 X10 F600\nS6000\nG01 X20\nM05\nG00 Z50\nM30\n",
+    )
+    .unwrap();
+    let posts = root().join("tests/data/posts/machine.toml");
+    let args = |m: &std::path::Path, json: bool| {
+        let mut a = vec![
+            "simulate".to_owned(),
+            prog.to_str().unwrap().to_owned(),
+            "--machine".to_owned(),
+            m.to_str().unwrap().to_owned(),
+        ];
+        if json {
+            a.push("--json".to_owned());
+        }
+        a
+    };
+    let run = |a: Vec<String>| {
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let out = dnurbs(&a);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).to_string()
+    };
+    let text = run(args(&posts, false));
+    assert!(
+        text.contains("spindle waits      2 feed moves wait for the spindle's speed: about 2.250 s of ramps, not in the machining time"),
+        "{text}"
+    );
+    let json: serde_json::Value = serde_json::from_str(&run(args(&posts, true))).unwrap();
+    assert_eq!(json["spindle_waits"]["count"], 2, "{json}");
+    assert!(
+        (f(&json["spindle_waits"], "ramp_s") - 2.25).abs() < 1e-12,
+        "{json}"
+    );
+    let paper = machine("paper-ac-table.toml");
+    let text = run(args(&paper, false));
+    assert!(!text.contains("spindle waits"), "{text}");
+    let json: serde_json::Value = serde_json::from_str(&run(args(&paper, true))).unwrap();
+    assert!(json.get("spindle_waits").is_none(), "{json}");
+}

@@ -97,6 +97,33 @@ pub struct Summary {
     pub end_position_error_mm: f64,
     /// Spindle, coolant, tool, stop and dwell words, one line each (`crate::words`).
     pub program_words: Vec<String>,
+    /// Feed moves that wait for the spindle's speed, and the time its ramps take there, s
+    /// (from the commanded speeds and `[spindle] acceleration_rpm_s`; the drive's own
+    /// settling adds to it). Not in `machining_time_s`. Absent without a `[spindle]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spindle_waits: Option<SpindleWaits>,
+}
+
+/// See [`Summary::spindle_waits`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SpindleWaits {
+    pub count: u32,
+    pub ramp_s: f64,
+}
+
+impl SpindleWaits {
+    /// The waits of a path on a machine whose spindle ramps at `acc_rpm_s`.
+    pub fn of(path: &nc::segment::Path, acc_rpm_s: f64) -> SpindleWaits {
+        let (mut count, mut ramp_s, mut rpm) = (0, 0.0, 0.0);
+        for seg in &path.segments {
+            if seg.wait.spindle {
+                count += 1;
+                ramp_s += (seg.aux.spindle_rpm - rpm).abs() / acc_rpm_s;
+            }
+            rpm = seg.aux.spindle_rpm;
+        }
+        SpindleWaits { count, ramp_s }
+    }
 }
 
 /// Arc length of the cutter curve between two parameters, integrated directly.
@@ -287,6 +314,7 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         tool_axis_deviation_max_deg: tool_dev,
         end_position_error_mm: end_err,
         program_words: Vec::new(),
+        spindle_waits: None,
     }
 }
 
@@ -336,7 +364,16 @@ impl Summary {
             },
             self.tool_axis_deviation_max_deg,
             self.end_position_error_mm,
-        ) + &crate::words::text(&self.program_words)
+        ) + &self
+            .spindle_waits
+            .map(|w| {
+                format!(
+                    "spindle waits      {} feed moves wait for the spindle's speed: about {:.3} s of ramps, not in the machining time\n",
+                    w.count, w.ramp_s
+                )
+            })
+            .unwrap_or_default()
+            + &crate::words::text(&self.program_words)
     }
 }
 

@@ -36,6 +36,10 @@ pub fn simulate(
     }
     let mut summary = summarize(&result, &setup, prog.blocks.len());
     summary.program_words = crate::words::describe(&prog);
+    summary.spindle_waits = machine
+        .spindle
+        .as_ref()
+        .map(|s| crate::simulate::SpindleWaits::of(&result.path, s.acceleration_rpm_s));
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
