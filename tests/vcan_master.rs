@@ -78,7 +78,8 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
     }
     assert!(
         m.all_in(State::OperationEnabled),
-        "not enabled: {:?}",
+        "not enabled (fault {:?}): {:?}",
+        m.fault(),
         m.status()
     );
     let mut targets = initial.clone();

@@ -344,3 +344,47 @@ fn an_sdo_abort_is_reported_with_node_object_and_meaning() {
     );
     assert!(text.contains("does not exist"), "{text}");
 }
+
+/// Heartbeats a node sent during the set-up, before its NMT start (pre-operational), may
+/// still be queued in the socket when the master's first cycle reads it (seen in the
+/// PREEMPT_RT guest: every drive quick-stopped before it was ever enabled). They are not a
+/// fault while an Operational heartbeat can still come, within the heartbeat timeout; a node
+/// that leaves Operational afterwards, or never reaches it within the timeout, is.
+#[test]
+fn a_pre_operational_heartbeat_queued_from_the_set_up_is_not_a_fault() {
+    use drives::wire::heartbeat::{self, NmtState};
+    let id = NodeId::new(1).unwrap();
+    let beat = |node: &mut SocketLink, s: NmtState| {
+        node.send_all(&[heartbeat::encode(id, s)]).unwrap();
+    };
+    let (link, mut node) = SocketLink::pair().unwrap();
+    let mut m = Master::new(link, &[id], &[0], SUPERVISION, 0.0).unwrap();
+    beat(&mut node, NmtState::PreOperational);
+    assert!(m.cycle(&[0], 0.002).is_none(), "{:?}", m.fault());
+    beat(&mut node, NmtState::Operational);
+    assert!(m.cycle(&[0], 0.004).is_none(), "{:?}", m.fault());
+    beat(&mut node, NmtState::PreOperational);
+    let f = m
+        .cycle(&[0], 0.006)
+        .expect("leaving Operational is a fault");
+    assert_eq!(
+        f.cause,
+        FaultCause::NotOperational(NmtState::PreOperational)
+    );
+
+    // Never Operational: a fault once the heartbeat timeout (0.35 s) has passed.
+    let (link, mut node) = SocketLink::pair().unwrap();
+    let mut m = Master::new(link, &[id], &[0], SUPERVISION, 0.0).unwrap();
+    beat(&mut node, NmtState::PreOperational);
+    assert!(m.cycle(&[0], 0.002).is_none(), "{:?}", m.fault());
+    beat(&mut node, NmtState::PreOperational);
+    assert!(m.cycle(&[0], 0.34).is_none(), "{:?}", m.fault());
+    beat(&mut node, NmtState::PreOperational);
+    let f = m
+        .cycle(&[0], 0.36)
+        .expect("still pre-operational after the timeout");
+    assert_eq!(
+        f.cause,
+        FaultCause::NotOperational(NmtState::PreOperational)
+    );
+}

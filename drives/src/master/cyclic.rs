@@ -71,6 +71,11 @@ pub struct NodeStatus {
     pub last_emcy: Option<Emcy>,
     /// Cycles since the last TPDO1.
     pub cycles_without_feedback: u32,
+    /// An Operational heartbeat has come since the master took over. Until then a
+    /// pre-operational, stopped or boot-up heartbeat may be one the node sent during the
+    /// set-up, before its NMT start, still queued in the socket: it is a fault only once
+    /// the heartbeat timeout has passed without an Operational one.
+    pub operational_seen: bool,
     seq: Sequencer,
 }
 
@@ -120,6 +125,8 @@ pub struct Master<L: CanLink> {
     sup: Supervision,
     cycles: u64,
     dropped: u64,
+    /// The clock value the master was created at, s.
+    started: f64,
 }
 
 impl<L: CanLink> Master<L> {
@@ -170,6 +177,7 @@ impl<L: CanLink> Master<L> {
                 last_heartbeat: Some(now),
                 last_emcy: None,
                 cycles_without_feedback: 0,
+                operational_seen: false,
                 seq: Sequencer::new(),
             })
             .ok()?;
@@ -182,6 +190,7 @@ impl<L: CanLink> Master<L> {
             sup,
             cycles: 0,
             dropped: 0,
+            started: now,
         })
     }
 
@@ -299,6 +308,7 @@ impl<L: CanLink> Master<L> {
                 if let Ok((_, state)) = heartbeat::decode(frame) {
                     n.nmt = Some(state);
                     n.last_heartbeat = Some(now);
+                    n.operational_seen |= state == NmtState::Operational;
                 }
             }
             _ => {}
@@ -306,6 +316,7 @@ impl<L: CanLink> Master<L> {
     }
 
     fn supervise(&mut self, now: f64) {
+        let grace_over = now - self.started > self.sup.heartbeat_timeout_s;
         for i in 0..self.nodes.len() {
             let n = self.nodes[i];
             let node = n.node.get();
@@ -333,7 +344,7 @@ impl<L: CanLink> Master<L> {
                     (
                         Some(s @ (NmtState::Stopped | NmtState::PreOperational | NmtState::BootUp)),
                         _,
-                    ) => Some(FaultCause::NotOperational(s)),
+                    ) if n.operational_seen || grace_over => Some(FaultCause::NotOperational(s)),
                     (_, Some(t))
                         if self.sup.heartbeat_timeout_s > 0.0
                             && now - t > self.sup.heartbeat_timeout_s =>
