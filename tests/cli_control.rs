@@ -64,15 +64,6 @@ fn ctl_pauses_overrides_resumes_and_stops_a_run() {
     let mode = std::fs::metadata(&sock).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode, 0o660, "socket mode {mode:o}");
 
-    // The demo starts its spindle in line 9 (12 000 rpm at 8 000 rpm/s): the curve of line
-    // 11 waits for it at rest, and the status says so.
-    let waiting = wait_for(&sock, |l| l.contains("waits for the spindle"));
-    assert!(
-        waiting.contains("(line 11 waits for the spindle to reach its speed)")
-            && feed(&waiting) == 0.0,
-        "{waiting}"
-    );
-
     // Into the program at its feed (F400 = 400 mm/min).
     let running = wait_for(&sock, |l| l.starts_with("running") && feed(l) > 399.0);
     assert!(

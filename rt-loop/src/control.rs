@@ -76,8 +76,6 @@ pub struct Progress {
     pub paused: AtomicBool,
     /// Source line of the operator stop (`M00`, `M01`, `M06`) the path waits at; 0: none.
     pub awaiting: AtomicU32,
-    /// Source line of the first feed move that waits for the spindle's speed; 0: none.
-    pub awaiting_spindle: AtomicU32,
     /// Source line of the block being machined, and its N number (or index).
     pub line: AtomicU32,
     pub block: AtomicU32,
@@ -96,8 +94,6 @@ pub struct Snapshot {
     pub paused: bool,
     /// The line of the operator stop the path waits at (`M00`, `M01`, `M06`).
     pub awaiting: Option<u32>,
-    /// The line of the feed move that waits for the spindle drive to report its speed.
-    pub awaiting_spindle: Option<u32>,
     pub line: u32,
     pub block: u32,
     pub axes: [f64; 5],
@@ -119,7 +115,6 @@ impl Progress {
         stage: usize,
         paused: bool,
         awaiting: Option<u32>,
-        awaiting_spindle: Option<u32>,
         line: u32,
         block: u32,
         axes: &[f64; 5],
@@ -129,8 +124,6 @@ impl Progress {
         self.stage.store(stage.min(STAGES.len() - 1) as u8, Relaxed);
         self.paused.store(paused, Relaxed);
         self.awaiting.store(awaiting.unwrap_or(0), Relaxed);
-        self.awaiting_spindle
-            .store(awaiting_spindle.unwrap_or(0), Relaxed);
         self.line.store(line, Relaxed);
         self.block.store(block, Relaxed);
         for (a, v) in self.axes.iter().zip(axes) {
@@ -145,7 +138,6 @@ impl Progress {
             stage: STAGES[usize::from(self.stage.load(Relaxed)).min(STAGES.len() - 1)],
             paused: self.paused.load(Relaxed),
             awaiting: Some(self.awaiting.load(Relaxed)).filter(|&l| l != 0),
-            awaiting_spindle: Some(self.awaiting_spindle.load(Relaxed)).filter(|&l| l != 0),
             line: self.line.load(Relaxed),
             block: self.block.load(Relaxed),
             axes: core::array::from_fn(|j| f64::from_bits(self.axes[j].load(Relaxed))),

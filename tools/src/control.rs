@@ -46,9 +46,6 @@ pub struct Status {
     /// goes on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub awaiting_operator: Option<u32>,
-    /// The line of the feed move that waits for the spindle drive to report its speed.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub awaiting_spindle: Option<u32>,
     /// Source line and block (N number, or index) being machined.
     pub line: u32,
     pub block: u32,
@@ -80,7 +77,6 @@ impl Status {
             stage: s.stage.to_owned(),
             paused: s.paused,
             awaiting_operator: s.awaiting,
-            awaiting_spindle: s.awaiting_spindle,
             line: s.line,
             block: s.block,
             axis_names: names.to_vec(),
@@ -105,13 +101,10 @@ impl Status {
         format!(
             "{}{}  line {}  block {}  {}  F {:.1} mm/min  override {} %  cycle {}  overruns {}  feed holds {}  {:.1} %",
             self.stage,
-            match (self.awaiting_operator, self.awaiting_spindle, self.paused) {
-                (Some(l), _, _) => format!(" (stopped for the operator at line {l}: resume)"),
-                (None, _, true) => " (paused)".to_owned(),
-                (None, Some(l), false) => {
-                    format!(" (line {l} waits for the spindle to reach its speed)")
-                }
-                (None, None, false) => String::new(),
+            match (self.awaiting_operator, self.paused) {
+                (Some(l), _) => format!(" (stopped for the operator at line {l}: resume)"),
+                (None, true) => " (paused)".to_owned(),
+                (None, false) => String::new(),
             },
             self.line,
             self.block,

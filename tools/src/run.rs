@@ -520,23 +520,6 @@ fn run_threads<L: CanLink + Send>(
 pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-table.toml");
 /// The demo's program: the paper's example.
 pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
-/// What the demo adds to the paper's machine: a second bus with a spindle drive and a
-/// coolant I/O module.
-pub const DEMO_SPINDLE_COOLANT: &str = include_str!("demo/spindle-coolant.toml");
-
-/// The demo's machine file: the paper's, with [`DEMO_SPINDLE_COOLANT`].
-pub fn demo_machine() -> String {
-    format!("{DEMO_MACHINE}{DEMO_SPINDLE_COOLANT}")
-}
-
-/// The demo's program: the paper's example with the spindle started at 12 000 rpm and
-/// flood coolant on in its first line (`G90 G21`), both off in its last (`M30`); every
-/// other line, and so every line number, as the paper's.
-pub fn demo_program() -> String {
-    DEMO_PROGRAM
-        .replacen("\nG90 G21\n", "\nG90 G21 S12000 M03 M08\n", 1)
-        .replacen("\nM30\n", "\nM05 M09 M30\n", 1)
-}
 
 /// The in-process bus of `dnurbs demo` (`--link`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -558,7 +541,7 @@ pub fn demo(
     link: DemoLink,
 ) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
     let machine = config::from_str(
-        &demo_machine(),
+        DEMO_MACHINE,
         std::path::Path::new("config/machines/paper-ac-table.toml"),
     )?;
     match link {
@@ -593,7 +576,7 @@ fn demo_on<L: CanLink + Send + 'static>(
         )?);
         links.push(master_end);
     }
-    let result = run(demo_program().as_bytes(), machine, move || Ok(links), opts);
+    let result = run(DEMO_PROGRAM.as_bytes(), machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))
 }

@@ -371,7 +371,6 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             stage,
             self.follower.is_paused(),
             self.follower.awaiting(),
-            self.follower.awaiting_spindle(),
             self.follower.line(),
             sp.block,
             &axes,

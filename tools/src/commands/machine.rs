@@ -49,32 +49,13 @@ pub fn demo(
         DemoLink::Socketpair => "a socketpair CAN link",
     };
     eprintln!(
-        "dnurbs demo: the paper's example on the paper's A/C table machine with a spindle \
-         and flood coolant: 5 simulated CiA-402 drives, and a spindle drive and a coolant \
-         I/O module on a second bus, each bus {bus}, 2 ms period{}{}",
+        "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
+         CiA-402 drives on {bus}, 2 ms period{}{}",
         lead_text(lead_ns),
         cpu_text(rt)
     );
     let (r, records) = crate::run::demo(&opts, link)?;
     println!("simulated drives received {} targets", records.len());
-    let machine = config::from_str(&crate::run::demo_machine(), Path::new("demo"))?;
-    if let Some(s) = &machine.spindle {
-        println!(
-            "spindle drive node {} received speeds {} ({} drive units a rpm)",
-            s.node,
-            received(&records, s.node),
-            s.units_per_rpm
-        );
-    }
-    if let Some(c) = &machine.coolant {
-        println!(
-            "coolant module node {} received outputs {} (mist {}, flood {})",
-            c.node,
-            received(&records, c.node),
-            c.outputs(true, false),
-            c.outputs(false, true)
-        );
-    }
     finish(
         &r,
         report,
@@ -83,18 +64,6 @@ pub fn demo(
         "dnurbs demo: paper example, 2 ms",
         2_000_000,
     )
-}
-
-/// The targets one simulated node received, in order, repeats left out: `0 -> 12000 -> 0`.
-fn received(records: &[drives::sim::Record], node: u8) -> String {
-    let mut seq: Vec<i32> = Vec::new();
-    for r in records.iter().filter(|r| r.node == node) {
-        if seq.last() != Some(&r.target_counts) {
-            seq.push(r.target_counts);
-        }
-    }
-    let seq: Vec<String> = seq.iter().map(i32::to_string).collect();
-    seq.join(" -> ")
 }
 
 pub fn run(
