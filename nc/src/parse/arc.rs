@@ -55,7 +55,7 @@ pub enum Centre {
     Radius(f64),
 }
 
-/// The control net of an arc: points, weights, knots (degree 2).
+/// The control net of an arc: degree, points, weights, knots.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ArcNet {
     /// 2 for a circular arc; 4 for a helix (see the module doc).
@@ -195,11 +195,9 @@ pub fn arc(
         let slope = kk * (al.sin() + al * (1.0 - al.cos()));
         let a3 = (slope - kk * al) / 2.0;
         let a1 = kk * al - a3;
-        [-1.0, -0.5, 0.0, 0.5, 1.0]
-            .iter()
-            .zip([-1.0, 0.5, 0.0, -0.5, 1.0])
-            .map(|(s1, s3)| a1 * s1 + a3 * s3)
-            .collect::<Vec<f64>>()
+        const S1: [f64; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
+        const S3: [f64; 5] = [-1.0, 0.5, 0.0, -0.5, 1.0];
+        core::array::from_fn::<f64, 5, _>(|i| a1 * S1[i] + a3 * S3[i])
     };
     for i in 0..pieces {
         let f = |k: f64| (2.0 * i as f64 + k) / (2.0 * pieces as f64);
