@@ -67,7 +67,7 @@
 //! # cpu = 1                 # pin the real-time thread to this CPU (default: not pinned)
 //! # idle_poll = true        # keep that CPU from halting between periods (needs cpu)
 //! # lead_us = 60            # wake 60 µs early: warm up, compute, send at the deadline
-//! queue_depth = 64          # planned segments queued ahead of the interpolator, 1..=1024
+//! queue_depth = 64          # planned segments queued ahead of the interpolator, 2..=1024
 //! max_consecutive_overruns = 10 # more periods in a row past their deadline stop the run
 //! heartbeat_timeout_ms = 300    # a drive without heartbeat this long is lost
 //! feedback_timeout_ms = 20      # ... without TPDO feedback (default max(20, 5 periods))

@@ -249,7 +249,7 @@ pub struct Realtime {
     /// Wake this long before each deadline, warm the caches, compute the step and send at
     /// the deadline, s; 0 sleeps to the deadline.
     pub lead_s: f64,
-    /// Segments the planner may keep queued ahead of the interpolator, 1..=1024.
+    /// Segments the planner may keep queued ahead of the interpolator, 2..=1024.
     pub queue_depth: usize,
     /// More periods in a row than this overrunning their deadline stop the run along the
     /// path (exit 3), 1..=100000.

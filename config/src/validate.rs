@@ -406,9 +406,9 @@ impl Check<'_, '_> {
             "queue_depth",
             r.queue_depth,
             d.queue_depth as i64,
-            1,
+            2,
             Realtime::MAX_QUEUE_DEPTH as i64,
-            "segments",
+            "segments; the interpolator keeps one until it has the next",
         )?;
         let overruns = int(
             "max_consecutive_overruns",

@@ -5,7 +5,7 @@
 mod common;
 
 use common::{
-    assert_at, assert_mentions, fail, pos_of, remove, rename_table, set, MINIMAL, ORIGIN,
+    assert_at, assert_mentions, fail, parse, pos_of, remove, rename_table, set, MINIMAL, ORIGIN,
 };
 use config::ConfigError;
 
@@ -438,8 +438,13 @@ fn realtime_settings_have_ranges_and_defaults() {
     };
     assert!(with("priority", "0").ends_with("must be an integer in 1..=99 (SCHED_FIFO priority)"));
     assert!(with("priority", "100").contains("1..=99"));
-    assert!(with("queue_depth", "0").contains("1..=1024 (segments)"));
-    assert!(with("queue_depth", "5000").contains("1..=1024"));
+    assert!(with("queue_depth", "0").contains("2..=1024 (segments"));
+    // One segment alive would deadlock a hold: the interpolator waits at its end for the
+    // next, which the planner cannot push until that one is handed back.
+    assert!(with("queue_depth", "1").contains("2..=1024 (segments; the interpolator keeps one"));
+    let two = parse(&format!("{MINIMAL}\n[realtime]\nqueue_depth = 2\n")).unwrap();
+    assert_eq!(two.realtime.queue_depth, 2);
+    assert!(with("queue_depth", "5000").contains("2..=1024"));
     assert!(with("cpu", "-1").contains("CPU number"));
     // Supervision shorter than two periods (2 ms here) would fault on the first late frame.
     assert!(with("heartbeat_timeout_ms", "3").contains("must be in 4..=600000 (ms)"));

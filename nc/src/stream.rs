@@ -17,6 +17,16 @@
 //! is limited to `hold_acc / v` and its rate of change to `hold_jerk / v`, with `v` the
 //! highest planned speed of the chunks at hand, so holding adds at most `hold_acc` of path
 //! acceleration and `hold_jerk` of path jerk to the plan's own.
+//!
+//! **Every axis's acceleration holds during a hold.** With the plan's joint trajectory
+//! q(tau) and tau advancing at the rate k, an axis moves at `k q'` and accelerates at
+//! `k^2 q'' + k' q'` (primes: derivatives in plan time). The plan's own check measured
+//! `|q''| <= f A` and `|q'| <= w` for each axis (its margins, with `f <= 1 - HOLD_RESERVE`),
+//! so the axis stays within its acceleration limit A as long as
+//! `|k'| <= A (1 - f k^2) / w`. The tracker's rate is held under the least of these over
+//! the axes (times [`HOLD_SHARE`], for the discretisation), evaluated at the highest k the
+//! period can reach: the bound grows as k falls, so a stop can always begin (f < 1) and then
+//! slows down faster and faster; a resume eases into the plan as k nears 1.
 
 use crate::interp::Setpoint;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
@@ -24,11 +34,20 @@ use crate::plan::FeedProfile;
 use crate::program::Aux;
 use crate::scurve::{Motion, Phase};
 use crate::segment::{Path, Pose, Segment};
+use crate::verify::Margins;
 use heapless::spsc::{Consumer, Producer, Queue};
 use heapless::Deque;
+use hold::AxisHold;
+pub use hold::{HoldConfig, HOLD_SHARE};
+
+mod hold;
 
 /// Deepest segment queue a machine file may ask for.
 pub const MAX_DEPTH: usize = 1024;
+/// Shallowest: the interpolator keeps a segment until it has passed its end, and a hold
+/// stops before the end of the data it has, so with one segment alive it would wait at the
+/// end of each for the next, which the planner could not push.
+pub const MIN_DEPTH: usize = 2;
 /// Queue storage (an SPSC queue of N holds N - 1).
 pub const QUEUE_N: usize = MAX_DEPTH + 1;
 /// Chunks the interpolator looks ahead over (taken from the queue as they arrive).
@@ -61,6 +80,9 @@ pub struct Start {
     pub joints: Joints,
     /// Number of chunks the program has.
     pub chunks: usize,
+    /// The plan's largest axis velocities and accelerations as fractions of their limits
+    /// (its setpoint check): what a hold may add on top of them.
+    pub margins: Margins,
 }
 
 fn phase_vmax(p: &Phase) -> f64 {
@@ -83,6 +105,7 @@ pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
         pose: path.start,
         joints: path.start_joints,
         chunks: path.segments.len(),
+        margins: profile.margins,
     };
     let mut out = Vec::with_capacity(path.segments.len());
     let eps = 1e-9 * profile.length.max(1.0);
@@ -153,7 +176,7 @@ impl Queues {
             Feeder {
                 ready: rp,
                 retired: tc,
-                depth: depth.clamp(1, MAX_DEPTH),
+                depth: depth.clamp(MIN_DEPTH, MAX_DEPTH),
                 alive: 0,
                 pushed: 0,
             },
@@ -211,26 +234,6 @@ pub struct Inlet<'q> {
     retired: Producer<'q, Box<Chunk>>,
 }
 
-/// Feed-hold and stop limits, in path units.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HoldConfig {
-    pub period: f64,
-    /// Path acceleration and jerk a hold may add to the plan's.
-    pub acc: f64,
-    pub jerk: f64,
-}
-
-impl HoldConfig {
-    /// Half the path's acceleration and jerk limits.
-    pub fn from_plan(cfg: &crate::plan::PlanConfig) -> Self {
-        HoldConfig {
-            period: cfg.period,
-            acc: cfg.path_acc / 2.0,
-            jerk: cfg.path_jerk / 2.0,
-        }
-    }
-}
-
 /// Counters of a streamed run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StreamCounters {
@@ -253,6 +256,7 @@ pub struct Follower<'q> {
     kin: MachineKinematics,
     lim: RotaryLimits,
     hold: HoldConfig,
+    axis_hold: AxisHold,
     start: Start,
     received: usize,
     cycle: u64,
@@ -313,6 +317,7 @@ impl<'q> Follower<'q> {
             kin,
             lim,
             hold,
+            axis_hold: AxisHold::new(&hold, &start.margins),
             start,
             received: 0,
             cycle: 0,
@@ -471,20 +476,32 @@ impl<'q> Follower<'q> {
 
     /// Distance needed to bring the override to 0 from its current state, travelling at
     /// most `v` (a bound, not the exact figure).
+    ///
+    /// The check runs before this period's step, which may still raise the override (by at
+    /// most `r Ts + jmax Ts^2`, its rate by `jmax Ts`); the stop is bounded from there, so
+    /// that a hold that begins next period still fits. At rest the distance is next to
+    /// nothing, so a hold creeps on toward the end of the data it has rather than wait for
+    /// data that cannot come (the queue full of what it holds).
     fn stop_distance(&self, v: f64, rmax: f64, jmax: f64) -> f64 {
-        let rise = self.r.max(0.0);
-        let kpk = (self.k + rise * rise / (2.0 * jmax)).min(1.0);
-        let t = rise / jmax + kpk / rmax + 2.0 * rmax / jmax + 2.0 * self.hold.period;
-        v * kpk * t + 2.0 * v * self.hold.period
+        let ts = self.hold.period;
+        let rise = self.r.max(0.0) + jmax * ts;
+        let k_next = (self.k + self.r.max(0.0) * ts + jmax * ts * ts).min(1.0);
+        let kpk = (k_next + rise * rise / (2.0 * jmax)).min(1.0);
+        // The rate's ramps: up to rmax and back, or a triangle if it never gets there.
+        let ramps = (2.0 * rmax / jmax).min(2.0 * (kpk / jmax).sqrt());
+        let t = rise / jmax + self.axis_hold.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
+        v * kpk * t
     }
 
     /// Move the override one period toward `target` with rate <= rmax, rate change <= jmax.
+    /// Where rmax has fallen below the present rate (it tightens as k nears 1), the rate
+    /// drops to it at once: the axes' acceleration comes before the override's smoothness.
     fn track(&mut self, target: f64, rmax: f64, jmax: f64) {
         let ts = self.hold.period;
         let d = target - self.k;
         let want = d.signum() * rmax.min((2.0 * jmax * d.abs()).sqrt());
         let dr = (want - self.r).clamp(-jmax * ts, jmax * ts);
-        let r_new = self.r + dr;
+        let r_new = (self.r + dr).clamp(-rmax, rmax);
         let mut k = self.k + 0.5 * (self.r + r_new) * ts;
         let mut r = r_new;
         if (target - k) * d <= 0.0 || d.abs() < 1e-12 {
@@ -551,12 +568,26 @@ impl<'q> Follower<'q> {
             .fold(1e-9, f64::max)
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
-        let jmax = self.hold.jerk / vb;
+        let mut jmax = self.hold.jerk / vb;
+        // The axes' bound at the highest override this period can reach (it falls as k
+        // rises), so that it holds over the whole period.
+        let k_hi = (self.k + self.r.abs() * ts + jmax * ts * ts).min(1.0);
+        let rate = rmax.min(self.axis_hold.rate(k_hi));
         let complete = self.received >= self.start.chunks;
         let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
+        let room = avail_end - self.motion.s;
+        // Held at rest for data, closer to its end than the least stop distance: creep on
+        // with a gentler jerk whose stop fits in half the room. The planner may be unable to
+        // push more (the queue's depth is in the chunks held here) until the first is left.
+        if !complete && self.k == 0.0 && self.r == 0.0 && room > 0.0 {
+            let d0 = self.stop_distance(vb, rmax, jmax);
+            if d0 >= room {
+                jmax *= 0.5 * room / d0;
+            }
+        }
         let target = if self.stop_requested {
             0.0
-        } else if !complete && avail_end - self.motion.s <= self.stop_distance(vb, rmax, jmax) {
+        } else if !complete && room <= self.stop_distance(vb, rmax, jmax) {
             if !self.holding {
                 self.holding = true;
                 self.counters.underruns += 1;
@@ -573,8 +604,15 @@ impl<'q> Follower<'q> {
         if self.holding {
             self.counters.hold_periods += 1;
         }
+        // At rest (the plan at rest, or already held), the override drops to 0 at once:
+        // nothing moves. Otherwise a program whose first chunk is shorter than the distance
+        // to stop from the plan's start would begin to move, then stop short at its end.
+        if target == 0.0 && self.motion.v == 0.0 {
+            self.k = 0.0;
+            self.r = 0.0;
+        }
         let k_old = self.k;
-        self.track(target, rmax, jmax);
+        self.track(target, rate, jmax);
         let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
         // An operator stop ahead: the plan is at rest where it arrives there; hold it there
         // (paused) until the operator resumes. Only the next boundary can hold one.

@@ -13,6 +13,9 @@
 //!   Jerk is not limited over a junction whose joint path is not G2-continuous (a corner
 //!   or a change of curvature between blocks): there the velocity or the acceleration
 //!   changes direction within one period by design (the corner policy in `crate::plan`).
+//!   At such a junction the acceleration is also measured on the stencil centred on the
+//!   junction itself, its worst phase ([`corner`]): a hold or an override shifts the phase at
+//!   which the drives' setpoints meet a corner, and the limit must hold at any phase.
 //! * chord error: the largest distance of the cutter path between two setpoints from the
 //!   straight chord between them (the drives interpolate linearly), measured at the quarter
 //!   points of a curve's parameter interval and at every segment junction the chord spans.
@@ -23,7 +26,7 @@
 
 use crate::interp::{Interpolator, Mark, Method, Setpoint};
 use crate::kinematics::{Joints, MachineKinematics};
-use crate::plan::{FeedProfile, PlanConfig};
+use crate::plan::{AxisLimit, FeedProfile, PlanConfig};
 use crate::scurve::Phase;
 use crate::segment::{Geometry, Path, Segment};
 use nalgebra::Vector3;
@@ -85,12 +88,19 @@ pub struct Violation {
     pub limit: f64,
     /// For [`Quantity::Branch`]: (tilt, C) before and after the change, radians.
     pub rotary: [[f64; 2]; 2],
+    /// The acceleration of a kink at its worst phase ([`corner`]): the velocity jump, so
+    /// the value, grows linearly with the speed `v` at the junction.
+    pub kink: bool,
 }
 
 impl Violation {
     /// Factor by which the path speed must drop for this limit to hold, if slowing helps.
     pub fn speed_factor(&self) -> Option<f64> {
-        let n = self.quantity.speed_power()?;
+        let n = if self.kink {
+            1
+        } else {
+            self.quantity.speed_power()?
+        };
         Some((self.limit / self.value).powf(1.0 / f64::from(n)))
     }
 }
@@ -115,6 +125,22 @@ pub struct Checked {
 
 /// Relative slack for rounding: a value within it of the limit holds.
 const SLACK: f64 = 1e-9;
+/// Share of every axis's velocity and acceleration a plan leaves unused. A feed hold, a
+/// stop or an override change adds acceleration along the path in proportion to
+/// `1 - k^2 f` (k the override, f the plan's largest fraction, see [`crate::stream`]), so a
+/// plan at exactly its limit could not begin to slow down; and after a hold the setpoints
+/// fall at other phases of the plan than the ones measured here, which sees the velocity
+/// and the acceleration averaged over the period. Between phases the velocity differs by at
+/// most `J Ts^2 / 8` and the acceleration by `J Ts / 2` (J the axis's jerk limit, kept inside
+/// blocks; corners are measured at their worst phase, [`corner`]): [`reserve`] adds that.
+pub const HOLD_RESERVE: f64 = 1e-3;
+
+/// The fraction of an axis's velocity and acceleration limits the plan's setpoints may use.
+pub fn reserve(ax: &AxisLimit, ts: f64) -> (f64, f64) {
+    let v = 1.0 - HOLD_RESERVE - ax.jerk * ts * ts / (8.0 * ax.velocity);
+    let a = 1.0 - HOLD_RESERVE - ax.jerk * ts / (2.0 * ax.acceleration);
+    (v.max(0.5), a.max(0.5))
+}
 /// Most periods a plan may take (24 h at 1 ms): a longer plan is refused, so neither the
 /// check nor `dnurbs simulate` ever stops short of the program's end.
 pub const MAX_CYCLES: u64 = 86_400_000;
@@ -252,7 +278,7 @@ fn check_marked(
         };
         win = [win[1], win[2], win[3], next];
         check_travel(&next, cfg, &mut out);
-        check_window(&win, path, cfg, smooth, &mut out);
+        check_window(&win, path, profile, kin, cfg, smooth, &mut out);
         if !done && next.cycle % every == 0 {
             trace.marks.push(TraceMark {
                 ip: ip.mark(),
@@ -293,6 +319,7 @@ fn violation(q: Quantity, axis: usize, w: &[Sample], value: f64, limit: f64) -> 
         value,
         limit,
         rotary: [[0.0; 2]; 2],
+        kink: false,
     }
 }
 
@@ -334,6 +361,8 @@ fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
 fn check_window(
     w: &[Sample; 4],
     path: &Path,
+    profile: &FeedProfile,
+    kin: &MachineKinematics,
     cfg: &PlanConfig,
     smooth: &[bool],
     out: &mut Checked,
@@ -354,24 +383,46 @@ fn check_window(
         }
     };
     let jerk_ok = !crosses_corner(w, smooth);
+    let kink = if w[1].seg < w[2].seg {
+        corner::stencil(w, path, profile, kin, cfg, smooth)
+    } else {
+        None
+    };
     for (j, ax) in cfg.axes.iter().enumerate() {
         let (q0, q1, q2, q3) = (w[0].q[j], w[1].q[j], w[2].q[j], w[3].q[j]);
         let vel = ((q3 - q2) / ts).abs();
         let acc = ((q3 - 2.0 * q2 + q1) / (ts * ts)).abs();
+        let (v_share, a_share) = reserve(ax, ts);
+        let (vel_limit, acc_limit) = (ax.velocity * v_share, ax.acceleration * a_share);
         let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / (ts * ts * ts)).abs();
         m.velocity[j] = m.velocity[j].max(vel / ax.velocity);
         m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
-        if vel > ax.velocity * (1.0 + SLACK) || vel.is_nan() {
+        if vel > vel_limit * (1.0 + SLACK) || vel.is_nan() {
             keep(
-                violation(Quantity::Velocity, j, &w[2..], vel, ax.velocity),
+                violation(Quantity::Velocity, j, &w[2..], vel, vel_limit),
                 &mut found,
             );
         }
-        if acc > ax.acceleration * (1.0 + SLACK) || acc.is_nan() {
+        if acc > acc_limit * (1.0 + SLACK) || acc.is_nan() {
             keep(
-                violation(Quantity::Acceleration, j, &w[1..], acc, ax.acceleration),
+                violation(Quantity::Acceleration, j, &w[1..], acc, acc_limit),
                 &mut found,
             );
+        }
+        if let Some(c) = &kink {
+            let [k0, k1, k2] = &c.q;
+            let acc = ((k2[j] - 2.0 * k1[j] + k0[j]) / (ts * ts)).abs();
+            m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
+            if acc > acc_limit * (1.0 + SLACK) || acc.is_nan() {
+                // The speed at the junction sets the jump: lower it there.
+                let v = Violation {
+                    s: (c.s, c.s),
+                    v: c.v,
+                    kink: true,
+                    ..violation(Quantity::Acceleration, j, &w[1..], acc, acc_limit)
+                };
+                keep(v, &mut found);
+            }
         }
         if jerk_ok {
             m.jerk[j] = m.jerk[j].max(jerk / ax.jerk);
@@ -498,5 +549,6 @@ fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bo
     })
 }
 
+mod corner;
 #[cfg(test)]
 mod tests;

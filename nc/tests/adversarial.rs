@@ -20,6 +20,9 @@ use nc::plan::{plan, PlanConfig};
 use nc::segment::{build, BuildLimits, Geometry, Path};
 use proptest::prelude::*;
 use std::fmt::Write;
+
+#[path = "adversarial/hold.rs"]
+mod hold;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 const PERIOD: f64 = 0.002;
@@ -426,6 +429,9 @@ struct Counts {
     turning_arcs: AtomicU64,
     refused: AtomicU64,
     long: AtomicU64,
+    /// Accepted programs run through the follower with a stop, a pause, an override change,
+    /// a slow planner ([`hold::Event`]).
+    held: [AtomicU64; 4],
 }
 
 /// Largest chord error between two setpoints of one NURBS segment.
@@ -574,7 +580,15 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
             (last.0.p - end).norm()
         );
     }
-    Ok(())
+    let ev = hold::event(src);
+    let kind = match ev {
+        hold::Event::Stop { .. } => 0,
+        hold::Event::Pause { .. } => 1,
+        hold::Event::Override { .. } => 2,
+        hold::Event::Underrun { .. } => 3,
+    };
+    counts.held[kind].fetch_add(1, Ordering::Relaxed);
+    hold::check(path, &profile, &cfg, kin, ev, src)
 }
 
 /// Cases per run: `ADV_CASES` (default 300; CI sets 10 000), shared by the two halves below
@@ -642,7 +656,12 @@ fn run_half(half: u64, cases: u32) {
         counts.refused.load(Ordering::Relaxed),
         counts.long.load(Ordering::Relaxed),
     );
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool), refused with a position {refd}, too long to interpolate here {long}");
+    let held: Vec<u64> = counts
+        .held
+        .iter()
+        .map(|c| c.load(Ordering::Relaxed))
+        .collect();
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}), refused with a position {refd}, too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
     if let Err(e) = result {
         panic!("{e}");
     }

@@ -151,7 +151,7 @@ fn the_real_time_follower_streams_the_turning_arc_as_interpolated() {
     let (start, all) = chunks(path, &profile);
     let mut source = all.into_iter();
     let mut q = Queues::new();
-    let (mut feeder, inlet) = q.split(8);
+    let (mut feeder, inlet) = q.split(64);
     let mut f = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(&cfg));
     let mut streamed = Vec::new();
     loop {

@@ -1,0 +1,113 @@
+//! Limits of a feed hold, a stop and an override change: the path acceleration and jerk
+//! a hold adds, and the bound on the override's rate that keeps every axis's acceleration
+//! within its limit (see the text of [`crate::stream`]).
+
+use crate::plan::AxisLimit;
+use crate::verify::Margins;
+
+/// Feed-hold and stop limits, in path units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoldConfig {
+    pub period: f64,
+    /// Path acceleration and jerk a hold may add to the plan's.
+    pub acc: f64,
+    pub jerk: f64,
+    /// The axes' limits (X Y Z tilt C), which a hold keeps (see the module's text).
+    pub axes: [AxisLimit; 5],
+}
+
+/// Share of each axis's spare acceleration `A (1 - f k^2)` the override's rate may use; the
+/// rest covers the difference between the continuous argument and setpoints one period
+/// apart.
+pub const HOLD_SHARE: f64 = 0.9;
+
+/// Per axis, the rate bound's two factors: `c = HOLD_SHARE * A / w` (infinite for an axis
+/// the plan does not move) and `f`, the plan's acceleration fraction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct AxisHold {
+    c: [f64; 5],
+    f: [f64; 5],
+    /// Least c and greatest f: a lower bound of the rate bound, for the stop distance.
+    c_min: f64,
+    f_max: f64,
+}
+
+impl AxisHold {
+    pub(super) fn new(hold: &HoldConfig, margins: &Margins) -> Self {
+        let c: [f64; 5] = core::array::from_fn(|j| {
+            let ax = &hold.axes[j];
+            let w = margins.velocity[j] * ax.velocity;
+            if w > 0.0 && w.is_finite() {
+                HOLD_SHARE * ax.acceleration / w
+            } else {
+                f64::INFINITY
+            }
+        });
+        // A fraction at or above 1 would leave no room: k could never leave 1. A plan from
+        // `plan` keeps HOLD_RESERVE, unless the jerk term is over half the limit (an axis
+        // that reaches its acceleration within a period); then the floor keeps a stop
+        // possible.
+        // The plan's acceleration at any phase: what its check measured, plus the most the
+        // phase can add (`crate::verify::reserve`).
+        let f: [f64; 5] = core::array::from_fn(|j| {
+            let ax = &hold.axes[j];
+            let f = margins.acceleration[j] + ax.jerk * hold.period / (2.0 * ax.acceleration);
+            if f.is_finite() {
+                f.clamp(0.0, 1.0 - crate::verify::HOLD_RESERVE)
+            } else {
+                1.0 - crate::verify::HOLD_RESERVE
+            }
+        });
+        AxisHold {
+            c,
+            f,
+            c_min: c.iter().copied().fold(f64::INFINITY, f64::min),
+            f_max: f.iter().copied().fold(0.0, f64::max),
+        }
+    }
+
+    /// Highest |dk/dt| that keeps every axis's acceleration within its limit at override k
+    /// (and at any lower k).
+    pub(super) fn rate(&self, k: f64) -> f64 {
+        let k2 = k * k;
+        (0..5)
+            .map(|j| self.c[j] * (1.0 - self.f[j] * k2).max(0.0))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Upper bound of the time to bring the override from `kk` to 0 at a rate of at most
+    /// min(r, rate(k)): the integral of dk / min(r, c_min (1 - f_max k^2)).
+    pub(super) fn time_to_zero(&self, kk: f64, r: f64) -> f64 {
+        let (c, f) = (self.c_min, self.f_max.min(1.0 - 1e-12));
+        if !c.is_finite() || kk <= 0.0 {
+            return kk / r;
+        }
+        if f <= 0.0 {
+            return kk / r.min(c);
+        }
+        // Below k_star the axes allow at least r.
+        let k_star = if r >= c {
+            0.0
+        } else {
+            ((1.0 - r / c) / f).sqrt()
+        };
+        let sf = f.sqrt();
+        let mut t = kk.min(k_star) / r;
+        if kk > k_star {
+            t += ((sf * kk).atanh() - (sf * k_star).atanh()) / (c * sf);
+        }
+        t
+    }
+}
+
+impl HoldConfig {
+    /// Half the path's acceleration and jerk limits.
+    pub fn from_plan(cfg: &crate::plan::PlanConfig) -> Self {
+        HoldConfig {
+            period: cfg.period,
+            acc: cfg.path_acc / 2.0,
+            jerk: cfg.path_jerk / 2.0,
+            axes: cfg.axes,
+        }
+    }
+}

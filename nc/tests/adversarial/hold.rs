@@ -1,0 +1,200 @@
+//! The same guarantee through a hold: every accepted program also runs through the real-time
+//! [`Follower`] with one operator or planner event at a generated moment (a stop request, a
+//! pause and resume, an override change and back, or a planner that falls behind), and its
+//! setpoints hold every axis's velocity and acceleration limit and the travel, by finite
+//! differences at the period, with no hard stop; a run that is not stopped ends at the
+//! program's end. The event comes from a hash of the program text, so the programs the seeds
+//! give stay the same.
+
+use super::PERIOD;
+use nc::interp::Setpoint;
+use nc::kinematics::MachineKinematics;
+use nc::plan::{FeedProfile, PlanConfig};
+use nc::segment::Path;
+use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use proptest::prelude::*;
+
+/// One event during the run, at `at` (a fraction of the plan's duration).
+#[derive(Clone, Copy, Debug)]
+pub enum Event {
+    Stop {
+        at: f64,
+    },
+    /// Pause, and resume `rest` periods after the path is at rest.
+    Pause {
+        at: f64,
+        rest: u64,
+    },
+    /// Override `k` for `periods`, then back to 100 %.
+    Override {
+        at: f64,
+        k: f64,
+        periods: u64,
+    },
+    /// The planner pushes one chunk every `every` periods into a queue `depth` deep.
+    Underrun {
+        every: u64,
+        depth: usize,
+    },
+}
+
+/// FNV-1a of the program text, then the splitmix64 finaliser (FNV's low bits depend only
+/// on the low bits of the bytes).
+fn hash(src: &str) -> u64 {
+    let h = src.bytes().fold(0xcbf2_9ce4_8422_2325, |h: u64, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    let h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    let h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^ (h >> 31)
+}
+
+/// The event for a program: a function of its text alone.
+pub fn event(src: &str) -> Event {
+    let h = hash(src);
+    let frac = |shift: u32| ((h >> shift) & 0xffff) as f64 / 65_535.0;
+    let at = frac(8);
+    match h % 4 {
+        0 => Event::Stop { at },
+        1 => Event::Pause {
+            at,
+            rest: 1 + (h >> 24) % 200,
+        },
+        2 => Event::Override {
+            at,
+            k: 0.05 + 0.95 * frac(24),
+            periods: 1 + (h >> 40) % 2000,
+        },
+        _ => Event::Underrun {
+            every: 1 + (h >> 24) % 400,
+            depth: 2 + ((h >> 40) % 7) as usize,
+        },
+    }
+}
+
+/// Run `path` through the follower with `ev` and check its setpoints.
+pub fn check(
+    path: Path,
+    profile: &FeedProfile,
+    cfg: &PlanConfig,
+    kin: MachineKinematics,
+    ev: Event,
+    src: &str,
+) -> Result<(), TestCaseError> {
+    let end = path.segments.last().map(|s| s.pose(s.length).p);
+    let (start, all) = chunks(path, profile);
+    let mut source = all.into_iter();
+    let mut q = Queues::new();
+    let depth = match ev {
+        Event::Underrun { depth, .. } => depth,
+        _ => 64,
+    };
+    let (mut feeder, inlet) = q.split(depth);
+    let mut f = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(cfg));
+    let planned = (profile.duration / PERIOD).ceil() as u64;
+    let at = |x: f64| (x * planned as f64) as u64 + 1;
+    let mut sps: Vec<Setpoint> = Vec::new();
+    let (mut rest, mut back_at) = (0u64, None);
+    // Longest the run may take: the plan, a pause or an override's extra time, and the
+    // holds of a slow planner, with room to spare.
+    let limit = 4 * planned + 20_000 + 2 * 401 * start.chunks as u64;
+    for i in 0..limit {
+        let push = match ev {
+            Event::Underrun { every, .. } => i % every == 0,
+            _ => true,
+        };
+        if push {
+            feeder.feed(&mut source.by_ref().take(1));
+        }
+        match ev {
+            Event::Stop { at: x } if i == at(x) => f.request_stop(),
+            Event::Pause { at: x, .. } if i == at(x) => f.pause(),
+            Event::Pause { rest: r, .. } if f.is_paused() => {
+                if sps.last().is_some_and(|s| s.feed == 0.0) {
+                    rest += 1;
+                }
+                if rest >= r {
+                    f.resume();
+                }
+            }
+            Event::Override { at: x, k, periods } => {
+                if i == at(x) {
+                    f.set_override(k);
+                    back_at = Some(i + periods);
+                }
+                if back_at == Some(i) {
+                    f.set_override(1.0);
+                }
+            }
+            _ => {}
+        }
+        // An operator stop in the program (none today): the operator resumes at once.
+        if f.awaiting().is_some() && !matches!(ev, Event::Pause { .. }) {
+            f.resume();
+        }
+        let sp = f.step();
+        sps.push(sp);
+        if sp.done
+            || (f.is_stopped()
+                && sps.len() > 3
+                && sps[sps.len() - 3..].iter().all(|s| s.feed == 0.0))
+        {
+            break;
+        }
+    }
+    feeder.feed(&mut std::iter::empty());
+    let counters = f.counters();
+    prop_assert_eq!(counters.hard_stops, 0, "{:?} {:?}\n{}", ev, counters, src);
+    let last = *sps.last().unwrap();
+    match ev {
+        Event::Stop { .. } => prop_assert!(
+            last.done || f.is_stopped(),
+            "{ev:?}: neither stopped nor done after {} periods\n{src}",
+            sps.len()
+        ),
+        _ => {
+            prop_assert!(
+                last.done,
+                "{ev:?}: not done after {} periods\n{src}",
+                sps.len()
+            );
+            if let Some(end) = end {
+                prop_assert!(
+                    (last.p - end).norm() < 1e-3,
+                    "{ev:?}: ends off the end\n{src}"
+                );
+            }
+        }
+    }
+    // The drives hold the start before and the last setpoint after.
+    let mut q: Vec<Setpoint> = vec![sps[0]; 2];
+    q.extend(sps.iter().copied());
+    q.extend([last; 2]);
+    let slack = 1.0 + 1e-6;
+    for w in q.windows(3) {
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            let (q1, q2, q3) = (w[0].joints[j], w[1].joints[j], w[2].joints[j]);
+            prop_assert!(q3.is_finite(), "NaN setpoint");
+            let v = ((q3 - q2) / PERIOD).abs();
+            let a = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
+            prop_assert!(
+                v <= ax.velocity * slack,
+                "{ev:?}: axis {j} velocity {v} > {} at t={}\n{src}",
+                ax.velocity,
+                w[2].t
+            );
+            prop_assert!(
+                a <= ax.acceleration * slack,
+                "{ev:?}: axis {j} acceleration {a} > {} at cycle {}\n{src}",
+                ax.acceleration,
+                w[2].cycle
+            );
+            let (lo, hi) = cfg.travel[j];
+            prop_assert!(
+                q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
+                "axis {j} at {q3} outside travel"
+            );
+        }
+    }
+    Ok(())
+}
