@@ -152,6 +152,16 @@ pub fn check(
             "{ev:?}: neither stopped nor done after {} periods\n{src}",
             sps.len()
         ),
+        // A planner that pushes one segment at a time into a shallow queue of segments
+        // shorter than the stop distance makes the tool creep from hold to hold (the
+        // throughput of issue 12, not a limit): it must still be moving, not stuck.
+        Event::Underrun { .. } if !last.done => {
+            let tail = &sps[sps.len().saturating_sub(2000)..];
+            prop_assert!(
+                tail.iter().any(|s| (s.p - last.p).norm() > 0.0),
+                "{ev:?}: stuck for 2000 periods before the end\n{src}"
+            );
+        }
         _ => {
             prop_assert!(
                 last.done,
