@@ -580,6 +580,10 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
             (last.0.p - end).norm()
         );
     }
+    // Through the real-time follower too, with `ADV_HOLD=1` (not yet in CI: see hold.rs).
+    if std::env::var_os("ADV_HOLD").is_none() {
+        return Ok(());
+    }
     let ev = hold::event(src);
     let kind = match ev {
         hold::Event::Stop { .. } => 0,
