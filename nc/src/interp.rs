@@ -444,9 +444,9 @@ pub(crate) mod tests {
         let (_, _, sps) = run(Method::ArcLength);
         let c = paper();
         for sp in sps.iter().filter(|s| s.u.is_some()) {
-            let (p, t) = c.both(sp.u.unwrap(), 0);
+            let (p, d) = c.cutter_and_tool(sp.u.unwrap(), 0);
             assert!((sp.p - p.p).norm() < 1e-12);
-            let axis = (t.p - p.p).normalize();
+            let axis = d.p.normalize();
             assert!((sp.tool - axis).norm() < 1e-12);
             // Paper kinematics: machine XYZ = workpiece XYZ, A/C reproduce the tool axis.
             let k = MachineKinematics::Paper;

@@ -67,8 +67,12 @@ pub struct DoubleNurbs {
     knots: HVec<f64, MAX_KNOTS>,
     /// Homogeneous cutter control points (w x, w y, w z, w).
     cw: HVec<Vector4<f64>, MAX_CTRL>,
-    /// Homogeneous orientation control points (w u, w v, w w, w); empty for G06.2.
-    tw: HVec<Vector4<f64>, MAX_CTRL>,
+    /// Homogeneous tool vectors, the orientation net less the cutter net
+    /// (w (u - x), w (v - y), w (w - z), w); empty for G06.2. CT(u) - C(u) is the rational
+    /// curve of this net: evaluated directly, its direction keeps full relative precision
+    /// where the tool is near the vertical (a difference of the two curves' points would
+    /// carry the rounding of the coordinates, 1e-15 of 20 mm, into a tilt of 1e-12).
+    dw: HVec<Vector4<f64>, MAX_CTRL>,
 }
 
 /// Basis functions and their first two derivatives at one parameter (A2.3 output).
@@ -154,16 +158,42 @@ impl DoubleNurbs {
         weights: &[f64],
         knots: &[f64],
     ) -> Result<Self, CurveError> {
+        if ctrl.len() > MAX_CTRL {
+            return Err(CurveError::CtrlCount(ctrl.len()));
+        }
+        if !tool.is_empty() && tool.len() != ctrl.len() {
+            return Err(CurveError::ToolCount {
+                ctrl: ctrl.len(),
+                tool: tool.len(),
+            });
+        }
+        let mut vectors: HVec<[f64; 3], MAX_CTRL> = HVec::new();
+        for (t, c) in tool.iter().zip(ctrl) {
+            // At most MAX_CTRL: cannot fail.
+            let _ = vectors.push([t[0] - c[0], t[1] - c[1], t[2] - c[2]]);
+        }
+        Self::with_tool_vectors(degree, ctrl, &vectors, weights, knots)
+    }
+
+    /// Build from the cutter net and the tool vectors (orientation point less cutter point,
+    /// per control point); `vectors` is either empty or as long as `ctrl`.
+    pub fn with_tool_vectors(
+        degree: usize,
+        ctrl: &[[f64; 3]],
+        vectors: &[[f64; 3]],
+        weights: &[f64],
+        knots: &[f64],
+    ) -> Result<Self, CurveError> {
         let n = ctrl.len();
         if n > MAX_CTRL {
             return Err(CurveError::CtrlCount(n));
         }
-        validate_net(degree, n, tool.len(), weights, knots)?;
+        validate_net(degree, n, vectors.len(), weights, knots)?;
         let mut out = DoubleNurbs {
             degree,
             knots: HVec::new(),
             cw: HVec::new(),
-            tw: HVec::new(),
+            dw: HVec::new(),
         };
         // Capacities were checked above, so these pushes cannot fail.
         out.knots
@@ -175,9 +205,9 @@ impl DoubleNurbs {
             }
             let hp = homogeneous(p, w).ok_or(CurveError::NonFinite)?;
             let _ = out.cw.push(hp);
-            if let Some(&t) = tool.get(i) {
-                let ht = homogeneous(t, w).ok_or(CurveError::NonFinite)?;
-                let _ = out.tw.push(ht);
+            if let Some(&d) = vectors.get(i) {
+                let hd = homogeneous(d, w).ok_or(CurveError::NonFinite)?;
+                let _ = out.dw.push(hd);
             }
         }
         Ok(out)
@@ -189,7 +219,7 @@ impl DoubleNurbs {
 
     /// Whether the block carries an orientation curve (G06.5).
     pub fn has_tool_curve(&self) -> bool {
-        !self.tw.is_empty()
+        !self.dw.is_empty()
     }
 
     pub fn knots(&self) -> &[f64] {
@@ -332,15 +362,15 @@ impl DoubleNurbs {
         self.rational(&b, &self.cw, nd)
     }
 
-    /// C(u) and CT(u), each with derivatives up to `nd`, from one basis evaluation.
-    /// For a block without orientation curve, the second value equals the first.
-    pub fn both(&self, u: f64, nd: usize) -> (Ders, Ders) {
+    /// C(u) and the tool vector CT(u) - C(u), each with derivatives up to `nd`, from one
+    /// basis evaluation. For a block without orientation curve the tool vector is zero.
+    pub fn cutter_and_tool(&self, u: f64, nd: usize) -> (Ders, Ders) {
         let b = self.basis(u, nd);
         let c = self.rational(&b, &self.cw, nd);
-        if self.tw.is_empty() {
-            return (c, c);
+        if self.dw.is_empty() {
+            return (c, Ders::default());
         }
-        (c, self.rational(&b, &self.tw, nd))
+        (c, self.rational(&b, &self.dw, nd))
     }
 
     /// |C'(u)|: the parametric speed, the integrand of arc length.
@@ -532,9 +562,9 @@ pub(crate) mod tests {
         let c = paper();
         let h = 1e-5;
         for &u in &[0.05, 0.3, 0.5, 0.51, 0.8, 0.95] {
-            let (d, t) = c.both(u, 2);
-            let (dp, tp) = c.both(u + h, 1);
-            let (dm, tm) = c.both(u - h, 1);
+            let (d, t) = c.cutter_and_tool(u, 2);
+            let (dp, tp) = c.cutter_and_tool(u + h, 1);
+            let (dm, tm) = c.cutter_and_tool(u - h, 1);
             let fd1 = (dp.p - dm.p) / (2.0 * h);
             let fd2 = (dp.d1 - dm.d1) / (2.0 * h);
             assert!((fd1 - d.d1).norm() < 1e-6 * d.d1.norm(), "u={u}");
@@ -542,6 +572,42 @@ pub(crate) mod tests {
             let tfd1 = (tp.p - tm.p) / (2.0 * h);
             assert!((tfd1 - t.d1).norm() < 1e-6 * t.d1.norm(), "u={u}");
         }
+    }
+
+    #[test]
+    fn the_tool_vector_keeps_its_direction_where_it_leaves_the_vertical() {
+        // From the adversarial suite: a degree-1 block that starts with the tool exactly
+        // vertical (U V W over X Y Z) at Y -22.6. As the difference of two evaluated points,
+        // (Tx, Ty) carried the coordinates' rounding (1e-15) and its direction swung by 1e-4
+        // rad at a tilt of 1e-12 rad: C steps the drives see when a hold creeps off the
+        // vertical. From the net of tool vectors it is exact.
+        let y = -22.60927444923984;
+        let c = DoubleNurbs::new(
+            1,
+            &[[0.0, y, 0.0], [7.4481150232466735, y, 6.752408483251727]],
+            &[
+                [0.0, y, 10.162275665719585],
+                [10.073281307934828, -23.039876326592815, 16.56030992581492],
+            ],
+            &[1.0, 0.024651413916821106],
+            &[0.0, 0.0, 1.0, 1.0],
+        )
+        .unwrap();
+        let (dx, dy): (f64, f64) = (
+            10.073281307934828 - 7.4481150232466735,
+            -23.039876326592815 - y,
+        );
+        let want = (-dx).atan2(dy);
+        for e in 1..=15 {
+            let u = 10f64.powi(-e);
+            let (_, d) = c.cutter_and_tool(u, 0);
+            let got = (-d.p.x).atan2(d.p.y);
+            assert!((got - want).abs() < 1e-14, "u = {u}: {got} against {want}");
+        }
+        assert_eq!(
+            c.cutter_and_tool(0.0, 0).1.p,
+            Vector3::new(0.0, 0.0, 10.162275665719585)
+        );
     }
 
     #[test]

@@ -161,9 +161,9 @@ impl Segment {
     /// Pose at `u`; `fraction` gives the fraction of the segment's length there, needed
     /// only by an arc that turns the tool ([`Tooling::Angles`]).
     fn pose_at(&self, curve: &DoubleNurbs, u: f64, fraction: impl FnOnce() -> f64) -> Pose {
-        let (c, ct) = curve.both(u, 0);
+        let (c, d) = curve.cutter_and_tool(u, 0);
         let tool = match self.tooling {
-            Tooling::Curve => self.tool_at(0.0, Some((ct.p - c.p).normalize())),
+            Tooling::Curve => self.tool_at(0.0, Some(d.p.normalize())),
             Tooling::Angles { .. } => self.tool_at(fraction(), None),
             _ => self.tool_at(0.0, None),
         };
@@ -572,8 +572,8 @@ fn nurbs(
                 tool_clear(&curve).map_err(err)?;
                 if i == 0 {
                     let (u0, _) = curve.range();
-                    let (c, t) = curve.both(u0, 0);
-                    let start = (t.p - c.p).normalize();
+                    let (c, d) = curve.cutter_and_tool(u0, 0);
+                    let start = d.p.normalize();
                     let angle = current.cross(&start).norm().atan2(current.dot(&start));
                     if angle.to_degrees() > MAX_ORIENTATION_STEP_DEG {
                         return Err(err(BuildErrorKind::OrientationJump {
@@ -679,8 +679,8 @@ fn tool_clear(curve: &DoubleNurbs) -> Result<(), BuildErrorKind> {
     let n = 2048;
     for i in 0..=n {
         let u = u0 + (u1 - u0) * i as f64 / n as f64;
-        let (c, t) = curve.both(u, 0);
-        let dist = (t.p - c.p).norm();
+        let (_, d) = curve.cutter_and_tool(u, 0);
+        let dist = d.p.norm();
         if dist.is_nan() || dist < MIN_TOOL_VECTOR_MM {
             return Err(BuildErrorKind::ToolVectorTooShort { u, dist });
         }

@@ -4,7 +4,7 @@
 //!
 //! A cut at a parameter `u` raises the multiplicity of `u` to the degree by knot insertion
 //! (Boehm's algorithm, Piegl & Tiller A5.1, one knot at a time) on the homogeneous points of
-//! both nets at once, since they share knots and weights. The curve is unchanged by
+//! the cutter net and the tool vectors at once, since they share knots and weights. The curve is unchanged by
 //! insertion, so the pieces join with the block's own continuity there: a cut at a simple
 //! knot of a cubic keeps C2, and the planner passes the joint at speed.
 //!
@@ -35,7 +35,9 @@ pub struct Piece {
     pub corner: bool,
 }
 
-/// A homogeneous point of both nets: w x, w y, w z, w u, w v, w w, w.
+/// A homogeneous point of the cutter net and of the tool vectors (orientation point less
+/// cutter point, see [`DoubleNurbs::with_tool_vectors`]): w x, w y, w z, w (u - x),
+/// w (v - y), w (w - z), w.
 type Hp = [f64; 7];
 
 /// Cut a block's net into pieces (see the module doc). The whole net is validated first
@@ -89,14 +91,17 @@ fn cut(
     let mut pts: Vec<Hp> = (0..n)
         .map(|i| {
             let (c, w) = (ctrl[i], weights[i]);
-            let t = tool.get(i).copied().unwrap_or([0.0; 3]);
+            // The tool vector (none for G06.2).
+            let d = tool
+                .get(i)
+                .map_or([0.0; 3], |t| [t[0] - c[0], t[1] - c[1], t[2] - c[2]]);
             [
                 c[0] * w,
                 c[1] * w,
                 c[2] * w,
-                t[0] * w,
-                t[1] * w,
-                t[2] * w,
+                d[0] * w,
+                d[1] * w,
+                d[2] * w,
                 w,
             ]
         })
@@ -170,7 +175,7 @@ fn cut(
         } else {
             Vec::new()
         };
-        let curve = DoubleNurbs::new(p, &c, &t, &w, k)?;
+        let curve = DoubleNurbs::with_tool_vectors(p, &c, &t, &w, k)?;
         let corner = out
             .last()
             .is_some_and(|prev: &Piece| turns(&prev.curve, &curve));

@@ -962,7 +962,7 @@ mod tests {
         assert_eq!(counters.underruns, 0);
         // The stop point is on the curve.
         let (curve, _) = path.segments[0].nurbs().unwrap();
-        let (c, _) = curve.both(last.u.unwrap(), 0);
+        let c = curve.cutter(last.u.unwrap(), 0);
         assert!((c.p - last.p).norm() < 1e-9);
         let v = 400.0 / 60.0;
         check_smooth(&sps, &hold, v, 1.5 * cfg.path_acc + hold.acc);
@@ -1013,7 +1013,7 @@ mod tests {
         // Every setpoint on the curve, the end reached.
         let (curve, _) = keep.segments[0].nurbs().unwrap();
         for sp in &sps[1..] {
-            let (c, _) = curve.both(sp.u.unwrap(), 0);
+            let c = curve.cutter(sp.u.unwrap(), 0);
             assert!((c.p - sp.p).norm() < 1e-9);
         }
         check_smooth(&sps, &hold, 400.0 / 60.0, 1.5 * cfg.path_acc + hold.acc);

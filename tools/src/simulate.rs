@@ -280,8 +280,8 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
             let j: [f64; 5] =
                 core::array::from_fn(|i| w[0].joints[i] + (w[1].joints[i] - w[0].joints[i]) * f);
             let got = setup.kin.tool_axis(j[3], j[4]);
-            let (c, t) = curve.both(k, 0);
-            let want = (t.p - c.p).normalize();
+            let (_, d) = curve.cutter_and_tool(k, 0);
+            let want = d.p.normalize();
             tool_dev = tool_dev.max(got.cross(&want).norm().atan2(got.dot(&want)).to_degrees());
         }
     }

@@ -83,12 +83,13 @@ fn a_block_of_ten_thousand_points_is_cut_into_pieces_that_are_the_same_curve() {
         for i in 0..=3000 {
             let u = i as f64 / 3000.0;
             let piece = pieces.iter().find(|x| u <= x.curve.range().1).unwrap();
-            let (pc, pt) = piece.curve.both(u, 0);
+            let (pc, pd) = piece.curve.cutter_and_tool(u, 0);
+            let pt = pc.p + pd.p;
             let (ec, et) = (point(p, &c, &w, &k, u), point(p, &t, &w, &k, u));
             for d in 0..3 {
                 worst = worst
                     .max((pc.p[d] - ec[d]).abs())
-                    .max((pt.p[d] - et[d]).abs());
+                    .max((pt[d] - et[d]).abs());
             }
         }
         assert!(worst < 1e-9, "degree {p}: {worst} mm");
