@@ -569,10 +569,6 @@ impl<'q> Follower<'q> {
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
         let mut jmax = self.hold.jerk / vb;
-        // The axes' bound at the highest override this period can reach (it falls as k
-        // rises), so that it holds over the whole period.
-        let k_hi = (self.k + self.r.abs() * ts + jmax * ts * ts).min(1.0);
-        let rate = rmax.min(self.axis_hold.rate(k_hi));
         let complete = self.received >= self.start.chunks;
         let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
         let room = avail_end - self.motion.s;
@@ -611,6 +607,22 @@ impl<'q> Follower<'q> {
             self.k = 0.0;
             self.r = 0.0;
         }
+        // The axes' bound at the highest override this period can reach (the bound falls
+        // as k rises), so that it holds over the whole period. Within the period the rate
+        // moves linearly from r to the new rate, which is at most r toward a lower target,
+        // else at most one jerk step up, the path's bound and the axes' bound at the
+        // present k. (A bound of a whole jerk step, jmax Ts^2, would be most of the range
+        // where the plan is slow and jmax large: the rate would stay at the bound for k = 1
+        // through the whole stop, far slower than the stop distance assumes.)
+        let up = if target > self.k {
+            (self.r + jmax * ts)
+                .min(rmax)
+                .min(self.axis_hold.rate(self.k))
+        } else {
+            0.0
+        };
+        let k_hi = (self.k + ts * self.r.max(up).max(0.0)).min(1.0);
+        let rate = rmax.min(self.axis_hold.rate(k_hi));
         let k_old = self.k;
         self.track(target, rate, jmax);
         let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
