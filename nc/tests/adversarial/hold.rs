@@ -6,10 +6,13 @@
 //! program's end. The event comes from a hash of the program text, so the programs the seeds
 //! give stay the same.
 //!
-//! Runs with `ADV_HOLD=1`. Not yet in CI: on the CI seeds' 10 000 cases it finds one
-//! violation still open, C at 25.8 rad/s^2 (1.64x) seven periods into a degree-1 G06.5 block
-//! that starts with the tool exactly vertical, in a hold for data (a segment every 67
-//! periods, queue depth 5).
+//! Two faults this check found on the CI seeds, and their regressions here: C at 25.8
+//! rad/s^2 (1.64x) seven periods into a degree-1 G06.5 block that starts with the tool
+//! exactly vertical, while a hold for data crept off the vertical (the tool axis was the
+//! difference of two evaluated points, its direction noise at a tilt of 1e-12; now the curve
+//! of the tool vectors, `DoubleNurbs::cutter_and_tool`); and 38 hard stops on a 0.0086 mm
+//! arc turning A and C, where the override's rate was bounded at k = 1 through a whole stop
+//! because the bound's look-ahead was a full jerk step (`Follower::advance`).
 
 use super::PERIOD;
 use nc::interp::Setpoint;
