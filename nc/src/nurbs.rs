@@ -158,9 +158,8 @@ impl DoubleNurbs {
         weights: &[f64],
         knots: &[f64],
     ) -> Result<Self, CurveError> {
-        if ctrl.len() > MAX_CTRL {
-            return Err(CurveError::CtrlCount(ctrl.len()));
-        }
+        // A longer tool net would pass as its first ctrl.len() points; a net over MAX_CTRL
+        // is refused by `with_tool_vectors` (whatever the pushes below dropped).
         if !tool.is_empty() && tool.len() != ctrl.len() {
             return Err(CurveError::ToolCount {
                 ctrl: ctrl.len(),
