@@ -59,8 +59,9 @@ pub struct PlanConfig {
 }
 
 /// Slowest speed the planner schedules where a ceiling would be lower (path units/s), so
-/// that every section ends in finite time.
-const V_FLOOR: f64 = 1e-3;
+/// that every section ends in finite time: the plan's "exact stop" at a kink passes the
+/// kink at this speed, and its setpoint check holds there.
+pub const V_FLOOR: f64 = 1e-3;
 /// Likewise for a section's path acceleration and jerk.
 const A_FLOOR: f64 = 1e-3;
 /// Replanning rounds before every violating station is made critical at once.

@@ -30,7 +30,7 @@
 
 use crate::interp::Setpoint;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
-use crate::plan::FeedProfile;
+use crate::plan::{FeedProfile, V_FLOOR};
 use crate::program::Aux;
 use crate::scurve::{Motion, Phase};
 use crate::segment::{Path, Pose, Segment};
@@ -71,6 +71,11 @@ pub struct Chunk {
     pub t_start: f64,
     /// Highest planned speed over `phases`.
     pub vmax: f64,
+    /// Time at which the plan arrives at the segment's end (the next one's `t_start`).
+    pub t_arrive: f64,
+    /// The plan is at rest where it arrives at the segment's end (an exact stop: at most
+    /// the floor speed, [`V_FLOOR`]).
+    pub rests_at_end: bool,
 }
 
 /// The program's start, known before any chunk.
@@ -141,10 +146,27 @@ pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
             t_end,
             t_start,
             vmax,
+            t_arrive: t_end,
+            rests_at_end: false,
         }));
+    }
+    for i in 1..out.len() {
+        let t = out[i].t_start;
+        let c = &mut out[i - 1];
+        c.t_arrive = t;
+        c.rests_at_end = c
+            .phases
+            .iter()
+            .find(|p| t <= p.t0 + p.dur)
+            .is_some_and(|p| p.at((t - p.t0).clamp(0.0, p.dur)).v <= REST_V);
     }
     (start, out)
 }
+
+/// A planned speed this low is at rest: the plan's exact stop, which passes a kink at the
+/// floor speed (its setpoint check holds there, where the path's direction turns at once).
+/// Stopping from it at once is a smaller step than the plan's own at the kink.
+const REST_V: f64 = V_FLOOR * (1.0 + 1e-9);
 
 /// The two queues; create them before the threads, then [`Queues::split`].
 pub struct Queues {
@@ -673,9 +695,24 @@ impl<'q> Follower<'q> {
                 }
             }
         }
-        // Find the chunk that holds tau; bounded by the look-ahead.
+        // The data ends where the plan comes to rest (an exact stop at a kink): wait there,
+        // at rest like the plan, for the next chunk. Nothing is cut short: no hard stop.
+        let rest_end = match (self.local.len(), self.local.front()) {
+            (1, Some(c)) => c.rests_at_end && c.index + 1 < self.start.chunks && tau >= c.t_arrive,
+            _ => false,
+        };
         let mut m = self.motion;
-        for _ in 0..=LOOKAHEAD {
+        if let (true, Some(c)) = (rest_end, self.local.front()) {
+            tau = c.t_arrive.max(self.tau);
+            m = Self::motion_in(c, tau, &mut self.phase);
+            m.s = m.s.min(c.s1).max(self.motion.s);
+            m.v = 0.0;
+            self.k = 0.0;
+            self.r = 0.0;
+        }
+        // Otherwise find the chunk that holds tau; bounded by the look-ahead.
+        let walk = if rest_end { 0 } else { LOOKAHEAD + 1 };
+        for _ in 0..walk {
             let Some(c) = self.local.front() else { break };
             m = Self::motion_in(c, tau, &mut self.phase);
             if c.index + 1 == self.start.chunks {

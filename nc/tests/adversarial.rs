@@ -689,7 +689,7 @@ fn run_half(half: u64, cases: u32) {
 /// they were generated: each text gives its event (a slow planner) by its own hash.
 #[test]
 fn the_hold_faults_found_stay_fixed() {
-    let cases: [(&str, hold::Event); 2] = [
+    let cases: [(&str, hold::Event); 3] = [
         (
             include_str!("adversarial/hold-creeps-off-the-vertical.nc"),
             hold::Event::Underrun {
@@ -702,6 +702,13 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 131,
                 depth: 6,
+            },
+        ),
+        (
+            include_str!("adversarial/hold-at-a-plan-stop-at-the-end-of-data.nc"),
+            hold::Event::Underrun {
+                every: 171,
+                depth: 2,
             },
         ),
     ];

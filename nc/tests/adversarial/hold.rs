@@ -12,7 +12,12 @@
 //! difference of two evaluated points, its direction noise at a tilt of 1e-12; now the curve
 //! of the tool vectors, `DoubleNurbs::cutter_and_tool`); and 38 hard stops on a 0.0086 mm
 //! arc turning A and C, where the override's rate was bounded at k = 1 through a whole stop
-//! because the bound's look-ahead was a full jerk step (`Follower::advance`).
+//! because the bound's look-ahead was a full jerk step (`Follower::advance`). And, from the
+//! long run, one hard stop with no limit broken: the data ended at a kink where the plan
+//! makes an exact stop, passed at its floor speed, and the follower stepped past it into
+//! phases it did not have (now it waits there, at rest like the plan).
+//!
+//! Jerk is not checked here: through a hold it is bounded along the path, not per axis.
 
 use super::PERIOD;
 use nc::interp::Setpoint;
