@@ -111,6 +111,13 @@ impl FeedProfile {
         m.v = m.v.max(0.0);
         m
     }
+
+    /// Path state at time t, by a binary search over the phases (for random access;
+    /// [`Self::at`] walks forward).
+    pub fn motion_at(&self, t: f64) -> Motion {
+        let mut i = self.phases.partition_point(|p| p.t0 <= t).saturating_sub(1);
+        self.at(t, &mut i)
+    }
 }
 
 fn joint_derivatives(q: &[Joints], h: f64, i: usize) -> ([f64; 5], [f64; 5]) {

@@ -223,6 +223,13 @@ fn check_marked(
     earlier: Option<Earlier>,
     every: u64,
 ) -> (Checked, Trace) {
+    let ctx = Ctx {
+        path,
+        profile,
+        kin,
+        cfg,
+        smooth,
+    };
     let mut out = Checked::default();
     let mut trace = Trace::default();
     let ts = cfg.period;
@@ -278,7 +285,7 @@ fn check_marked(
         };
         win = [win[1], win[2], win[3], next];
         check_travel(&next, cfg, &mut out);
-        check_window(&win, path, profile, kin, cfg, smooth, &mut out);
+        check_window(&win, &ctx, &mut out);
         if !done && next.cycle % every == 0 {
             trace.marks.push(TraceMark {
                 ip: ip.mark(),
@@ -358,15 +365,18 @@ fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
     (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
 }
 
-fn check_window(
-    w: &[Sample; 4],
-    path: &Path,
-    profile: &FeedProfile,
-    kin: &MachineKinematics,
-    cfg: &PlanConfig,
-    smooth: &[bool],
-    out: &mut Checked,
-) {
+/// What a check measures against: the path, its plan, the machine, and which junctions
+/// are G2-continuous.
+struct Ctx<'a> {
+    path: &'a Path,
+    profile: &'a FeedProfile,
+    kin: &'a MachineKinematics,
+    cfg: &'a PlanConfig,
+    smooth: &'a [bool],
+}
+
+fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
+    let cfg = ctx.cfg;
     let (ts, m) = (cfg.period, &mut out.margins);
     let mut found: Option<Violation> = None;
     let keep = |v: Violation, found: &mut Option<Violation>| {
@@ -382,9 +392,9 @@ fn check_window(
             *found = Some(v);
         }
     };
-    let jerk_ok = !crosses_corner(w, smooth);
+    let jerk_ok = !crosses_corner(w, ctx.smooth);
     let kink = if w[1].seg < w[2].seg {
-        corner::stencil(w, path, profile, kin, cfg, smooth)
+        corner::stencil(w, ctx)
     } else {
         None
     };
@@ -434,7 +444,7 @@ fn check_window(
     if let Some(v) = branch_change(w) {
         keep(v, &mut found);
     }
-    let chord = chord_error(&w[2], &w[3], path);
+    let chord = chord_error(&w[2], &w[3], ctx.path);
     m.chord = m.chord.max(chord / cfg.chord_tol);
     if chord > cfg.chord_tol * (1.0 + SLACK) || chord.is_nan() {
         keep(

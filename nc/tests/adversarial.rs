@@ -456,44 +456,84 @@ fn chord(path: &Path, seg: usize, a: &Setpoint, b: &Setpoint) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// A refusal, which must name its line; counted, and shown with `ADV_VERBOSE` (and the
+/// program with `ADV_SRC`).
+fn refused(
+    stage: &str,
+    line: u32,
+    e: &dyn std::fmt::Display,
+    src: &str,
+    counts: &Counts,
+) -> Result<(), TestCaseError> {
+    prop_assert!(line >= 1, "{stage} error without a line: {e}");
+    if std::env::var_os("ADV_VERBOSE").is_some() {
+        eprintln!("refused ({stage}): {e}");
+        if std::env::var_os("ADV_SRC").is_some() {
+            eprintln!("{src}");
+        }
+    }
+    counts.refused.fetch_add(1, Ordering::Relaxed);
+    Ok(())
+}
+
+/// Every axis on the four setpoints `w` (oldest first), by finite differences at the
+/// period: velocity and acceleration on the newest, jerk too if `jerk`, and the travel.
+/// `tag` names the run in a failure.
+fn axes_hold(
+    cfg: &PlanConfig,
+    w: [&Setpoint; 4],
+    jerk: bool,
+    tag: &dyn std::fmt::Debug,
+    src: &str,
+) -> Result<(), TestCaseError> {
+    let slack = 1.0 + 1e-6;
+    let t = w[3].t;
+    for (j, ax) in cfg.axes.iter().enumerate() {
+        let [q0, q1, q2, q3] = w.map(|x| x.joints[j]);
+        prop_assert!(q3.is_finite(), "{tag:?}: NaN setpoint");
+        let v = ((q3 - q2) / PERIOD).abs();
+        let a = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
+        prop_assert!(
+            v <= ax.velocity * slack,
+            "{tag:?}: axis {j} velocity {v} > {} at t={t}\n{src}",
+            ax.velocity
+        );
+        prop_assert!(
+            a <= ax.acceleration * slack,
+            "{tag:?}: axis {j} acceleration {a} > {} at t={t}\n{src}",
+            ax.acceleration
+        );
+        if jerk {
+            let jk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / PERIOD.powi(3)).abs();
+            prop_assert!(
+                jk <= ax.jerk * slack,
+                "{tag:?}: axis {j} jerk {jk} > {} at t={t}\n{src}",
+                ax.jerk
+            );
+        }
+        let (lo, hi) = cfg.travel[j];
+        prop_assert!(
+            q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
+            "{tag:?}: axis {j} at {q3} outside travel at t={t}\n{src}"
+        );
+    }
+    Ok(())
+}
+
 /// Run the case: Ok(()) when refused with a position or when every limit holds.
 fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
     let (cfg, bl, kin) = machine();
     let program = match nc::parse::parse(src) {
         Ok(p) => p,
-        Err(e) => {
-            prop_assert!(e.pos.line >= 1, "parse error without a line: {e}");
-            if std::env::var_os("ADV_VERBOSE").is_some() {
-                eprintln!("refused (parse): {e}");
-                if std::env::var_os("ADV_SRC").is_some() {
-                    eprintln!("{src}");
-                }
-            }
-            counts.refused.fetch_add(1, Ordering::Relaxed);
-            return Ok(());
-        }
+        Err(e) => return refused("parse", e.pos.line, &e, src, counts),
     };
     let path = match build(&program, &kin, &bl) {
         Ok(p) => p,
-        Err(e) => {
-            prop_assert!(e.pos.line >= 1, "build error without a line: {e}");
-            if std::env::var_os("ADV_VERBOSE").is_some() {
-                eprintln!("refused (build): {e}");
-            }
-            counts.refused.fetch_add(1, Ordering::Relaxed);
-            return Ok(());
-        }
+        Err(e) => return refused("build", e.pos.line, &e, src, counts),
     };
     let profile = match plan(&path, &kin, &cfg) {
         Ok(p) => p,
-        Err(e) => {
-            prop_assert!(e.pos.line >= 1, "plan error without a line: {e}");
-            if std::env::var_os("ADV_VERBOSE").is_some() {
-                eprintln!("refused (plan): {e}");
-            }
-            counts.refused.fetch_add(1, Ordering::Relaxed);
-            return Ok(());
-        }
+        Err(e) => return refused("plan", e.pos.line, &e, src, counts),
     };
     if profile.duration / PERIOD > MAX_TEST_CYCLES {
         counts.long.fetch_add(1, Ordering::Relaxed);
@@ -532,40 +572,9 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
     q.extend([last; 3]);
     let slack = 1.0 + 1e-6;
     for (k, w) in q.windows(4).enumerate() {
-        let [a, b, c, d] = [&w[0].0, &w[1].0, &w[2].0, &w[3].0];
+        let [_, _, c, d] = [&w[0].0, &w[1].0, &w[2].0, &w[3].0];
         let same_seg = w.iter().all(|x| x.1 == w[0].1) && k >= 3 && k + 4 <= q.len() - 3;
-        for (j, ax) in cfg.axes.iter().enumerate() {
-            let (q0, q1, q2, q3) = (a.joints[j], b.joints[j], c.joints[j], d.joints[j]);
-            prop_assert!(q3.is_finite(), "NaN setpoint");
-            let v = ((q3 - q2) / PERIOD).abs();
-            let acc = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
-            prop_assert!(
-                v <= ax.velocity * slack,
-                "axis {j} velocity {v} > {} at t={}\n{src}",
-                ax.velocity,
-                d.t
-            );
-            prop_assert!(
-                acc <= ax.acceleration * slack,
-                "axis {j} acceleration {acc} > {} at t={}\n{src}",
-                ax.acceleration,
-                d.t
-            );
-            if same_seg {
-                let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / PERIOD.powi(3)).abs();
-                prop_assert!(
-                    jerk <= ax.jerk * slack,
-                    "axis {j} jerk {jerk} > {} at t={}\n{src}",
-                    ax.jerk,
-                    d.t
-                );
-            }
-            let (lo, hi) = cfg.travel[j];
-            prop_assert!(
-                q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
-                "axis {j} at {q3} outside travel\n{src}"
-            );
-        }
+        axes_hold(&cfg, [0, 1, 2, 3].map(|i| &w[i].0), same_seg, &"plan", src)?;
         if w[2].1 == w[3].1 {
             let e = chord(&path, w[3].1, c, d);
             prop_assert!(e <= cfg.chord_tol * slack, "chord {e} at t={}\n{src}", d.t);

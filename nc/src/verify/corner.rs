@@ -7,44 +7,21 @@
 //! measures the stencil centred on the kink: the setpoints the interpolator would give one
 //! period before the junction, on it, and one period after.
 
-use super::Sample;
-use crate::kinematics::{Joints, MachineKinematics};
-use crate::plan::{FeedProfile, PlanConfig};
-use crate::segment::Path;
-
-/// Path position of the plan at time t (the phases are in time order).
-fn s_at(profile: &FeedProfile, t: f64) -> f64 {
-    let i = profile
-        .phases
-        .partition_point(|p| p.t0 <= t)
-        .saturating_sub(1);
-    match profile.phases.get(i) {
-        Some(p) => p
-            .at((t - p.t0).clamp(0.0, p.dur))
-            .s
-            .clamp(0.0, profile.length),
-        None => 0.0,
-    }
-}
+use super::{Ctx, Sample};
+use crate::kinematics::Joints;
 
 /// Joints at path position s, near `prev`.
-fn joints_at(
-    path: &Path,
-    profile: &FeedProfile,
-    kin: &MachineKinematics,
-    cfg: &PlanConfig,
-    s: f64,
-    prev: &Joints,
-) -> Option<Joints> {
-    let k = profile
+fn joints_at(ctx: &Ctx, s: f64, prev: &Joints) -> Option<Joints> {
+    let k = ctx
+        .profile
         .seg_start
         .partition_point(|&x| x <= s)
         .saturating_sub(1)
-        .min(path.segments.len().checked_sub(1)?);
-    let seg = &path.segments[k];
+        .min(ctx.path.segments.len().checked_sub(1)?);
+    let seg = &ctx.path.segments[k];
     Some(
-        seg.pose(s - profile.seg_start[k])
-            .joints(kin, prev, &cfg.rotary),
+        seg.pose(s - ctx.profile.seg_start[k])
+            .joints(ctx.kin, prev, &ctx.cfg.rotary),
     )
 }
 
@@ -58,14 +35,8 @@ pub(super) struct Kink {
 }
 
 /// The stencil centred on the first kink between `w[1]` and `w[2]`, if there is one.
-pub(super) fn stencil(
-    w: &[Sample; 4],
-    path: &Path,
-    profile: &FeedProfile,
-    kin: &MachineKinematics,
-    cfg: &PlanConfig,
-    smooth: &[bool],
-) -> Option<Kink> {
+pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
+    let (profile, smooth) = (ctx.profile, ctx.smooth);
     let (a, b) = (w[1].seg, w[2].seg);
     let k = (a + 1..=b).find(|&k| !smooth.get(k).copied().unwrap_or(false))?;
     let s_j = *profile.seg_start.get(k)?;
@@ -76,27 +47,19 @@ pub(super) fn stencil(
     }
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if s_at(profile, mid) < s_j {
+        if profile.motion_at(mid).s < s_j {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let ts = cfg.period;
-    let before = joints_at(path, profile, kin, cfg, s_at(profile, hi - ts), &w[1].q)?;
-    let on = joints_at(path, profile, kin, cfg, s_j, &w[1].q)?;
-    let after = joints_at(path, profile, kin, cfg, s_at(profile, hi + ts), &w[2].q)?;
-    let i = profile
-        .phases
-        .partition_point(|p| p.t0 <= hi)
-        .saturating_sub(1);
-    let v = profile
-        .phases
-        .get(i)
-        .map_or(0.0, |p| p.at((hi - p.t0).clamp(0.0, p.dur)).v.max(0.0));
+    let ts = ctx.cfg.period;
+    let before = joints_at(ctx, profile.motion_at(hi - ts).s, &w[1].q)?;
+    let on = joints_at(ctx, s_j, &w[1].q)?;
+    let after = joints_at(ctx, profile.motion_at(hi + ts).s, &w[2].q)?;
     Some(Kink {
         q: [before, on, after],
         s: s_j,
-        v,
+        v: profile.motion_at(hi).v,
     })
 }

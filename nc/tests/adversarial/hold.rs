@@ -190,34 +190,11 @@ pub fn check(
         }
     }
     // The drives hold the start before and the last setpoint after.
-    let mut q: Vec<Setpoint> = vec![sps[0]; 2];
+    let mut q: Vec<Setpoint> = vec![sps[0]; 3];
     q.extend(sps.iter().copied());
     q.extend([last; 2]);
-    let slack = 1.0 + 1e-6;
-    for w in q.windows(3) {
-        for (j, ax) in cfg.axes.iter().enumerate() {
-            let (q1, q2, q3) = (w[0].joints[j], w[1].joints[j], w[2].joints[j]);
-            prop_assert!(q3.is_finite(), "NaN setpoint");
-            let v = ((q3 - q2) / PERIOD).abs();
-            let a = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
-            prop_assert!(
-                v <= ax.velocity * slack,
-                "{ev:?}: axis {j} velocity {v} > {} at t={}\n{src}",
-                ax.velocity,
-                w[2].t
-            );
-            prop_assert!(
-                a <= ax.acceleration * slack,
-                "{ev:?}: axis {j} acceleration {a} > {} at cycle {}\n{src}",
-                ax.acceleration,
-                w[2].cycle
-            );
-            let (lo, hi) = cfg.travel[j];
-            prop_assert!(
-                q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
-                "axis {j} at {q3} outside travel"
-            );
-        }
+    for w in q.windows(4) {
+        super::axes_hold(cfg, [&w[0], &w[1], &w[2], &w[3]], false, &ev, src)?;
     }
     Ok(())
 }
