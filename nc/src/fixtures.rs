@@ -5,6 +5,7 @@
 use crate::kinematics::RotaryLimits;
 use crate::plan::{AxisLimit, PlanConfig};
 use crate::segment::BuildLimits;
+use nalgebra::Vector3;
 
 /// Degree of the paper's block (`G06.5 P3`).
 pub const PAPER_DEGREE: usize = 3;
@@ -55,4 +56,78 @@ pub fn small_mill(period: f64) -> (PlanConfig, BuildLimits) {
         rotary: RotaryLimits::UNLIMITED,
     };
     (plan, build)
+}
+
+/// A G01 program through `points` (cutter, tool axis), written as a post-processor writes
+/// it: four decimals for positions, six for the unit axis; the first point is the start.
+pub fn g01_program(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_min: f64) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("%\nG90 G21 G94\n");
+    for (k, (p, a)) in points.iter().enumerate() {
+        let a = a.normalize();
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 {
+            format!(" F{feed_mm_min}")
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            s,
+            "N{} {g}X{:.4} Y{:.4} Z{:.4} I{:.6} J{:.6} K{:.6}{f}",
+            10 * (k + 1),
+            p.x,
+            p.y,
+            p.z,
+            a.x,
+            a.y,
+            a.z
+        );
+    }
+    s.push_str("M30\n%\n");
+    s
+}
+
+/// `n + 1` points along `f` (t in 0..=t_max) at equal steps of cutter path length: `step`
+/// mm, or the whole length in `n` steps if `step` is 0. By a table of 200 000 chords.
+pub fn resample(
+    f: impl Fn(f64) -> (Vector3<f64>, Vector3<f64>),
+    t_max: f64,
+    n: usize,
+    step: f64,
+) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+    let dense = 200_000;
+    let mut table = vec![(0.0, 0.0)];
+    let mut prev = f(0.0).0;
+    for j in 1..=dense {
+        let t = t_max * j as f64 / dense as f64;
+        let p = f(t).0;
+        let s = table.last().map_or(0.0, |x| x.1) + (p - prev).norm();
+        table.push((t, s));
+        prev = p;
+    }
+    let total = table.last().map_or(0.0, |x| x.1);
+    let step = if step > 0.0 { step } else { total / n as f64 };
+    (0..=n)
+        .map(|k| {
+            let s = (k as f64 * step).min(total);
+            let j = table.partition_point(|x| x.1 < s).clamp(1, dense);
+            let ((t0, s0), (t1, s1)) = (table[j - 1], table[j]);
+            let t = t0 + (t1 - t0) * (s - s0) / (s1 - s0).max(1e-300);
+            f(t)
+        })
+        .collect()
+}
+
+/// A blade-like 5-axis sweep at t (0..): the cutter along a twisted, cambered curve (about
+/// 41 mm a unit of t), the tool leaning 5..25 degrees and swinging with it.
+pub fn blade(t: f64) -> (Vector3<f64>, Vector3<f64>) {
+    let p = Vector3::new(
+        40.0 * t.cos() + 3.0 * (3.0 * t).cos(),
+        40.0 * t.sin() + 2.0 * (2.0 * t).sin(),
+        10.0 + 8.0 * t + 1.5 * (5.0 * t).sin(),
+    );
+    let lean = (15.0 + 10.0 * (2.0 * t).sin()).to_radians();
+    let sw = t + 30f64.to_radians() * t.sin();
+    let a = Vector3::new(lean.sin() * sw.cos(), lean.sin() * sw.sin(), lean.cos());
+    (p, a)
 }

@@ -16,6 +16,7 @@
 #![forbid(unsafe_code)]
 
 pub mod arclen;
+pub mod fit;
 pub mod fixtures;
 pub mod interp;
 pub mod kinematics;

@@ -473,7 +473,8 @@ fn branch_change(w: &[Sample; 4]) -> Option<Violation> {
     })
 }
 
-fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+/// Distance from `p` to the segment a..b.
+pub fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
     let ab = b - a;
     let l2 = ab.norm_squared();
     let f = if l2 > 0.0 {

@@ -219,6 +219,45 @@ pub enum Command {
         #[arg(long, short)]
         machine: PathBuf,
     },
+    /// Fit runs of G01 moves into G06.5 double-NURBS blocks (the paper's section 4).
+    ///
+    /// Each run of G01 moves (consecutive lines holding only the move, one feed, absolute
+    /// millimetres per minute, no corner above --corner-deg, each move turning the tool by at
+    /// most 10 degrees) becomes one G06.5 block: a cubic cutter curve and an orientation
+    /// curve on one knot vector, weights 1, with every programmed point within --tol-mm of
+    /// the cutter curve and every programmed tool axis within --tol-deg of the interpolated
+    /// one. Every other line passes through as it was. The result is then parsed again, both
+    /// programs are built into paths on the machine, and their deviations are measured by
+    /// dense sampling, independently of the fit; over the tolerances, nothing is written and
+    /// the exit code is 1. A summary goes to standard error.
+    #[command(after_help = crate::exit::TABLE)]
+    Fit {
+        /// NC program with G01 moves (X Y Z with I J K, or with the machine's angles).
+        program: PathBuf,
+        /// Machine file (TOML): its kinematics turn angle words into tool axes.
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Write the fitted program here (default: standard output).
+        #[arg(long, short, value_name = "OUT.nc")]
+        output: Option<PathBuf>,
+        /// Largest distance of a programmed point from the cutter curve, mm (1e-5..=1).
+        #[arg(long, default_value_t = 0.001)]
+        tol_mm: f64,
+        /// Largest angle between a programmed tool axis and the interpolated one, degrees
+        /// (1e-4..=5).
+        #[arg(long, default_value_t = 0.01)]
+        tol_deg: f64,
+        /// A turn of the path between two moves above this many degrees is a corner, where
+        /// one block ends and the next begins (0..=180).
+        #[arg(long, default_value_t = 10.0)]
+        corner_deg: f64,
+        /// Print the summary as one JSON object (on standard error).
+        #[arg(long)]
+        json: bool,
+        /// Tool table in LinuxCNC's format, for programs with `G43 H` (see `simulate`).
+        #[arg(long, value_name = "TOOL.TBL")]
+        tools: Option<PathBuf>,
+    },
     /// Compare the parameter-update methods on programs (a Markdown table).
     ///
     /// Simulates each program with taylor1, taylor2 and arclength and prints feed

@@ -7,7 +7,6 @@
 //! and the tool axis is recovered from the machine angles through forward kinematics.
 
 use crate::setup::MachineSetup;
-use nalgebra::Vector3;
 use nc::arclen::GL8;
 use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::Kinematics;
@@ -15,6 +14,7 @@ use nc::nurbs::DoubleNurbs;
 use nc::plan::{plan, FeedProfile, ProgramError};
 use nc::program::Program;
 use nc::segment::{build, Path, Tooling};
+use nc::verify::dist_to_chord;
 pub use nc::verify::MAX_CYCLES;
 use serde::Serialize;
 
@@ -143,17 +143,6 @@ pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
                 * h
         })
         .sum()
-}
-
-fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let f = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * f)).norm()
 }
 
 pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {

@@ -2,11 +2,13 @@
 //! kind picks the exit code ([`crate::exit`]).
 //!
 //! * [`offline`]: `simulate`, `compare`, `busload` (no bus, no real time);
+//! * [`fit`]: `fit` (G01 runs into G06.5 blocks);
 //! * [`machine`]: `run` and `demo` (drives, real-time thread, report);
 //! * [`latency`]: `latency` (the real-time loop alone);
 //! * [`ctl`]: `ctl` (the client of a run's control socket).
 
 pub mod ctl;
+pub mod fit;
 pub mod latency;
 pub mod machine;
 pub mod offline;
@@ -63,6 +65,27 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             shop,
         } => offline::compare(&programs, &machine, &shop),
         Command::Busload { machine } => offline::busload(&machine),
+        Command::Fit {
+            program,
+            machine,
+            output,
+            tol_mm,
+            tol_deg,
+            corner_deg,
+            json,
+            tools,
+        } => fit::fit(
+            &program,
+            &machine,
+            output.as_deref(),
+            fit::Tolerances {
+                mm: tol_mm,
+                deg: tol_deg,
+                corner_deg,
+            },
+            json,
+            tools,
+        ),
         Command::Latency {
             period,
             duration,

@@ -1,0 +1,313 @@
+//! `dnurbs fit`: runs of G01 moves fitted into G06.5 double-NURBS blocks (the paper's
+//! section 4: the cutter-centre curve and the orientation curve share one knot vector and
+//! one set of weights; its Fig. 7 turns 20 moves into one block).
+//!
+//! A run's programmed points (cutter centre and unit tool axis) are fitted by least squares
+//! with a cubic B-spline (all weights 1) whose end points are the run's first and last
+//! points, parameters by chord length (a radian of tool rotation counting as [`ROT_MM`]),
+//! then knots are inserted in every span where a point is off the cutter curve by more than
+//! the position tolerance, or the interpolated tool axis off the programmed one by more than
+//! the angle tolerance, or the curve bulges away from a move's chord by more than the
+//! tolerance and the sag of the arc the neighbouring moves turn on (the NURBS Book 9.4; the
+//! normal equations are banded and solved by Cholesky). Each insertion splits the data in
+//! the span in two, so a run costs a few refits, each linear in its points.
+//!
+//! [`runs`] finds the runs in a program's text and writes the result; [`deviation`]
+//! measures the result against the input independently of the fit, through the segment
+//! builder's own geometry.
+
+pub mod deviation;
+pub mod runs;
+mod spline;
+
+use nalgebra::Vector3;
+use spline::{basis, span, Band, MAX_FIT_DEGREE};
+
+/// Millimetres a radian of tool rotation counts as when the points are parametrised (so a
+/// move that only turns the tool still advances the parameter).
+pub const ROT_MM: f64 = 10.0;
+/// Refits before a run is given up (each splits every failing span).
+const MAX_ROUNDS: usize = 60;
+/// Parameter corrections per refit.
+const CORRECTIONS: usize = 3;
+
+/// Position and tool-axis tolerances.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Tolerance {
+    pub mm: f64,
+    pub rad: f64,
+}
+
+/// A programmed point: cutter centre (mm, workpiece frame) and unit tool axis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    pub p: Vector3<f64>,
+    pub axis: Vector3<f64>,
+}
+
+/// A fitted double curve, weights 1: cutter control points and tool vectors (the tool
+/// axis is the direction of their curve) on one knot vector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Fitted {
+    pub degree: usize,
+    pub knots: Vec<f64>,
+    pub ctrl: Vec<[f64; 3]>,
+    pub tool: Vec<[f64; 3]>,
+    /// The largest deviations the fit measured at its points (mm, rad).
+    pub dev_mm: f64,
+    pub dev_rad: f64,
+}
+
+impl Fitted {
+    /// Cutter point and tool axis (not normalised) at u.
+    pub fn eval(&self, u: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let p = self.degree;
+        let n = self.ctrl.len();
+        let i = span(&self.knots, p, n, u);
+        let mut b = [0.0; MAX_FIT_DEGREE + 1];
+        basis(&self.knots, p, i, u, &mut b);
+        let (mut c, mut t) = (Vector3::zeros(), Vector3::zeros());
+        for (r, &w) in b[..=p].iter().enumerate() {
+            c += Vector3::from(self.ctrl[i - p + r]) * w;
+            t += Vector3::from(self.tool[i - p + r]) * w;
+        }
+        (c, t)
+    }
+}
+
+/// Chord-length parameters of the points in [0, 1]; `None` if nothing moves.
+fn parameters(points: &[Point]) -> Option<Vec<f64>> {
+    let mut u = Vec::with_capacity(points.len());
+    let mut acc = 0.0;
+    u.push(0.0);
+    for w in points.windows(2) {
+        let dp = (w[1].p - w[0].p).norm();
+        let da = w[0].axis.angle(&w[1].axis) * ROT_MM;
+        acc += dp.hypot(da);
+        u.push(acc);
+    }
+    if !(acc > 0.0 && acc.is_finite()) {
+        return None;
+    }
+    for x in &mut u {
+        *x /= acc;
+    }
+    if let Some(last) = u.last_mut() {
+        *last = 1.0;
+    }
+    Some(u)
+}
+
+/// The distance the curve may stand off move k's chord (points k - 1 .. k) at its middle:
+/// the tolerance, plus four times the sag (h theta / 8) of an arc that turns as the
+/// neighbouring moves do: a guard against a curve that swings between its points, not a
+/// tolerance (the polyline is itself the CAM system's approximation of a smooth path).
+fn bulge_allowance(points: &[Point], k: usize, tol: f64) -> f64 {
+    let d = |a: usize, b: usize| points[b].p - points[a].p;
+    let h = d(k - 1, k).norm();
+    let turn = |a: usize, b: usize, c: usize| d(a, b).angle(&d(b, c));
+    let mut theta: f64 = 0.0;
+    if k >= 2 {
+        theta = theta.max(turn(k - 2, k - 1, k));
+    }
+    if k + 1 < points.len() {
+        theta = theta.max(turn(k - 1, k, k + 1));
+    }
+    if theta.is_nan() {
+        theta = 0.0;
+    }
+    tol + 0.5 * h * theta
+}
+
+/// Fit `points` (at least degree + 1 of them) within `tol`. `None` if nothing moves, or no
+/// curve with fewer control points than points meets the tolerance.
+pub fn fit(points: &[Point], tol: Tolerance, degree: usize) -> Option<Fitted> {
+    let p = degree.clamp(1, MAX_FIT_DEGREE);
+    let m = points.len().checked_sub(1)?;
+    if m < p {
+        return None;
+    }
+    let mut u = parameters(points)?;
+    // Start with one span per 32 moves, split at the data.
+    let spans0 = 1 + m / 128;
+    let mut interior: Vec<f64> = (1..spans0).map(|j| u[j * m / spans0]).collect();
+    interior.dedup();
+    interior.retain(|&x| x > 0.0 && x < 1.0);
+    for _ in 0..MAX_ROUNDS {
+        let mut knots = vec![0.0; p + 1];
+        knots.extend_from_slice(&interior);
+        knots.extend(std::iter::repeat_n(1.0, p + 1));
+        let n = knots.len() - p - 1;
+        if n > points.len() {
+            return None;
+        }
+        let mut curve = solve(points, &u, &knots, p)?;
+        // Parameter correction: each point's parameter moves to its foot on the curve, and
+        // the curve is solved again (Hoschek), so the error measured is the distance.
+        for _ in 0..CORRECTIONS {
+            if !project(&curve, points, &mut u) {
+                break;
+            }
+            curve = solve(points, &u, &knots, p)?;
+        }
+        let mut split: Vec<usize> = Vec::new();
+        let (mut dev_mm, mut dev_rad) = (0.0f64, 0.0f64);
+        let fail = |uu: f64, split: &mut Vec<usize>| {
+            let i = span(&knots, p, n, uu);
+            if split.last() != Some(&i) {
+                split.push(i);
+            }
+        };
+        for (k, pt) in points.iter().enumerate() {
+            let (c, t) = curve.eval(u[k]);
+            let e = (c - pt.p).norm();
+            let a = t.angle(&pt.axis);
+            dev_mm = dev_mm.max(e);
+            dev_rad = dev_rad.max(a);
+            if e > tol.mm || a > tol.rad || !e.is_finite() || !a.is_finite() {
+                fail(u[k], &mut split);
+            } else if k > 0 {
+                let um = 0.5 * (u[k - 1] + u[k]);
+                let (cm, _) = curve.eval(um);
+                let chord = deviation::to_segment(&cm, &points[k - 1].p, &pt.p);
+                if chord > bulge_allowance(points, k, tol.mm) {
+                    fail(um, &mut split);
+                }
+            }
+        }
+        if split.is_empty() {
+            return Some(Fitted {
+                dev_mm,
+                dev_rad,
+                ..curve
+            });
+        }
+        split.sort_unstable();
+        split.dedup();
+        let before = interior.len();
+        for i in split {
+            let (a, b) = (knots[i], knots[i + 1]);
+            // The middle datum strictly inside the span, else the span's middle.
+            let lo = u.partition_point(|&x| x <= a);
+            let hi = u.partition_point(|&x| x < b);
+            let at = if hi > lo {
+                u[(lo + hi) / 2]
+            } else {
+                0.5 * (a + b)
+            };
+            if at > a && at < b {
+                interior.push(at);
+            }
+        }
+        if interior.len() == before {
+            return None;
+        }
+        interior.sort_unstable_by(f64::total_cmp);
+        interior.dedup();
+    }
+    None
+}
+
+/// Each interior point's parameter moved to the foot of the perpendicular from the point to
+/// the curve (two Gauss-Newton steps), kept between its neighbours'. Whether any moved.
+fn project(curve: &Fitted, points: &[Point], u: &mut [f64]) -> bool {
+    const H: f64 = 1e-7;
+    let mut moved = false;
+    let m = u.len() - 1;
+    for k in 1..m {
+        let (lo, hi) = (u[k - 1], u[k + 1]);
+        let mut x = u[k];
+        for _ in 0..2 {
+            let (c, _) = curve.eval(x);
+            let d = (curve.eval((x + H).min(1.0)).0 - curve.eval((x - H).max(0.0)).0)
+                / ((x + H).min(1.0) - (x - H).max(0.0));
+            let dd = d.norm_squared();
+            if dd.is_nan() || dd <= 1e-18 {
+                break;
+            }
+            let step = (c - points[k].p).dot(&d) / dd;
+            let margin = 1e-9 * (hi - lo);
+            x = (x - step).clamp(lo + margin, hi - margin);
+        }
+        if x.is_finite() && (x - u[k]).abs() > 1e-13 {
+            u[k] = x;
+            moved = true;
+        }
+    }
+    moved
+}
+
+/// Least squares with the end points fixed: the interior control points of the cutter
+/// curve and of the tool vectors, from one set of normal equations.
+fn solve(points: &[Point], u: &[f64], knots: &[f64], p: usize) -> Option<Fitted> {
+    let n = knots.len() - p - 1;
+    let row =
+        |pt: &Point| -> [f64; 6] { [pt.p.x, pt.p.y, pt.p.z, pt.axis.x, pt.axis.y, pt.axis.z] };
+    let (first, last) = (row(points.first()?), row(points.last()?));
+    let mut net: Vec<[f64; 6]> = vec![first; n];
+    net[n - 1] = last;
+    let free = n.saturating_sub(2);
+    if free > 0 {
+        let mut a = Band::new(free, p.max(2));
+        let mut rhs = vec![[0.0; 6]; free];
+        let mut b = [0.0; MAX_FIT_DEGREE + 1];
+        for (pt, &uk) in points.iter().zip(u) {
+            let i = span(knots, p, n, uk);
+            basis(knots, p, i, uk, &mut b);
+            let mut r = row(pt);
+            for (k, &w) in b[..=p].iter().enumerate() {
+                let idx = i - p + k;
+                if idx == 0 || idx == n - 1 {
+                    let fixed = if idx == 0 { &first } else { &last };
+                    for c in 0..6 {
+                        r[c] -= w * fixed[c];
+                    }
+                }
+            }
+            for (k1, &w1) in b[..=p].iter().enumerate() {
+                let i1 = i - p + k1;
+                if i1 == 0 || i1 == n - 1 || w1 == 0.0 {
+                    continue;
+                }
+                for c in 0..6 {
+                    rhs[i1 - 1][c] += w1 * r[c];
+                }
+                for (k2, &w2) in b[..=k1].iter().enumerate() {
+                    let i2 = i - p + k2;
+                    if i2 == 0 || i2 == n - 1 {
+                        continue;
+                    }
+                    a.add(i1 - 1, i2 - 1, w1 * w2);
+                }
+            }
+        }
+        // A whisper of smoothing (second differences) keeps spans without data solvable.
+        let scale = (0..free)
+            .map(|i| a.get(i, i))
+            .fold(0.0, f64::max)
+            .max(1e-300);
+        let lambda = 1e-12 * scale;
+        for i in 0..free {
+            a.add(i, i, 6.0 * lambda);
+            if i >= 1 {
+                a.add(i, i - 1, -4.0 * lambda);
+            }
+            if i >= 2 {
+                a.add(i, i - 2, lambda);
+            }
+        }
+        a.solve(&mut rhs)?;
+        net[1..n - 1].copy_from_slice(&rhs);
+    }
+    Some(Fitted {
+        degree: p,
+        knots: knots.to_vec(),
+        ctrl: net.iter().map(|r| [r[0], r[1], r[2]]).collect(),
+        tool: net.iter().map(|r| [r[3], r[4], r[5]]).collect(),
+        dev_mm: 0.0,
+        dev_rad: 0.0,
+    })
+}
+
+#[cfg(test)]
+mod tests;

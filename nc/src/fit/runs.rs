@@ -1,0 +1,380 @@
+//! Runs of G01 moves in a program's text, and the program with each run fitted into one
+//! G06.5 block ([`fit_program`]).
+//!
+//! A run is a sequence of `G01` moves on consecutive lines that hold nothing else (no
+//! comment, no other word), all at one feed and tool length, in absolute millimetres with
+//! a feed per minute (`G90 G21 G94`), each moving the cutter and turning the tool by at
+//! most [`MAX_TURN_DEG`], with no corner sharper than the corner angle between two moves.
+//! It starts where the move before it ends (that move must be a `G00`/`G01`). Every other
+//! line is written as it was; so is a run the fit cannot bring within the tolerances (it
+//! is counted). Work offsets are left out of the parse (the program's own numbers are
+//! written back, and the offsets apply to them at run time as they did to the moves).
+
+use super::{fit, Fitted, Point, Tolerance};
+use crate::kinematics::{Kinematics, MachineKinematics};
+use crate::program::{Block, LinearMove, Orientation, Program};
+use nalgebra::Vector3;
+use std::fmt::Write;
+
+/// Largest tool turn (degrees) of one move in a run: the fit follows the tool axis at the
+/// points, so a move's own turn between them must be small (and a `C` turn of a whole
+/// revolution, which leaves the axis where it was, is never fitted away).
+pub const MAX_TURN_DEG: f64 = 10.0;
+/// Length the orientation points stand off the cutter points (mm): `U V W` = `X Y Z` +
+/// this times the tool vector, so the six decimals written give the axis to 1e-7 rad.
+pub const TOOL_MM: f64 = 10.0;
+
+/// How to fit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Options {
+    pub tol: Tolerance,
+    /// A turn of the path between two moves above this (degrees) is a corner: runs end there.
+    pub corner_deg: f64,
+    /// Degree of the curves written (`G06.5 P`).
+    pub degree: usize,
+    /// Shortest run fitted, in moves.
+    pub min_moves: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            tol: Tolerance {
+                mm: 0.001,
+                rad: 0.01f64.to_radians(),
+            },
+            corner_deg: 10.0,
+            degree: 3,
+            min_moves: 4,
+        }
+    }
+}
+
+/// One run and what became of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Run {
+    /// Source lines of its first and last move (1-based).
+    pub lines: (u32, u32),
+    /// The programmed points: where the run starts, then each move's end.
+    pub points: Vec<Point>,
+    /// Programmed feed of the run, mm/min.
+    pub feed_mm_min: f64,
+    /// The block written, or `None` when the moves were kept.
+    pub fitted: Option<Fitted>,
+}
+
+/// What [`fit_program`] did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Motion blocks (`G00`, `G01`, arcs, NURBS) in and out.
+    pub blocks_in: usize,
+    pub blocks_out: usize,
+    /// `G01` moves in, and those now inside a G06.5 block.
+    pub moves_in: usize,
+    pub moves_fitted: usize,
+    /// G06.5 blocks written.
+    pub fitted_blocks: usize,
+    /// Runs of at least `min_moves` the fit could not bring within tolerance (kept as G01).
+    pub runs_kept: usize,
+    pub bytes_in: usize,
+    pub bytes_out: usize,
+    /// The largest deviations the fit itself measured at the points (mm, degrees).
+    pub fit_mm: f64,
+    pub fit_deg: f64,
+}
+
+/// The fitted program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOutput {
+    pub text: String,
+    pub runs: Vec<Run>,
+    pub summary: Summary,
+}
+
+/// Modal state at the start of each line that decides whether a run may be written as
+/// absolute millimetres per minute: (G90, G21, G94) all in effect.
+fn plain_modes(src: &str) -> Vec<bool> {
+    let (mut abs, mut mm, mut per_min) = (true, true, true);
+    let mut out = Vec::new();
+    for line in src.split('\n') {
+        out.push(abs && mm && per_min);
+        for g in g_codes(&strip_comments(line)) {
+            match g {
+                900 => abs = true,
+                910 => abs = false,
+                210 => mm = true,
+                200 => mm = false,
+                940 => per_min = true,
+                930 | 950 => per_min = false,
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+/// The G codes of a line (comments stripped), in tenths: `G91` is 910, `G06.5` 65.
+fn g_codes(code: &str) -> impl Iterator<Item = u32> + '_ {
+    code.char_indices()
+        .filter(|(_, c)| c.eq_ignore_ascii_case(&'G'))
+        .filter_map(|(i, _)| {
+            let num: String = code[i + 1..]
+                .trim_start()
+                .chars()
+                .take_while(|c| c.is_ascii_digit() || *c == '.')
+                .collect();
+            let x: f64 = num.parse().ok()?;
+            let tenths = (x * 10.0).round();
+            ((tenths - x * 10.0).abs() < 1e-6 && tenths < 10_000.0).then_some(tenths as u32)
+        })
+}
+
+fn strip_comments(line: &str) -> String {
+    let mut out = String::with_capacity(line.len());
+    let mut depth = 0;
+    for ch in line.chars() {
+        match ch {
+            ';' if depth == 0 => break,
+            '(' => depth += 1,
+            ')' if depth > 0 => depth -= 1,
+            _ if depth == 0 => out.push(ch),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// A line that holds one linear move and nothing else: words N, G1/G01, X Y Z A B C I J K, F.
+fn pure_move_line(line: &str) -> bool {
+    let mut chars = line.trim_end_matches('\r').chars().peekable();
+    let mut words = 0;
+    while let Some(ch) = chars.next() {
+        if ch == ' ' || ch == '\t' {
+            continue;
+        }
+        let letter = ch.to_ascii_uppercase();
+        if !"NGXYZABCIJKF".contains(letter) {
+            return false;
+        }
+        let mut num = String::new();
+        while let Some(&c) = chars.peek() {
+            if c.is_ascii_digit() || c == '.' || c == '-' || c == '+' || c == ' ' {
+                if c != ' ' {
+                    num.push(c);
+                }
+                chars.next();
+                if c == ' ' && chars.peek().is_some_and(|c| c.is_ascii_alphabetic()) {
+                    break;
+                }
+            } else {
+                break;
+            }
+        }
+        let Ok(x) = num.parse::<f64>() else {
+            return false;
+        };
+        if letter == 'G' && x != 1.0 {
+            return false;
+        }
+        words += 1;
+    }
+    words > 0
+}
+
+fn point(m: &LinearMove, kin: &MachineKinematics) -> Point {
+    let axis = match m.orientation {
+        Orientation::Vector(v) => Vector3::from(v).normalize(),
+        Orientation::Angles { r1_deg, r2_deg } => {
+            kin.tool_axis(r1_deg.to_radians(), r2_deg.to_radians())
+        }
+    };
+    Point {
+        p: Vector3::from(m.end),
+        axis,
+    }
+}
+
+fn angles(m: &LinearMove) -> Option<(f64, f64)> {
+    match m.orientation {
+        Orientation::Angles { r1_deg, r2_deg } => Some((r1_deg, r2_deg)),
+        Orientation::Vector(_) => None,
+    }
+}
+
+/// Fit every run of `program` (parsed from `src` without work offsets).
+pub fn fit_program(
+    src: &str,
+    program: &Program,
+    kin: &MachineKinematics,
+    opts: &Options,
+) -> FitOutput {
+    let lines: Vec<&str> = src.split('\n').collect();
+    let plain = plain_modes(src);
+    let linear = |b: usize| match program.blocks.get(b) {
+        Some(Block::Linear(m)) => Some(m),
+        _ => None,
+    };
+    let line_of = |b: usize| program.blocks[b].pos().line as usize;
+    let turn_ok = |a: &LinearMove, b: &LinearMove| {
+        let (pa, pb) = (point(a, kin), point(b, kin));
+        let rot = match (angles(a), angles(b)) {
+            (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
+            _ => pa.axis.angle(&pb.axis).to_degrees(),
+        };
+        (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
+    };
+    // Move b may be in a run: a G01 on a line of its own, in plain modes, after a linear move.
+    let eligible = |b: usize| -> bool {
+        let (Some(m), Some(prev)) = (linear(b), b.checked_sub(1).and_then(linear)) else {
+            return false;
+        };
+        let l = line_of(b);
+        !m.rapid
+            && l >= 1
+            && lines.get(l - 1).is_some_and(|t| pure_move_line(t))
+            && plain.get(l - 1).copied().unwrap_or(false)
+            && turn_ok(prev, m)
+    };
+    let corner = |b: usize| -> bool {
+        let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
+            return true;
+        };
+        let (d1, d2) = (
+            Vector3::from(m.end) - Vector3::from(a.end),
+            Vector3::from(c.end) - Vector3::from(m.end),
+        );
+        d1.angle(&d2).to_degrees() > opts.corner_deg
+    };
+    let mut summary = Summary {
+        blocks_in: program.blocks.len(),
+        // Block 0 is the start pose, not a move.
+        moves_in: (1..program.blocks.len())
+            .filter(|&b| linear(b).is_some_and(|m| !m.rapid))
+            .count(),
+        bytes_in: src.len(),
+        ..Summary::default()
+    };
+    let mut runs = Vec::new();
+    let mut b = 1;
+    while b < program.blocks.len() {
+        if !eligible(b) {
+            b += 1;
+            continue;
+        }
+        let first = linear(b).copied();
+        let mut e = b;
+        while e + 1 < program.blocks.len()
+            && eligible(e + 1)
+            && line_of(e + 1) == line_of(e) + 1
+            && linear(e + 1).map(|m| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode))
+                == first.map(|m| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode))
+            && linear(e + 1).is_some_and(|m| !m.tooling.wait.is_some())
+            && !corner(e)
+        {
+            e += 1;
+        }
+        if e + 1 - b >= opts.min_moves {
+            let points: Vec<Point> = (b - 1..=e)
+                .filter_map(|k| linear(k).map(|m| point(m, kin)))
+                .collect();
+            let fitted = fit(&points, opts.tol, opts.degree);
+            runs.push(Run {
+                lines: (line_of(b) as u32, line_of(e) as u32),
+                points,
+                feed_mm_min: first.map_or(0.0, |m| m.feed_mm_min),
+                fitted,
+            });
+        }
+        b = e + 1;
+    }
+    let eol = if src.contains("\r\n") { "\r\n" } else { "\n" };
+    let mut text = String::with_capacity(src.len() / 2);
+    let mut next = 0;
+    for run in &runs {
+        let Some(f) = &run.fitted else {
+            summary.runs_kept += 1;
+            continue;
+        };
+        let (l0, l1) = (run.lines.0 as usize, run.lines.1 as usize);
+        for l in &lines[next..l0 - 1] {
+            text.push_str(l);
+            text.push('\n');
+        }
+        let n_word = n_word(lines[l0 - 1]);
+        write_block(&mut text, f, run.feed_mm_min, n_word.as_deref(), eol);
+        next = l1;
+        summary.fitted_blocks += 1;
+        summary.moves_fitted += l1 + 1 - l0;
+        summary.fit_mm = summary.fit_mm.max(f.dev_mm);
+        summary.fit_deg = summary.fit_deg.max(f.dev_rad.to_degrees());
+    }
+    let rest = &lines[next.min(lines.len())..];
+    for (i, l) in rest.iter().enumerate() {
+        text.push_str(l);
+        if i + 1 < rest.len() {
+            text.push('\n');
+        }
+    }
+    summary.bytes_out = text.len();
+    summary.blocks_out = summary.blocks_in - summary.moves_fitted + summary.fitted_blocks;
+    FitOutput {
+        text,
+        runs,
+        summary,
+    }
+}
+
+/// The line's `N` word, if it starts with one.
+fn n_word(line: &str) -> Option<String> {
+    let t = line.trim_start();
+    let rest = t.strip_prefix(['N', 'n'])?;
+    let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
+    (!digits.is_empty()).then(|| format!("N{digits}"))
+}
+
+/// A number with up to six decimals, no trailing zeros.
+fn num(x: f64) -> String {
+    let s = format!("{x:.6}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_owned()
+    } else {
+        s.to_owned()
+    }
+}
+
+fn write_block(out: &mut String, f: &Fitted, feed: f64, n: Option<&str>, eol: &str) {
+    let p = f.degree;
+    for (i, (c, t)) in f.ctrl.iter().zip(&f.tool).enumerate() {
+        if i == 0 {
+            if let Some(n) = n {
+                let _ = write!(out, "{n} ");
+            }
+            let _ = write!(out, "G06.5 P{p} ");
+        }
+        let _ = write!(
+            out,
+            "X{} Y{} Z{} U{} V{} W{} K{}",
+            num(c[0]),
+            num(c[1]),
+            num(c[2]),
+            num(c[0] + TOOL_MM * t[0]),
+            num(c[1] + TOOL_MM * t[1]),
+            num(c[2] + TOOL_MM * t[2]),
+            knot(f.knots[i])
+        );
+        if i == 0 {
+            let _ = write!(out, " F{}", num(feed));
+        }
+        out.push_str(eol);
+    }
+    let tail: Vec<String> = f.knots[f.ctrl.len()..].iter().map(|&k| knot(k)).collect();
+    let _ = write!(out, "K{}{eol}", tail.join(" K"));
+}
+
+/// Knots with twelve significant decimals: the fit's parameters, not lengths.
+fn knot(k: f64) -> String {
+    let s = format!("{k:.12}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_owned()
+}

@@ -1,0 +1,78 @@
+use super::*;
+
+fn pt(p: [f64; 3], a: [f64; 3]) -> Point {
+    Point {
+        p: Vector3::from(p),
+        axis: Vector3::from(a).normalize(),
+    }
+}
+
+const TOL: Tolerance = Tolerance {
+    mm: 0.001,
+    rad: 0.01 * core::f64::consts::PI / 180.0,
+};
+
+#[test]
+fn points_on_a_cubic_fit_into_one_span() {
+    // A cubic polynomial curve: one Bezier span reproduces it.
+    let points: Vec<Point> = (0..=40)
+        .map(|k| {
+            let t = f64::from(k) / 40.0;
+            pt(
+                [10.0 * t, 5.0 * t * t, 2.0 * t * t * t],
+                [0.0, 0.1 * t, 1.0],
+            )
+        })
+        .collect();
+    let f = fit(&points, TOL, 3).unwrap();
+    assert!(f.ctrl.len() <= 8, "{} control points", f.ctrl.len());
+    assert!(f.dev_mm <= TOL.mm && f.dev_rad <= TOL.rad);
+}
+
+#[test]
+fn a_circle_of_short_chords_needs_few_control_points_and_stays_within_tolerance() {
+    let r = 20.0;
+    let points: Vec<Point> = (0..=600)
+        .map(|k| {
+            let a = f64::from(k) * 0.1 / r;
+            pt(
+                [r * a.cos(), r * a.sin(), 0.0],
+                [a.cos() * 0.3, a.sin() * 0.3, 1.0],
+            )
+        })
+        .collect();
+    let f = fit(&points, TOL, 3).unwrap();
+    assert!(
+        f.ctrl.len() * 10 <= points.len(),
+        "{} control points",
+        f.ctrl.len()
+    );
+    assert!(
+        f.dev_mm <= TOL.mm && f.dev_rad <= TOL.rad,
+        "{} {}",
+        f.dev_mm,
+        f.dev_rad
+    );
+}
+
+#[test]
+fn noise_above_the_tolerance_is_followed_not_smoothed_away() {
+    // Points 5 um off a line on alternate moves: every point must still be within 1 um,
+    // which takes a control point for nearly every point.
+    let points: Vec<Point> = (0..=50)
+        .map(|k| {
+            let y = if k % 2 == 1 { 0.005 } else { 0.0 };
+            pt([f64::from(k) * 0.1, y, 0.0], [0.0, 0.0, 1.0])
+        })
+        .collect();
+    if let Some(f) = fit(&points, TOL, 3) {
+        assert!(f.dev_mm <= TOL.mm, "{}", f.dev_mm);
+        assert!(f.ctrl.len() > 25, "{} control points", f.ctrl.len());
+    }
+}
+
+#[test]
+fn nothing_moving_is_not_fitted() {
+    let points = vec![pt([1.0, 2.0, 3.0], [0.0, 0.0, 1.0]); 6];
+    assert!(fit(&points, TOL, 3).is_none());
+}

@@ -1,0 +1,215 @@
+//! `nc::fit` on programs it did not write: the paper's 20 moves, a blade-like sweep, a
+//! raster with corners, a post's program with lines that are not moves, and generated
+//! curves. Every result is read back by the parser, built by the segment builder and
+//! measured against the input by `fit::deviation` (dense sampling of the built paths), not
+//! by the fit's own numbers.
+
+use nalgebra::Vector3;
+use nc::fit::deviation::{measure, Deviation};
+use nc::fit::runs::{fit_program, FitOutput, Options};
+use nc::fit::Tolerance;
+use nc::fixtures::{blade, g01_program as g01, resample};
+use nc::kinematics::MachineKinematics;
+use nc::nurbs::DoubleNurbs;
+use nc::segment::build;
+use proptest::prelude::*;
+use std::fmt::Write;
+
+const KIN: MachineKinematics = MachineKinematics::Paper;
+
+/// Fit `src`, read the result back and measure it against the input.
+fn fit_and_measure(src: &str, opts: &Options) -> (FitOutput, Deviation) {
+    let (_, bl) = nc::fixtures::small_mill(0.002);
+    let input = nc::parse::parse(src).expect("input parses");
+    let out = fit_program(src, &input, &KIN, opts);
+    let fitted = nc::parse::parse(&out.text)
+        .unwrap_or_else(|e| panic!("the result does not parse: {e}\n{}", out.text));
+    let a = build(&input, &KIN, &bl).expect("input builds");
+    let b = build(&fitted, &KIN, &bl)
+        .unwrap_or_else(|e| panic!("the result does not build: {e}\n{}", out.text));
+    let dev = measure(&a, &b, &KIN, 0.002);
+    (out, dev)
+}
+
+fn within(dev: &Deviation, tol: Tolerance) {
+    assert!(dev.point_mm <= tol.mm + 5e-7, "{dev:?}");
+    assert!(dev.point_deg <= tol.rad.to_degrees() * 1.001, "{dev:?}");
+}
+
+/// The paper's G06.5 block (its section 6.2), evaluated by the controller's own code.
+fn paper_curve() -> DoubleNurbs {
+    use nc::fixtures::{PAPER_C, PAPER_DEGREE, PAPER_K, PAPER_T};
+    DoubleNurbs::new(PAPER_DEGREE, &PAPER_C, &PAPER_T, &[1.0; 5], &PAPER_K).unwrap()
+}
+
+#[test]
+fn the_papers_twenty_moves_become_one_block() {
+    // Fig. 7: a CAM path of 20 moves, here at equal steps of length along the paper's block.
+    let curve = paper_curve();
+    let points = resample(
+        |t| {
+            let (c, d) = curve.cutter_and_tool(t.min(1.0), 0);
+            (c.p, d.p)
+        },
+        1.0,
+        20,
+        0.0,
+    );
+    let src = g01(&points, 400.0);
+    let opts = Options::default();
+    let (out, dev) = fit_and_measure(&src, &opts);
+    assert_eq!(out.summary.moves_in, 20, "{:?}", out.summary);
+    assert_eq!(out.summary.moves_fitted, 20, "{:?}", out.summary);
+    assert_eq!(out.summary.fitted_blocks, 1);
+    assert_eq!(out.summary.blocks_out, 2, "{}", out.text);
+    within(&dev, opts.tol);
+    // It runs: the planner accepts it on the test machine.
+    let (cfg, bl) = nc::fixtures::small_mill(0.002);
+    let prog = nc::parse::parse(&out.text).unwrap();
+    let path = build(&prog, &KIN, &bl).unwrap();
+    nc::plan::plan(&path, &KIN, &cfg).expect("the fitted block plans");
+}
+
+#[test]
+fn a_blade_sweep_of_3000_moves_shrinks_tenfold_within_the_tolerances() {
+    let points = resample(blade, 8.0, 3000, 0.1);
+    let src = g01(&points, 3000.0);
+    let opts = Options::default();
+    let (out, dev) = fit_and_measure(&src, &opts);
+    let s = &out.summary;
+    assert_eq!(s.moves_in, 3000);
+    assert!(s.blocks_out * 10 <= s.blocks_in, "{s:?}");
+    assert!(s.bytes_out * 10 <= s.bytes_in, "{s:?}");
+    within(&dev, opts.tol);
+    // Between the points the curve stays within a micrometre of the programmed chords too.
+    assert!(dev.path_mm <= 2e-3, "{dev:?}");
+}
+
+#[test]
+fn a_raster_keeps_its_corners() {
+    // Rows of 0.1 mm moves along a gentle wave, 1 mm step-over moves at 90 degrees.
+    let mut points = Vec::new();
+    let rows = 6;
+    for r in 0..rows {
+        let y = f64::from(r);
+        for k in 0..=300 {
+            let x = f64::from(k) * 0.1;
+            let x = if r % 2 == 0 { x } else { 30.0 - x };
+            let z = 0.5 * (x / 5.0).sin() + 0.1 * y;
+            points.push((Vector3::new(x, y, z), Vector3::new(0.0, 0.0, 1.0)));
+        }
+    }
+    let src = g01(&points, 3000.0);
+    let opts = Options::default();
+    let (out, dev) = fit_and_measure(&src, &opts);
+    assert_eq!(
+        out.summary.fitted_blocks, rows as usize,
+        "{:?}",
+        out.summary
+    );
+    within(&dev, opts.tol);
+    // Each block starts and ends on a corner point exactly as programmed.
+    let prog = nc::parse::parse(&out.text).unwrap();
+    let corners: Vec<[f64; 3]> = prog
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            nc::program::Block::Nurbs(n) => Some([n.ctrl[0], n.ctrl[n.ctrl.len() - 1]]),
+            _ => None,
+        })
+        .flatten()
+        .collect();
+    for c in corners {
+        let hit = points.iter().any(|(p, _)| {
+            (p - Vector3::from(c)).norm() < 1e-4 && (p.x.abs() < 1e-9 || (p.x - 30.0).abs() < 1e-9)
+        });
+        assert!(hit, "block end {c:?} is not a row end");
+    }
+}
+
+#[test]
+fn lines_that_are_not_plain_moves_pass_through_and_end_runs() {
+    let wave = |k: usize| {
+        let x = k as f64 * 0.1;
+        format!("X{x:.4} Y{:.4} Z1", (x / 3.0).sin())
+    };
+    let mut src =
+        String::from("%\nO1001 (post header)\nG90 G21 G94\nT1 M6\nS8000 M3\nG00 X0 Y0 Z1\n");
+    for k in 1..=40 {
+        let _ = writeln!(src, "G01 {} F2000", wave(k));
+    }
+    src.push_str("(a comment between two runs)\nM8\n");
+    for k in 41..=80 {
+        let _ = writeln!(src, "{}", wave(k));
+    }
+    src.push_str("G91\n");
+    for _ in 81..=100 {
+        src.push_str("X0.1 Y0.01\n");
+    }
+    src.push_str("G90 G93\n");
+    for k in 101..=120 {
+        let _ = writeln!(src, "{} F600", wave(k));
+    }
+    src.push_str("M5 M9\nM30\n%\n");
+    let opts = Options::default();
+    let (out, dev) = fit_and_measure(&src, &opts);
+    within(&dev, opts.tol);
+    assert_eq!(out.summary.fitted_blocks, 2, "{}", out.text);
+    // Every line that is not a fitted move is there, in order: the fitted ones are the
+    // G01 lines of the first run and the bare wave lines (ending in Z1) of the second.
+    let fitted = |l: &str| l.starts_with("G01 X") || (l.starts_with('X') && l.ends_with("Z1"));
+    let kept: Vec<&str> = src.lines().filter(|l| !fitted(l)).collect();
+    assert!(kept.len() > 40, "{kept:?}");
+    let mut at = 0;
+    for l in kept {
+        let found = out.text[at..].find(l).unwrap_or_else(|| panic!("{l} lost"));
+        at += found + l.len();
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// Generated curves (a random cubic net for the cutter, a random tilt and swing for the
+    /// tool), sampled at jittered steps and rounded as a post would: wherever the fit writes
+    /// a block, every programmed point and tool axis holds the tolerances.
+    #[test]
+    fn every_fitted_block_holds_the_tolerances(
+        net in proptest::collection::vec((-40.0f64..40.0, -40.0f64..40.0, -20.0f64..20.0), 4..9),
+        tilt in (0.0f64..40.0, -30.0f64..30.0, 0.5f64..3.0),
+        n in 20usize..300,
+        jitter in 0.0f64..0.5,
+        tol_mm in 0.0005f64..0.01,
+        tol_deg in 0.005f64..0.05,
+    ) {
+        let ctrl: Vec<[f64; 3]> = net.iter().map(|&(x, y, z)| [x, y, z]).collect();
+        let m = ctrl.len();
+        let mut knots = vec![0.0; 4];
+        for j in 1..m - 3 {
+            knots.push(j as f64 / (m - 3) as f64);
+        }
+        knots.extend([1.0; 4]);
+        let curve = DoubleNurbs::new(3, &ctrl, &[], &vec![1.0; m], &knots).unwrap();
+        let axis = |t: f64| {
+            let lean = (tilt.0 + tilt.1 * (tilt.2 * t).sin()).to_radians();
+            let sw = tilt.2 * t;
+            Vector3::new(lean.sin() * sw.cos(), lean.sin() * sw.sin(), lean.cos())
+        };
+        let mut points = resample(|t| (curve.cutter(t.min(1.0), 0).p, axis(t)), 1.0, n, 0.0);
+        // Jitter the spacing: move each interior point along the curve by up to `jitter` of
+        // a step (keeps the order).
+        for k in 1..points.len() - 1 {
+            let f = jitter * (((k * 7919) % 13) as f64 / 13.0 - 0.5);
+            let (a, b) = (points[k].0, points[k + 1].0);
+            points[k].0 = a + (b - a) * f.max(0.0);
+        }
+        let src = g01(&points, 2000.0);
+        let opts = Options {
+            tol: Tolerance { mm: tol_mm, rad: tol_deg.to_radians() },
+            ..Options::default()
+        };
+        let (_, dev) = fit_and_measure(&src, &opts);
+        prop_assert!(dev.point_mm <= tol_mm + 5e-7, "{dev:?}\n{src}");
+        prop_assert!(dev.point_deg <= tol_deg * 1.001, "{dev:?}\n{src}");
+    }
+}

@@ -1,0 +1,93 @@
+//! `dnurbs fit` through the real binary: a G01 program in, a G06.5 program out that
+//! `simulate` runs, the summary on stderr (text and JSON), and bad input refused with exit 2.
+
+mod common;
+use common::*;
+use std::fmt::Write;
+
+/// A helix of `n` moves of about 0.1 mm with the tool leaning as it turns, as a post writes it.
+fn helix(n: usize) -> String {
+    let mut s = String::from("%\n(helix)\nG90 G21 G94\nS6000 M3\n");
+    for k in 0..=n {
+        let t = k as f64 * 0.1 / 20.0;
+        let (x, y, z) = (20.0 * t.cos(), 20.0 * t.sin(), 30.0 + 0.5 * t);
+        let lean = (10.0 + 5.0 * t.sin()).to_radians();
+        let (i, j, kk) = (lean.sin() * t.cos(), lean.sin() * t.sin(), lean.cos());
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 { " F2000" } else { "" };
+        let _ = writeln!(s, "{g}X{x:.4} Y{y:.4} Z{z:.4} I{i:.6} J{j:.6} K{kk:.6}{f}");
+    }
+    s.push_str("M5\nM30\n%\n");
+    s
+}
+
+/// `dnurbs CMD FILE -m paper-ac-table.toml EXTRA...`.
+fn on_paper_machine(cmd: &str, file: &std::path::Path, extra: &[&str]) -> std::process::Output {
+    let mach = machine("paper-ac-table.toml");
+    let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    dnurbs(&args)
+}
+
+#[test]
+fn fit_writes_a_program_that_simulate_runs() {
+    let src = temp("fit-helix.nc");
+    let out = temp("fit-helix-out.nc");
+    std::fs::write(&src, helix(600)).unwrap();
+    let r = on_paper_machine("fit", &src, &["-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("600 in, 600 fitted into 1 G06.5 blocks"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("G06.5 P3"), "{text}");
+    assert!(text.contains("S6000 M3") && text.contains("M5"), "{text}");
+    let sim = on_paper_machine("simulate", &out, &[]);
+    assert_eq!(
+        sim.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&sim.stderr)
+    );
+    let _ = std::fs::remove_file(&src);
+    let _ = std::fs::remove_file(&out);
+}
+
+#[test]
+fn fit_summarises_in_json_and_writes_to_stdout() {
+    let src = temp("fit-helix-json.nc");
+    std::fs::write(&src, helix(200)).unwrap();
+    let r = on_paper_machine("fit", &src, &["--json", "--tol-mm", "0.002"]);
+    assert_eq!(r.status.code(), Some(0));
+    let v: serde_json::Value = serde_json::from_slice(&r.stderr).unwrap();
+    assert_eq!(v["moves_in"], 200);
+    assert_eq!(v["fitted_blocks"], 1);
+    assert!(v["point_mm"].as_f64().unwrap() <= 0.002 + 5e-7);
+    assert!(v["point_deg"].as_f64().unwrap() <= 0.01 * 1.001);
+    let out = String::from_utf8_lossy(&r.stdout);
+    assert!(out.contains("G06.5 P3"), "{out}");
+    let _ = std::fs::remove_file(&src);
+}
+
+#[test]
+fn fit_refuses_bad_input_with_exit_2() {
+    let src = temp("fit-bad.nc");
+    std::fs::write(&src, "G90 G21\nG01 X0 Y0 Z0 F100\nG01 X1 Q5\nM30\n").unwrap();
+    let r = on_paper_machine("fit", &src, &[]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(err.contains("fit-bad.nc:3:"), "{err}");
+    for (flag, value) in [
+        ("--tol-mm", "0"),
+        ("--tol-deg", "NaN"),
+        ("--corner-deg", "200"),
+    ] {
+        let r = on_paper_machine("fit", &src, &[flag, value]);
+        let err = String::from_utf8_lossy(&r.stderr).to_string();
+        assert_eq!(r.status.code(), Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(flag), "{err}");
+    }
+    let _ = std::fs::remove_file(&src);
+}

@@ -1,0 +1,212 @@
+//! `fit`: runs of G01 moves into G06.5 blocks ([`nc::fit`]), the result measured against
+//! the input before it is written.
+
+use crate::exit::{InputError, Outcome};
+use crate::setup::MachineSetup;
+use crate::shop::parse_setup;
+use crate::{load_machine, program_text};
+use anyhow::{bail, Context};
+use nc::fit::deviation::{measure, Deviation};
+use nc::fit::runs::{fit_program, Options, Summary};
+use nc::fit::Tolerance;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The command line's tolerances.
+#[derive(Clone, Copy, Debug)]
+pub struct Tolerances {
+    pub mm: f64,
+    pub deg: f64,
+    pub corner_deg: f64,
+}
+
+/// Most samples per path the deviation check takes (it lengthens the step beyond).
+const MAX_SAMPLES: f64 = 4e6;
+/// Sampling step of the deviation check, mm (or degrees on rotary-only moves).
+const STEP: f64 = 0.005;
+
+fn check_range(name: &str, x: f64, lo: f64, hi: f64) -> Result<(), InputError> {
+    if x.is_finite() && (lo..=hi).contains(&x) {
+        Ok(())
+    } else {
+        Err(InputError::Usage(format!(
+            "{name} {x} is outside {lo}..={hi}"
+        )))
+    }
+}
+
+pub fn fit(
+    program: &Path,
+    machine: &Path,
+    output: Option<&Path>,
+    tol: Tolerances,
+    json: bool,
+    tools: Option<PathBuf>,
+) -> anyhow::Result<Outcome> {
+    check_range("--tol-mm", tol.mm, 1e-5, 1.0)?;
+    check_range("--tol-deg", tol.deg, 1e-4, 5.0)?;
+    check_range("--corner-deg", tol.corner_deg, 0.0, 180.0)?;
+    let machine = load_machine(machine)?;
+    let setup = MachineSetup::new(&machine);
+    let shop = crate::shop::ShopArgs {
+        tools,
+        ..Default::default()
+    }
+    .load()?;
+    // No work offsets: the program's own numbers are what the fit reads and writes.
+    let mut parse = parse_setup(&machine, &shop);
+    parse.work_offsets = [Some([0.0; 3]); 6];
+    let file = program.display().to_string();
+    let bytes = std::fs::read(program).map_err(|error| InputError::ReadProgram {
+        file: file.clone(),
+        error,
+    })?;
+    let text = program_text(&bytes).map_err(|message| InputError::Encoding {
+        file: file.clone(),
+        message,
+    })?;
+    let input = nc::parse::parse_with(text, &parse).map_err(|errors| InputError::Parse {
+        file: file.clone(),
+        errors,
+    })?;
+    let in_path = nc::segment::build(&input, &setup.kin, &setup.build)
+        .map_err(|e| InputError::program(program, e))?;
+    let opts = Options {
+        tol: Tolerance {
+            mm: tol.mm,
+            rad: tol.deg.to_radians(),
+        },
+        corner_deg: tol.corner_deg,
+        ..Options::default()
+    };
+    let t0 = Instant::now();
+    let out = fit_program(text, &input, &setup.kin, &opts);
+    let fit_s = t0.elapsed().as_secs_f64();
+    // The result, read back as `simulate` and `run` would read it.
+    let fitted = nc::parse::parse_with(&out.text, &parse)
+        .map_err(|e| anyhow::anyhow!("the fitted program does not parse: {:?}", e.first()))?;
+    let out_path = nc::segment::build(&fitted, &setup.kin, &setup.build)
+        .map_err(|e| anyhow::anyhow!("the fitted program does not build: {e}"))?;
+    let length: f64 = in_path.segments.iter().map(|s| s.length).sum();
+    let step = STEP.max(length / MAX_SAMPLES);
+    let dev = measure(&in_path, &out_path, &setup.kin, step);
+    let report = Report {
+        file: &file,
+        summary: &out.summary,
+        dev: &dev,
+        fit_s,
+        step,
+        tol,
+    };
+    if json {
+        eprintln!("{}", serde_json::to_string_pretty(&report.json())?);
+    } else {
+        eprint!("{}", report.text());
+    }
+    // Half a micrometre of slack for the six decimals written and the sampling.
+    if dev.point_mm > tol.mm + 5e-7 || dev.point_deg > tol.deg * (1.0 + 1e-3) {
+        bail!(
+            "{file}: the fitted program is off its input beyond the tolerances (a point {:.6} mm \
+             off at line {}, a tool axis {:.5} deg off at line {}); nothing written",
+            dev.point_mm,
+            dev.point_mm_line,
+            dev.point_deg,
+            dev.point_deg_line
+        );
+    }
+    match output {
+        Some(path) => std::fs::write(path, &out.text)
+            .with_context(|| format!("{}: cannot write the fitted program", path.display()))?,
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            stdout.write_all(out.text.as_bytes())?;
+            stdout.flush()?;
+        }
+    }
+    Ok(Outcome::Completed)
+}
+
+struct Report<'a> {
+    file: &'a str,
+    summary: &'a Summary,
+    dev: &'a Deviation,
+    fit_s: f64,
+    step: f64,
+    tol: Tolerances,
+}
+
+impl Report<'_> {
+    fn text(&self) -> String {
+        let (s, d) = (self.summary, self.dev);
+        let ratio = |a: usize, b: usize| a as f64 / (b.max(1)) as f64;
+        format!(
+            "dnurbs fit: {file}\n\
+             \x20 G01 moves: {mi} in, {mf} fitted into {fb} G06.5 blocks; runs kept as G01 (not within tolerance): {rk}\n\
+             \x20 motion blocks: {bi} in, {bo} out ({br:.1}x fewer)\n\
+             \x20 bytes: {yi} in, {yo} out ({yr})\n\
+             \x20 tolerances: {tm} mm, {td} deg, corners above {tc} deg\n\
+             \x20 measured on the result ({np} programmed points, {ns} samples every {st} mm):\n\
+             \x20   points off the cutter path: {pm:.6} mm (line {pml}); tool axes off: {pd:.5} deg (line {pdl})\n\
+             \x20   cutter path off the programmed moves: {pa:.6} mm\n\
+             \x20 fit: {ft:.3} s, {rate:.0} moves/s\n",
+            file = self.file,
+            mi = s.moves_in,
+            mf = s.moves_fitted,
+            fb = s.fitted_blocks,
+            rk = s.runs_kept,
+            bi = s.blocks_in,
+            bo = s.blocks_out,
+            br = ratio(s.blocks_in, s.blocks_out),
+            yi = s.bytes_in,
+            yo = s.bytes_out,
+            yr = if s.bytes_out <= s.bytes_in {
+                format!("{:.1}x smaller", ratio(s.bytes_in, s.bytes_out))
+            } else {
+                format!("{:.2}x larger", ratio(s.bytes_out, s.bytes_in))
+            },
+            tm = self.tol.mm,
+            td = self.tol.deg,
+            tc = self.tol.corner_deg,
+            np = d.points,
+            ns = d.samples,
+            st = self.step,
+            pm = d.point_mm,
+            pml = d.point_mm_line,
+            pd = d.point_deg,
+            pdl = d.point_deg_line,
+            pa = d.path_mm,
+            ft = self.fit_s,
+            rate = s.moves_in as f64 / self.fit_s.max(1e-9),
+        )
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let (s, d) = (self.summary, self.dev);
+        serde_json::json!({
+            "file": self.file,
+            "moves_in": s.moves_in,
+            "moves_fitted": s.moves_fitted,
+            "fitted_blocks": s.fitted_blocks,
+            "runs_kept": s.runs_kept,
+            "blocks_in": s.blocks_in,
+            "blocks_out": s.blocks_out,
+            "bytes_in": s.bytes_in,
+            "bytes_out": s.bytes_out,
+            "tol_mm": self.tol.mm,
+            "tol_deg": self.tol.deg,
+            "corner_deg": self.tol.corner_deg,
+            "fit_measured_mm": s.fit_mm,
+            "fit_measured_deg": s.fit_deg,
+            "point_mm": d.point_mm,
+            "point_mm_line": d.point_mm_line,
+            "point_deg": d.point_deg,
+            "point_deg_line": d.point_deg_line,
+            "path_mm": d.path_mm,
+            "points": d.points,
+            "samples": d.samples,
+            "sample_step": self.step,
+            "fit_seconds": self.fit_s,
+        })
+    }
+}
