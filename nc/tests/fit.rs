@@ -28,7 +28,40 @@ fn fit_and_measure(src: &str, opts: &Options) -> (FitOutput, Deviation) {
     let b = build(&fitted, &KIN, &bl)
         .unwrap_or_else(|e| panic!("the result does not build: {e}\n{}", out.text));
     let dev = measure(&a, &b, &KIN, 0.002);
+    // Every block not fitted is there as it was: same kind, end, feed and rapid flag.
+    let fitted_lines: Vec<(u32, u32)> = out
+        .runs
+        .iter()
+        .filter(|r| r.fitted.is_some())
+        .map(|r| r.lines)
+        .collect();
+    let in_run = |l: u32| fitted_lines.iter().any(|&(a, b)| (a..=b).contains(&l));
+    let kept_in: Vec<String> = input
+        .blocks
+        .iter()
+        .filter(|bl| !in_run(bl.pos().line))
+        .map(describe)
+        .collect();
+    let kept_out: Vec<String> = fitted
+        .blocks
+        .iter()
+        .filter(|bl| !matches!(bl, nc::program::Block::Nurbs(n) if n.kind == nc::program::NurbsKind::G065))
+        .map(describe)
+        .collect();
+    assert_eq!(kept_in, kept_out, "{}", out.text);
     (out, dev)
+}
+
+fn describe(b: &nc::program::Block) -> String {
+    match b {
+        nc::program::Block::Linear(m) => {
+            format!(
+                "G01 rapid {} end {:?} feed {}",
+                m.rapid, m.end, m.feed_mm_min
+            )
+        }
+        nc::program::Block::Nurbs(n) => format!("{:?} {:?} feed {}", n.kind, n.ctrl, n.feed_mm_min),
+    }
 }
 
 fn within(dev: &Deviation, tol: Tolerance) {

@@ -7,7 +7,8 @@
 //! most [`MAX_TURN_DEG`], with no corner sharper than the corner angle between two moves.
 //! It starts where the move before it ends (that move must be a `G00`/`G01`). Every other
 //! line is written as it was; so is a run the fit cannot bring within the tolerances (it
-//! is counted). Work offsets are left out of the parse (the program's own numbers are
+//! is counted). A run begins where the modal motion is already `G01`, so that the
+//! mode after it is the same without its lines. Work offsets are left out of the parse (the program's own numbers are
 //! written back, and the offsets apply to them at run time as they did to the moves).
 
 use super::{fit, Fitted, Point, Tolerance};
@@ -91,15 +92,18 @@ pub struct FitOutput {
     pub summary: Summary,
 }
 
-/// Modal state at the start of each line that decides whether a run may be written as
-/// absolute millimetres per minute: (G90, G21, G94) all in effect.
-fn plain_modes(src: &str) -> Vec<bool> {
-    let (mut abs, mut mm, mut per_min) = (true, true, true);
+/// Modal state at the start of each line: whether a run may be written there (`G90`, `G21`
+/// and `G94` all in effect), and whether the modal motion is `G01` (a run that begins where
+/// it is not, with a `G01` word of its own, would leave the motion mode changed once that
+/// word is gone).
+fn modes(src: &str) -> Vec<(bool, bool)> {
+    let (mut abs, mut mm, mut per_min, mut motion) = (true, true, true, 0);
     let mut out = Vec::new();
     for line in src.split('\n') {
-        out.push(abs && mm && per_min);
+        out.push((abs && mm && per_min, motion == 10));
         for g in g_codes(&strip_comments(line)) {
             match g {
+                0 | 10 | 20 | 30 => motion = g,
                 900 => abs = true,
                 910 => abs = false,
                 210 => mm = true,
@@ -209,7 +213,7 @@ pub fn fit_program(
     opts: &Options,
 ) -> FitOutput {
     let lines: Vec<&str> = src.split('\n').collect();
-    let plain = plain_modes(src);
+    let modes = modes(src);
     let linear = |b: usize| match program.blocks.get(b) {
         Some(Block::Linear(m)) => Some(m),
         _ => None,
@@ -232,9 +236,10 @@ pub fn fit_program(
         !m.rapid
             && l >= 1
             && lines.get(l - 1).is_some_and(|t| pure_move_line(t))
-            && plain.get(l - 1).copied().unwrap_or(false)
+            && modes.get(l - 1).is_some_and(|m| m.0)
             && turn_ok(prev, m)
     };
+    let starts_in_g01 = |b: usize| modes.get(line_of(b) - 1).is_some_and(|m| m.1);
     let corner = |b: usize| -> bool {
         let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
             return true;
@@ -257,7 +262,7 @@ pub fn fit_program(
     let mut runs = Vec::new();
     let mut b = 1;
     while b < program.blocks.len() {
-        if !eligible(b) {
+        if !eligible(b) || !starts_in_g01(b) {
             b += 1;
             continue;
         }
