@@ -22,6 +22,7 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
     let machine_file = data("vcan-machine.toml");
     let machine = config::load(&machine_file).expect("vcan machine file");
     let period = machine.period_s;
+    let boot = BootWatch::open(&iface);
     let sim = KillOnDrop(
         std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
             .args([
@@ -36,7 +37,7 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
             .spawn()
             .expect("start dnurbs sim-drives"),
     );
-    std::thread::sleep(Duration::from_millis(500));
+    boot.wait(Duration::from_secs(60));
 
     let nodes: Vec<NodeId> = machine
         .drives

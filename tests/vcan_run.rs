@@ -55,6 +55,7 @@ fn run_on_vcan(program: &str) {
     let bin = env!("CARGO_BIN_EXE_dnurbs");
     let prog = data(program);
 
+    let boot = common::BootWatch::open(&iface);
     let mut sim = Command::new(bin)
         .args(["sim-drives", "--iface", &iface, "--machine"])
         .arg(&machine_file)
@@ -62,7 +63,7 @@ fn run_on_vcan(program: &str) {
         .arg(&record)
         .spawn()
         .expect("start dnurbs sim-drives");
-    std::thread::sleep(Duration::from_millis(500));
+    boot.wait(Duration::from_secs(60));
     let run = Command::new(bin)
         .arg("run")
         .arg(&prog)
@@ -226,6 +227,7 @@ fn vcan_run_cam_post_with_spindle_and_coolant_on_the_bus() {
         ("vcan0", "post-axes.csv"),
         ("vcan1", "post-spindle-coolant.csv"),
     ] {
+        let boot = common::BootWatch::open(iface);
         let sim = Command::new(bin)
             .args(["sim-drives", "--iface", iface, "--machine"])
             .arg(&machine_file)
@@ -233,9 +235,9 @@ fn vcan_run_cam_post_with_spindle_and_coolant_on_the_bus() {
             .arg(out.join(file))
             .spawn()
             .expect("start dnurbs sim-drives");
+        boot.wait(Duration::from_secs(60));
         sims.push(sim);
     }
-    std::thread::sleep(Duration::from_millis(500));
     let report = out.join("run-post-report");
     let run = Command::new(bin)
         .arg("run")

@@ -306,3 +306,29 @@ impl Drop for KillOnDrop {
         let _ = self.0.wait();
     }
 }
+
+/// Boot-up messages on a CAN interface, watched from before a `dnurbs sim-drives` process
+/// starts: once one arrives the process is up and listening (its nodes announce themselves
+/// at power-on). A fixed sleep instead was outlasted in CI by a loaded guest under software
+/// emulation, whose simulated drives then missed the master's NMT reset.
+pub struct BootWatch(drives::link::SocketLink);
+
+impl BootWatch {
+    pub fn open(iface: &str) -> BootWatch {
+        BootWatch(drives::link::SocketLink::open(iface).expect("open the CAN interface"))
+    }
+
+    /// Wait for a boot-up message (0x701..=0x77F, data 0x00), up to `timeout`.
+    pub fn wait(mut self, timeout: std::time::Duration) {
+        use drives::link::CanLink;
+        let t0 = std::time::Instant::now();
+        while t0.elapsed() < timeout {
+            match self.0.recv() {
+                Ok(Some(f)) if (0x701..=0x77f).contains(&f.id()) && f.data() == [0] => return,
+                Ok(_) => std::thread::sleep(std::time::Duration::from_millis(5)),
+                Err(e) => panic!("watching for boot-up: {e}"),
+            }
+        }
+        panic!("no boot-up message within {timeout:?} of starting dnurbs sim-drives");
+    }
+}
