@@ -91,3 +91,28 @@ fn fit_refuses_bad_input_with_exit_2() {
     }
     let _ = std::fs::remove_file(&src);
 }
+
+#[test]
+fn simulate_compresses_on_request_and_says_so() {
+    let src = temp("fit-helix-compress.nc");
+    std::fs::write(&src, helix(400)).unwrap();
+    let plain = on_paper_machine("simulate", &src, &["--json"]);
+    let packed = on_paper_machine("simulate", &src, &["--json", "--compress"]);
+    assert_eq!(plain.status.code(), Some(0));
+    assert_eq!(
+        packed.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&packed.stderr)
+    );
+    let p: serde_json::Value = serde_json::from_slice(&plain.stdout).unwrap();
+    let c: serde_json::Value = serde_json::from_slice(&packed.stdout).unwrap();
+    assert!(p.get("compressed").is_none());
+    assert_eq!(c["compressed"]["moves_fitted"], 400);
+    assert_eq!(c["compressed"]["fitted_blocks"], 1);
+    let time = |v: &serde_json::Value| v["machining_time_s"].as_f64().unwrap();
+    assert!(time(&c) < time(&p), "{} vs {}", time(&c), time(&p));
+    let both = on_paper_machine("simulate", &src, &["--compress", "--no-compress"]);
+    assert_eq!(both.status.code(), Some(2));
+    let _ = std::fs::remove_file(&src);
+}

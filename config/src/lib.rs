@@ -52,6 +52,10 @@
 //! path_jerk = 20000.0
 //! max_feed_mm_min = 10000.0
 //! rapid_feed_mm_min = 10000.0   # default: max_feed_mm_min
+//! compress = false          # fit runs of G01 moves into G06.5 blocks before planning
+//! compress_tol_mm = 0.001   # 1e-5..=1: programmed points off the fitted curve
+//! compress_tol_deg = 0.01   # 1e-4..=5: programmed tool axes off the fitted axis
+//! compress_corner_deg = 10  # 0..=180: a sharper turn between moves ends a block
 //!
 //! [axes.x]                  # also [axes.y], [axes.z]
 //! min = -300.0
@@ -111,7 +115,7 @@ use std::path::Path;
 
 pub use error::{ConfigError, LineCol, Location};
 pub use machine::{
-    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
+    Axes, AxisLimits, Compress, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
     UnknownMethod,
 };
 pub use spindle::{Coolant, Spindle};

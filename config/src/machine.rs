@@ -301,6 +301,34 @@ pub struct Interpolation {
     pub max_feed_mm_min: f64,
     /// Feed for rapid moves, mm/min.
     pub rapid_feed_mm_min: f64,
+    /// On-line compression: runs of G01 moves fitted into G06.5 blocks before planning.
+    pub compress: bool,
+    /// Its tolerances (kept when it is off: `--compress` turns it on with them).
+    pub compression: Compress,
+}
+
+/// `[interpolation] compress = true` and its tolerances.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Compress {
+    /// Largest distance of a programmed point from the fitted cutter curve, mm.
+    pub tol_mm: f64,
+    /// Largest angle between a programmed tool axis and the fitted one, degrees.
+    pub tol_deg: f64,
+    /// A turn of the path between two moves above this is a corner (degrees).
+    pub corner_deg: f64,
+}
+
+impl Compress {
+    /// Defaults: 1 um, 0.01 degree, corners above 10 degrees.
+    pub const DEFAULT: Compress = Compress {
+        tol_mm: 0.001,
+        tol_deg: 0.01,
+        corner_deg: 10.0,
+    };
+    /// Allowed ranges of the three.
+    pub const TOL_MM: (f64, f64) = (1e-5, 1.0);
+    pub const TOL_DEG: (f64, f64) = (1e-4, 5.0);
+    pub const CORNER_DEG: (f64, f64) = (0.0, 180.0);
 }
 
 impl Interpolation {
@@ -326,6 +354,8 @@ impl Default for Interpolation {
             path_jerk: Self::DEFAULT_PATH_JERK,
             max_feed_mm_min: Self::DEFAULT_MAX_FEED_MM_MIN,
             rapid_feed_mm_min: Self::DEFAULT_MAX_FEED_MM_MIN,
+            compress: false,
+            compression: Compress::DEFAULT,
         }
     }
 }

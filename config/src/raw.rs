@@ -215,4 +215,8 @@ pub(crate) struct RawInterpolation {
     pub path_jerk: Option<f64>,
     pub max_feed_mm_min: Option<f64>,
     pub rapid_feed_mm_min: Option<f64>,
+    pub compress: Option<bool>,
+    pub compress_tol_mm: Option<f64>,
+    pub compress_tol_deg: Option<f64>,
+    pub compress_corner_deg: Option<f64>,
 }

@@ -7,7 +7,7 @@
 use crate::bus::{self, Bus, Drive};
 use crate::error::ConfigError;
 use crate::machine::{
-    Axes, AxisLimits, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
+    Axes, AxisLimits, Compress, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
 };
 use crate::raw::{
     RawAxes, RawAxis, RawBus, RawFile, RawInterpolation, RawKinematics, RawMachine, RawRealtime,
@@ -353,6 +353,45 @@ impl Check<'_, '_> {
             path_jerk: opt("path_jerk", i.path_jerk, d.path_jerk, "mm/s^3")?,
             max_feed_mm_min: max_feed,
             rapid_feed_mm_min: opt("rapid_feed_mm_min", i.rapid_feed_mm_min, max_feed, "mm/min")?,
+            compress: i.compress.unwrap_or(false),
+            compression: self.compression(i)?,
+        })
+    }
+
+    /// The compressor's tolerances (checked whether or not `compress` is on).
+    fn compression(&self, i: &RawInterpolation) -> Result<Compress, ConfigError> {
+        let d = Compress::DEFAULT;
+        let range = |field: &'static str, v: Option<f64>, default: f64, (lo, hi): (f64, f64)| {
+            let x = v.unwrap_or(default);
+            if x.is_finite() && (lo..=hi).contains(&x) {
+                Ok(x)
+            } else {
+                Err(self.invalid(
+                    &["interpolation", field],
+                    Some(x.to_string()),
+                    format!("must be finite and in {lo}..={hi}"),
+                ))
+            }
+        };
+        Ok(Compress {
+            tol_mm: range(
+                "compress_tol_mm",
+                i.compress_tol_mm,
+                d.tol_mm,
+                Compress::TOL_MM,
+            )?,
+            tol_deg: range(
+                "compress_tol_deg",
+                i.compress_tol_deg,
+                d.tol_deg,
+                Compress::TOL_DEG,
+            )?,
+            corner_deg: range(
+                "compress_corner_deg",
+                i.compress_corner_deg,
+                d.corner_deg,
+                Compress::CORNER_DEG,
+            )?,
         })
     }
 }

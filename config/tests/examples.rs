@@ -46,6 +46,8 @@ fn paper_machine_loads_with_expected_values() {
             path_jerk: 20000.0,
             max_feed_mm_min: 10000.0,
             rapid_feed_mm_min: 15000.0,
+            compress: false,
+            compression: config::Compress::DEFAULT,
         }
     );
     let names = m.axes.all().map(|(name, _)| name);

@@ -508,3 +508,24 @@ fn two_buses_on_one_interface_are_refused() {
     assert_eq!(err.key(), Some("bus.1.interface"), "{shown}");
     assert_mentions(&shown, &["\"vcan0\"", "bus 0 (\"can0\") is already on it"]);
 }
+
+#[test]
+fn compression_tolerances_must_be_in_range() {
+    for (key, bad, rule) in [
+        ("compress_tol_mm", "0", "0.00001..=1"),
+        ("compress_tol_mm", "2", "0.00001..=1"),
+        ("compress_tol_deg", "nan", "0.0001..=5"),
+        ("compress_corner_deg", "-1", "0..=180"),
+    ] {
+        let text = with_interpolation(key, bad);
+        let (_, shown) = fail(&text);
+        assert_mentions(&shown, &[&format!("interpolation.{key} = {bad}")]);
+        assert_mentions(&shown, &[rule]);
+    }
+    let m = common::parse(&with_interpolation("compress", "true")).unwrap();
+    assert!(m.interpolation.compress);
+    assert_eq!(m.interpolation.compression, config::Compress::DEFAULT);
+    let m = common::parse(&with_interpolation("compress_tol_mm", "0.005")).unwrap();
+    assert!(!m.interpolation.compress);
+    assert_eq!(m.interpolation.compression.tol_mm, 0.005);
+}

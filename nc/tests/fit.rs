@@ -32,7 +32,7 @@ fn fit_and_measure(src: &str, opts: &Options) -> (FitOutput, Deviation) {
     let fitted_lines: Vec<(u32, u32)> = out
         .runs
         .iter()
-        .filter(|r| r.fitted.is_some())
+        .filter(|r| r.found.fitted.is_some())
         .map(|r| r.lines)
         .collect();
     let in_run = |l: u32| fitted_lines.iter().any(|&(a, b)| (a..=b).contains(&l));
@@ -245,4 +245,53 @@ proptest! {
         prop_assert!(dev.point_mm <= tol_mm + 5e-7, "{dev:?}\n{src}");
         prop_assert!(dev.point_deg <= tol_deg * 1.001, "{dev:?}\n{src}");
     }
+}
+
+/// On-line compression (`nc::fit::compress`) of a parsed program: every programmed point
+/// within the tolerances of the compressed path, every program word before the same point
+/// as before, and the compressed program planned faster.
+#[test]
+fn compressing_a_program_keeps_its_points_and_its_words() {
+    let points = resample(blade, 8.0, 1200, 0.1);
+    let mut src = g01(&points, 3000.0);
+    // A coolant word in the middle splits the run; the program ends with a rapid.
+    let mid = src.lines().position(|l| l.starts_with("N6000 ")).unwrap();
+    let mut lines: Vec<&str> = src.lines().collect();
+    lines.insert(mid, "M8");
+    lines.insert(lines.len() - 2, "G00 Z150");
+    src = lines.join("\n") + "\n";
+    let (cfg, bl) = nc::fixtures::small_mill(0.002);
+    let program = nc::parse::parse(&src).unwrap();
+    let opts = Options::default();
+    let (small, c) = nc::fit::compress::compress(&program, &KIN, &opts);
+    assert_eq!(c.fitted_blocks, 2, "{c:?}");
+    assert_eq!(c.moves_fitted, 1200, "{c:?}");
+    assert_eq!(small.blocks.len(), 4, "{c:?}");
+    let (a, b) = (
+        build(&program, &KIN, &bl).unwrap(),
+        build(&small, &KIN, &bl).unwrap(),
+    );
+    within(&measure(&a, &b, &KIN, 0.002), opts.tol);
+    // Each word stands before a block that starts where it started before.
+    let start_of = |p: &nc::program::Program, k: usize| match k.checked_sub(1).map(|j| &p.blocks[j])
+    {
+        Some(nc::program::Block::Linear(m)) => m.end,
+        Some(nc::program::Block::Nurbs(n)) => n.ctrl[n.ctrl.len() - 1],
+        None => [f64::NAN; 3],
+    };
+    assert_eq!(program.actions.len(), small.actions.len());
+    for (x, y) in program.actions.iter().zip(&small.actions) {
+        assert_eq!(x.kind, y.kind);
+        let (p, q) = (
+            start_of(&program, x.before_block),
+            start_of(&small, y.before_block),
+        );
+        assert!(
+            (Vector3::from(p) - Vector3::from(q)).norm() < 1e-12,
+            "{x:?} {y:?}"
+        );
+    }
+    let t_in = nc::plan::plan(&a, &KIN, &cfg).unwrap().duration;
+    let t_out = nc::plan::plan(&b, &KIN, &cfg).unwrap().duration;
+    assert!(t_out < t_in, "{t_out} s compressed, {t_in} s as G01");
 }

@@ -150,7 +150,7 @@ fn plan_program(
     setup: &MachineSetup,
     shop: &nc::parse::Setup,
 ) -> Result<Planned, InputError> {
-    let program = crate::parse_program(src, name, shop)?;
+    let (program, _) = setup.prepare(crate::parse_program(src, name, shop)?);
     let words = crate::words::describe(&program);
     let file = std::path::Path::new(name);
     let path =
@@ -239,7 +239,7 @@ pub fn run<L: CanLink + Send>(
     check_drives(machine)?;
     crate::check_bus_load(machine)?;
     let started = crate::report::now_utc();
-    let setup = MachineSetup::new(machine);
+    let setup = MachineSetup::new(machine).with_compress(opts.shop.compress);
     let shop = crate::shop::parse_setup(machine, &opts.shop);
     let rtc = &machine.realtime;
     let period = machine.period_s;

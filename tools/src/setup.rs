@@ -24,6 +24,11 @@ pub struct MachineSetup {
     pub axis_names: [&'static str; 5],
     /// Axis limits as in the machine file (mm or degrees), joint order.
     pub limits: [config::AxisLimits; 5],
+    /// On-line compression (`[interpolation] compress`): runs of G01 moves fitted into
+    /// G06.5 blocks before the program is built and planned; `None` when off.
+    pub compress: Option<nc::fit::runs::Options>,
+    /// The compressor's settings from the machine file, for `--compress`.
+    compression: nc::fit::runs::Options,
 }
 
 pub fn method_of(m: config::Method) -> Method {
@@ -76,6 +81,15 @@ impl MachineSetup {
             (limits[j].min * k, limits[j].max * k)
         });
         let ip = &m.interpolation;
+        let c = ip.compression;
+        let compression = nc::fit::runs::Options {
+            tol: nc::fit::Tolerance {
+                mm: c.tol_mm,
+                rad: c.tol_deg.to_radians(),
+            },
+            corner_deg: c.corner_deg,
+            ..nc::fit::runs::Options::default()
+        };
         MachineSetup {
             name: m.name.clone(),
             period: m.period_s,
@@ -97,6 +111,31 @@ impl MachineSetup {
             method: method_of(ip.method),
             axis_names,
             limits,
+            compress: ip.compress.then_some(compression),
+            compression,
+        }
+    }
+
+    /// `--compress` (`Some(true)`) or `--no-compress` (`Some(false)`) over the machine file.
+    pub fn with_compress(mut self, over: Option<bool>) -> MachineSetup {
+        if let Some(on) = over {
+            self.compress = on.then_some(self.compression);
+        }
+        self
+    }
+
+    /// The program the planner plans: compressed when compression is on, with what the
+    /// compressor did.
+    pub fn prepare(
+        &self,
+        program: nc::program::Program,
+    ) -> (nc::program::Program, Option<nc::fit::compress::Compressed>) {
+        match &self.compress {
+            Some(o) => {
+                let (p, c) = nc::fit::compress::compress(&program, &self.kin, o);
+                (p, Some(c))
+            }
+            None => (program, None),
         }
     }
 }

@@ -26,6 +26,14 @@ pub struct ShopArgs {
     /// Stop at M01 and wait for the operator (optional stop). Without it M01 is passed.
     #[arg(long)]
     pub optional_stop: bool,
+    /// Fit runs of G01 moves into G06.5 blocks before planning (as `dnurbs fit` does, with
+    /// the machine file's `compress_tol_mm`, `compress_tol_deg` and `compress_corner_deg`),
+    /// whatever the machine file's `[interpolation] compress` says.
+    #[arg(long, conflicts_with = "no_compress")]
+    pub compress: bool,
+    /// Plan the G01 moves as they are, whatever the machine file's `compress` says.
+    #[arg(long)]
+    pub no_compress: bool,
 }
 
 /// The shop's options as values (tool lengths loaded).
@@ -37,6 +45,8 @@ pub struct ShopOptions {
     pub work_offsets: config::offsets::WorkOffsets,
     pub block_delete: bool,
     pub optional_stop: bool,
+    /// `--compress` (Some(true)) or `--no-compress` (Some(false)) over the machine file.
+    pub compress: Option<bool>,
 }
 
 impl ShopArgs {
@@ -58,6 +68,11 @@ impl ShopArgs {
             work_offsets,
             block_delete: self.block_delete,
             optional_stop: self.optional_stop,
+            compress: match (self.compress, self.no_compress) {
+                (true, _) => Some(true),
+                (_, true) => Some(false),
+                _ => None,
+            },
         })
     }
 }

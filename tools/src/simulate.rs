@@ -102,6 +102,9 @@ pub struct Summary {
     /// settling adds to it). Not in `machining_time_s`. Absent without a `[spindle]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub spindle_waits: Option<SpindleWaits>,
+    /// What on-line compression did, when it was on.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compressed: Option<Compression>,
 }
 
 /// See [`Summary::spindle_waits`].
@@ -304,6 +307,7 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         end_position_error_mm: end_err,
         program_words: Vec::new(),
         spindle_waits: None,
+        compressed: None,
     }
 }
 
@@ -362,7 +366,51 @@ impl Summary {
                 )
             })
             .unwrap_or_default()
+            + &self
+                .compressed
+                .map(|c| {
+                    format!(
+                        "compressed         {} of {} G01 moves into {} G06.5 blocks ({} motion blocks in, {} planned; runs left as G01: {}; largest fit deviation {:.2e} mm, {:.2e} deg)\n",
+                        c.moves_fitted,
+                        c.moves_in,
+                        c.fitted_blocks,
+                        c.blocks_in,
+                        c.blocks_out,
+                        c.runs_kept,
+                        c.fit_mm,
+                        c.fit_deg
+                    )
+                })
+                .unwrap_or_default()
             + &crate::words::text(&self.program_words)
+    }
+}
+
+/// [`nc::fit::compress::Compressed`] for the summary.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Compression {
+    pub moves_in: usize,
+    pub moves_fitted: usize,
+    pub fitted_blocks: usize,
+    pub runs_kept: usize,
+    pub blocks_in: usize,
+    pub blocks_out: usize,
+    pub fit_mm: f64,
+    pub fit_deg: f64,
+}
+
+impl From<nc::fit::compress::Compressed> for Compression {
+    fn from(c: nc::fit::compress::Compressed) -> Self {
+        Compression {
+            moves_in: c.moves_in,
+            moves_fitted: c.moves_fitted,
+            fitted_blocks: c.fitted_blocks,
+            runs_kept: c.runs_kept,
+            blocks_in: c.blocks_in,
+            blocks_out: c.blocks_out,
+            fit_mm: c.fit_mm,
+            fit_deg: c.fit_deg,
+        }
     }
 }
 

@@ -16,7 +16,9 @@
 //! measures the result against the input independently of the fit, through the segment
 //! builder's own geometry.
 
+pub mod compress;
 pub mod deviation;
+pub mod find;
 pub mod runs;
 mod spline;
 

@@ -11,16 +11,12 @@
 //! mode after it is the same without its lines. Work offsets are left out of the parse (the program's own numbers are
 //! written back, and the offsets apply to them at run time as they did to the moves).
 
-use super::{fit, Fitted, Point, Tolerance};
-use crate::kinematics::{Kinematics, MachineKinematics};
-use crate::program::{Block, LinearMove, Orientation, Program};
-use nalgebra::Vector3;
+use super::find::{find_runs, moves_in, Found};
+use super::{Fitted, Tolerance};
+use crate::kinematics::MachineKinematics;
+use crate::program::Program;
 use std::fmt::Write;
 
-/// Largest tool turn (degrees) of one move in a run: the fit follows the tool axis at the
-/// points, so a move's own turn between them must be small (and a `C` turn of a whole
-/// revolution, which leaves the axis where it was, is never fitted away).
-pub const MAX_TURN_DEG: f64 = 10.0;
 /// Length the orientation points stand off the cutter points (mm): `U V W` = `X Y Z` +
 /// this times the tool vector, so the six decimals written give the axis to 1e-7 rad.
 pub const TOOL_MM: f64 = 10.0;
@@ -51,17 +47,12 @@ impl Default for Options {
     }
 }
 
-/// One run and what became of it.
+/// One run, where it stands in the text, and what became of it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Run {
     /// Source lines of its first and last move (1-based).
     pub lines: (u32, u32),
-    /// The programmed points: where the run starts, then each move's end.
-    pub points: Vec<Point>,
-    /// Programmed feed of the run, mm/min.
-    pub feed_mm_min: f64,
-    /// The block written, or `None` when the moves were kept.
-    pub fitted: Option<Fitted>,
+    pub found: Found,
 }
 
 /// What [`fit_program`] did.
@@ -185,26 +176,6 @@ fn pure_move_line(line: &str) -> bool {
     words > 0
 }
 
-fn point(m: &LinearMove, kin: &MachineKinematics) -> Point {
-    let axis = match m.orientation {
-        Orientation::Vector(v) => Vector3::from(v).normalize(),
-        Orientation::Angles { r1_deg, r2_deg } => {
-            kin.tool_axis(r1_deg.to_radians(), r2_deg.to_radians())
-        }
-    };
-    Point {
-        p: Vector3::from(m.end),
-        axis,
-    }
-}
-
-fn angles(m: &LinearMove) -> Option<(f64, f64)> {
-    match m.orientation {
-        Orientation::Angles { r1_deg, r2_deg } => Some((r1_deg, r2_deg)),
-        Orientation::Vector(_) => None,
-    }
-}
-
 /// Fit every run of `program` (parsed from `src` without work offsets).
 pub fn fit_program(
     src: &str,
@@ -214,89 +185,39 @@ pub fn fit_program(
 ) -> FitOutput {
     let lines: Vec<&str> = src.split('\n').collect();
     let modes = modes(src);
-    let linear = |b: usize| match program.blocks.get(b) {
-        Some(Block::Linear(m)) => Some(m),
-        _ => None,
-    };
     let line_of = |b: usize| program.blocks[b].pos().line as usize;
-    let turn_ok = |a: &LinearMove, b: &LinearMove| {
-        let (pa, pb) = (point(a, kin), point(b, kin));
-        let rot = match (angles(a), angles(b)) {
-            (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
-            _ => pa.axis.angle(&pb.axis).to_degrees(),
-        };
-        (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
-    };
-    // Move b may be in a run: a G01 on a line of its own, in plain modes, after a linear move.
-    let eligible = |b: usize| -> bool {
-        let (Some(m), Some(prev)) = (linear(b), b.checked_sub(1).and_then(linear)) else {
-            return false;
-        };
+    // The text's side of a run: a line of its own, in plain modes.
+    let plain_line = |b: usize| {
         let l = line_of(b);
-        !m.rapid
-            && l >= 1
+        l >= 1
             && lines.get(l - 1).is_some_and(|t| pure_move_line(t))
             && modes.get(l - 1).is_some_and(|m| m.0)
-            && turn_ok(prev, m)
     };
-    let starts_in_g01 = |b: usize| modes.get(line_of(b) - 1).is_some_and(|m| m.1);
-    let corner = |b: usize| -> bool {
-        let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
-            return true;
-        };
-        let (d1, d2) = (
-            Vector3::from(m.end) - Vector3::from(a.end),
-            Vector3::from(c.end) - Vector3::from(m.end),
-        );
-        d1.angle(&d2).to_degrees() > opts.corner_deg
-    };
+    let found = find_runs(
+        program,
+        kin,
+        opts,
+        |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.1),
+        |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
+    );
     let mut summary = Summary {
         blocks_in: program.blocks.len(),
-        // Block 0 is the start pose, not a move.
-        moves_in: (1..program.blocks.len())
-            .filter(|&b| linear(b).is_some_and(|m| !m.rapid))
-            .count(),
+        moves_in: moves_in(program),
         bytes_in: src.len(),
         ..Summary::default()
     };
-    let mut runs = Vec::new();
-    let mut b = 1;
-    while b < program.blocks.len() {
-        if !eligible(b) || !starts_in_g01(b) {
-            b += 1;
-            continue;
-        }
-        let first = linear(b).copied();
-        let mut e = b;
-        while e + 1 < program.blocks.len()
-            && eligible(e + 1)
-            && line_of(e + 1) == line_of(e) + 1
-            && linear(e + 1).map(|m| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode))
-                == first.map(|m| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode))
-            && linear(e + 1).is_some_and(|m| !m.tooling.wait.is_some())
-            && !corner(e)
-        {
-            e += 1;
-        }
-        if e + 1 - b >= opts.min_moves {
-            let points: Vec<Point> = (b - 1..=e)
-                .filter_map(|k| linear(k).map(|m| point(m, kin)))
-                .collect();
-            let fitted = fit(&points, opts.tol, opts.degree);
-            runs.push(Run {
-                lines: (line_of(b) as u32, line_of(e) as u32),
-                points,
-                feed_mm_min: first.map_or(0.0, |m| m.feed_mm_min),
-                fitted,
-            });
-        }
-        b = e + 1;
-    }
+    let runs: Vec<Run> = found
+        .into_iter()
+        .map(|f| Run {
+            lines: (line_of(f.blocks.0) as u32, line_of(f.blocks.1) as u32),
+            found: f,
+        })
+        .collect();
     let eol = if src.contains("\r\n") { "\r\n" } else { "\n" };
     let mut text = String::with_capacity(src.len() / 2);
     let mut next = 0;
     for run in &runs {
-        let Some(f) = &run.fitted else {
+        let Some(f) = &run.found.fitted else {
             summary.runs_kept += 1;
             continue;
         };
@@ -306,7 +227,7 @@ pub fn fit_program(
             text.push('\n');
         }
         let n_word = n_word(lines[l0 - 1]);
-        write_block(&mut text, f, run.feed_mm_min, n_word.as_deref(), eol);
+        write_block(&mut text, f, run.found.feed_mm_min, n_word.as_deref(), eol);
         next = l1;
         summary.fitted_blocks += 1;
         summary.moves_fitted += l1 + 1 - l0;

@@ -22,8 +22,10 @@ pub fn simulate(
     if let Err(e) = machine.check_bus_load() {
         eprintln!("dnurbs simulate: warning (simulate uses no bus; run would refuse): {e}");
     }
-    let prog = load_program(program, &parse_setup(&machine, &shop.load()?))?;
-    let setup = MachineSetup::new(&machine);
+    let shop = shop.load()?;
+    let prog = load_program(program, &parse_setup(&machine, &shop))?;
+    let setup = MachineSetup::new(&machine).with_compress(shop.compress);
+    let (prog, compressed) = setup.prepare(prog);
     let method = method.unwrap_or(setup.method);
     let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
     if let Some(path) = &trace {
@@ -36,6 +38,7 @@ pub fn simulate(
     }
     let mut summary = summarize(&result, &setup, prog.blocks.len());
     summary.program_words = crate::words::describe(&prog);
+    summary.compressed = compressed.map(crate::simulate::Compression::from);
     summary.spindle_waits = machine
         .spindle
         .as_ref()
@@ -50,14 +53,15 @@ pub fn simulate(
 
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
     let machine = load_machine(machine)?;
-    let parse = parse_setup(&machine, &shop.load()?);
-    let setup = MachineSetup::new(&machine);
+    let shop = shop.load()?;
+    let parse = parse_setup(&machine, &shop);
+    let setup = MachineSetup::new(&machine).with_compress(shop.compress);
     println!(
         "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles |"
     );
     println!("|---|---|---|---|---|---|");
     for program in programs {
-        let prog = load_program(program, &parse)?;
+        let (prog, _) = setup.prepare(load_program(program, &parse)?);
         let name = program.file_name().map_or_else(
             || program.display().to_string(),
             |n| n.to_string_lossy().into_owned(),

@@ -1,0 +1,134 @@
+//! Runs of `G01` moves a fit may replace, found in a parsed program: the rules both the
+//! text rewrite (`dnurbs fit`, [`super::runs`]) and the on-line compressor
+//! ([`super::compress`]) share.
+//!
+//! Blocks b..=e form a run when each is a feed move (`G01`, not rapid) that follows a
+//! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`], has the
+//! run's feed and tool length and no wait before it (but the first), and no two of them
+//! meet at a corner sharper than the corner angle; the caller adds its own conditions for
+//! a run's first move and for each move that joins it.
+
+use super::runs::Options;
+use super::{fit, Fitted, Point};
+use crate::kinematics::{Kinematics, MachineKinematics};
+use crate::program::{Block, LinearMove, Orientation, Program};
+use nalgebra::Vector3;
+
+/// Largest tool turn (degrees) of one move in a run: the fit follows the tool axis at the
+/// points, so a move's own turn between them must be small (and a `C` turn of a whole
+/// revolution, which leaves the axis where it was, is never fitted away).
+pub const MAX_TURN_DEG: f64 = 10.0;
+
+/// A run and its fit.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Found {
+    /// Its first and last block (indices into [`Program::blocks`]).
+    pub blocks: (usize, usize),
+    /// The programmed points: where the run starts, then each move's end.
+    pub points: Vec<Point>,
+    /// Programmed feed, mm/min.
+    pub feed_mm_min: f64,
+    /// The fitted curve, or `None` when no curve meets the tolerances.
+    pub fitted: Option<Fitted>,
+}
+
+/// The cutter point and unit tool axis at a linear move's end.
+pub fn point(m: &LinearMove, kin: &MachineKinematics) -> Point {
+    let axis = match m.orientation {
+        Orientation::Vector(v) => Vector3::from(v).normalize(),
+        Orientation::Angles { r1_deg, r2_deg } => {
+            kin.tool_axis(r1_deg.to_radians(), r2_deg.to_radians())
+        }
+    };
+    Point {
+        p: Vector3::from(m.end),
+        axis,
+    }
+}
+
+fn angles(m: &LinearMove) -> Option<(f64, f64)> {
+    match m.orientation {
+        Orientation::Angles { r1_deg, r2_deg } => Some((r1_deg, r2_deg)),
+        Orientation::Vector(_) => None,
+    }
+}
+
+/// Feed moves of a program (block 0 is the start pose, not a move).
+pub fn moves_in(program: &Program) -> usize {
+    program
+        .blocks
+        .iter()
+        .skip(1)
+        .filter(|b| matches!(b, Block::Linear(m) if !m.rapid))
+        .count()
+}
+
+/// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
+/// run; `may_join(k)`: block k may follow block k - 1 in one.
+pub fn find_runs(
+    program: &Program,
+    kin: &MachineKinematics,
+    opts: &Options,
+    may_start: impl Fn(usize) -> bool,
+    may_join: impl Fn(usize) -> bool,
+) -> Vec<Found> {
+    let linear = |b: usize| match program.blocks.get(b) {
+        Some(Block::Linear(m)) => Some(m),
+        _ => None,
+    };
+    let turn_ok = |a: &LinearMove, b: &LinearMove| {
+        let (pa, pb) = (point(a, kin), point(b, kin));
+        let rot = match (angles(a), angles(b)) {
+            (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
+            _ => pa.axis.angle(&pb.axis).to_degrees(),
+        };
+        (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
+    };
+    let eligible = |b: usize| -> bool {
+        let (Some(m), Some(prev)) = (linear(b), b.checked_sub(1).and_then(linear)) else {
+            return false;
+        };
+        !m.rapid && turn_ok(prev, m)
+    };
+    let corner = |b: usize| -> bool {
+        let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
+            return true;
+        };
+        let (d1, d2) = (
+            Vector3::from(m.end) - Vector3::from(a.end),
+            Vector3::from(c.end) - Vector3::from(m.end),
+        );
+        d1.angle(&d2).to_degrees() > opts.corner_deg
+    };
+    let key = |m: &LinearMove| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode);
+    let mut runs = Vec::new();
+    let mut b = 1;
+    while b < program.blocks.len() {
+        let Some(first) = linear(b).filter(|_| eligible(b) && may_start(b)) else {
+            b += 1;
+            continue;
+        };
+        let mut e = b;
+        while e + 1 < program.blocks.len()
+            && eligible(e + 1)
+            && may_join(e + 1)
+            && linear(e + 1).is_some_and(|m| key(m) == key(first) && !m.tooling.wait.is_some())
+            && !corner(e)
+        {
+            e += 1;
+        }
+        if e + 1 - b >= opts.min_moves {
+            let points: Vec<Point> = (b - 1..=e)
+                .filter_map(|k| linear(k).map(|m| point(m, kin)))
+                .collect();
+            runs.push(Found {
+                blocks: (b, e),
+                fitted: fit(&points, opts.tol, opts.degree),
+                points,
+                feed_mm_min: first.feed_mm_min,
+            });
+        }
+        b = e + 1;
+    }
+    runs
+}
