@@ -17,6 +17,7 @@ use nc::segment::{build, Path, Tooling};
 use nc::verify::dist_to_chord;
 pub use nc::verify::MAX_CYCLES;
 use serde::Serialize;
+use std::collections::HashMap;
 
 /// A finished offline run.
 pub struct Run {
@@ -30,35 +31,44 @@ pub struct Run {
 pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Run, ProgramError> {
     let path = build(program, &setup.kin, &setup.build)?;
     let profile = plan(&path, &setup.kin, &setup.plan)?;
-    let creep = setup.plan.path_acc * setup.period;
-    let mut setpoints = Vec::with_capacity((profile.duration / setup.period) as usize + 2);
-    {
-        let mut ip = Interpolator::new(
-            &path,
-            &profile,
-            setup.kin,
-            setup.plan.rotary,
-            method,
-            setup.period,
-            creep,
-        );
-        loop {
-            let sp = ip.step();
-            setpoints.push(sp);
-            if sp.done || path.segments.is_empty() {
-                break;
-            }
-            if sp.cycle >= MAX_CYCLES {
-                return Err(ProgramError::Unfinished(MAX_CYCLES));
-            }
-        }
-    }
+    let setpoints = interpolate(&path, &profile, setup, method)?;
     Ok(Run {
         path,
         profile,
         setpoints,
         method,
     })
+}
+
+/// Every setpoint of a planned path, period by period, to the last (`done`); a run longer
+/// than [`MAX_CYCLES`] is an error, not a truncated result.
+pub fn interpolate(
+    path: &Path,
+    profile: &FeedProfile,
+    setup: &MachineSetup,
+    method: Method,
+) -> Result<Vec<Setpoint>, ProgramError> {
+    let creep = setup.plan.path_acc * setup.period;
+    let mut setpoints = Vec::with_capacity((profile.duration / setup.period) as usize + 2);
+    let mut ip = Interpolator::new(
+        path,
+        profile,
+        setup.kin,
+        setup.plan.rotary,
+        method,
+        setup.period,
+        creep,
+    );
+    loop {
+        let sp = ip.step();
+        setpoints.push(sp);
+        if sp.done || path.segments.is_empty() {
+            return Ok(setpoints);
+        }
+        if sp.cycle >= MAX_CYCLES {
+            return Err(ProgramError::Unfinished(MAX_CYCLES));
+        }
+    }
 }
 
 /// Per-axis values in machine order (X Y Z, tilt, C).
@@ -148,40 +158,63 @@ pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
         .sum()
 }
 
+/// What the summary needs to know about one block's segments, found in one pass so the
+/// summary stays linear in the program (it searched every segment for every setpoint).
+#[derive(Default)]
+struct BlockSegs<'a> {
+    /// The block has a straight move (a setpoint without u belongs to it).
+    line: bool,
+    /// The block has a turn at rest (the cutter stands while the tool turns).
+    turns: bool,
+    /// The block's curve pieces in parameter order (`nc::split`).
+    pieces: Vec<&'a DoubleNurbs>,
+}
+
+impl<'a> BlockSegs<'a> {
+    fn index(path: &'a Path) -> HashMap<u32, BlockSegs<'a>> {
+        let mut map: HashMap<u32, BlockSegs<'a>> = HashMap::new();
+        for s in &path.segments {
+            let b = map.entry(s.block).or_default();
+            match s.nurbs() {
+                Some((c, _)) => b.pieces.push(c),
+                None if s.rotary_only => b.turns = true,
+                None => b.line = true,
+            }
+        }
+        map
+    }
+
+    /// The piece that holds parameter `u`: the first whose range reaches it, else the last.
+    fn piece_at(&self, u: f64) -> Option<&'a DoubleNurbs> {
+        let i = self.pieces.partition_point(|c| c.range().1 < u);
+        self.pieces
+            .get(i.min(self.pieces.len().saturating_sub(1)))
+            .copied()
+    }
+
+    /// Arc length of the block's curve between two parameters, over the pieces they span.
+    fn arc(&self, lo: f64, hi: f64) -> f64 {
+        let first = self.pieces.partition_point(|c| c.range().1 <= lo);
+        self.pieces[first..]
+            .iter()
+            .take_while(|c| c.range().0 < hi)
+            .map(|c| {
+                let (r0, r1) = c.range();
+                arc_between(c, lo.max(r0), hi.min(r1))
+            })
+            .sum()
+    }
+}
+
 pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     let sps = &run.setpoints;
     let ts = setup.period;
     // A block may be several segments: pieces of a large or kinked curve (`nc::split`), a
     // turn at rest before it. A setpoint's u says which piece holds it; a line's setpoints
     // (no u) belong to the block's straight move.
-    let line_of = |block: u32| {
-        run.path
-            .segments
-            .iter()
-            .find(|s| s.block == block && !s.rotary_only && s.nurbs().is_none())
-    };
-    let turns = |block: u32| {
-        run.path
-            .segments
-            .iter()
-            .any(|s| s.block == block && s.rotary_only)
-    };
-    let pieces = |block: u32| {
-        run.path
-            .segments
-            .iter()
-            .filter(move |s| s.block == block)
-            .filter_map(|s| s.nurbs().map(|(c, _)| c))
-    };
-    let piece_at = |block: u32, u: f64| {
-        let mut it = pieces(block).peekable();
-        while let Some(c) = it.next() {
-            if u <= c.range().1 || it.peek().is_none() {
-                return Some(c);
-            }
-        }
-        None
-    };
+    let index = BlockSegs::index(&run.path);
+    let none = BlockSegs::default();
+    let seg_of = |block: u32| index.get(&block).unwrap_or(&none);
     let (mut fmax, mut fsq, mut fn_) = (0.0f64, 0.0f64, 0u64);
     let mut chord = 0.0f64;
     for w in sps.windows(2) {
@@ -189,31 +222,20 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
         if a.block != b.block || b.done {
             continue;
         }
+        let segs = seg_of(b.block);
         let ds = match (a.u, b.u) {
             (Some(ua), Some(ub)) => {
                 for f in [0.25, 0.5, 0.75] {
                     let u = ua + (ub - ua) * f;
-                    if let Some(curve) = piece_at(b.block, u) {
+                    if let Some(curve) = segs.piece_at(u) {
                         let p = curve.cutter(u, 0).p;
                         chord = chord.max(dist_to_chord(&p, &a.p, &b.p));
                     }
                 }
-                let (lo, hi) = (ua.min(ub), ua.max(ub));
-                pieces(b.block)
-                    .map(|c| {
-                        let (r0, r1) = c.range();
-                        if r1 <= lo || r0 >= hi {
-                            0.0
-                        } else {
-                            arc_between(c, lo.max(r0), hi.min(r1))
-                        }
-                    })
-                    .sum()
+                segs.arc(ua.min(ub), ua.max(ub))
             }
             // A turn at rest in the block (the cutter stands, the tool turns) is no feed.
-            (None, None) if line_of(b.block).is_some() && !(a.p == b.p && turns(b.block)) => {
-                (b.p - a.p).norm()
-            }
+            (None, None) if segs.line && !(a.p == b.p && segs.turns) => (b.p - a.p).norm(),
             _ => continue,
         };
         if a.feed == b.feed && b.feed > 0.0 {
@@ -249,25 +271,35 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     }
     // Tool axis at the knots: machine angles interpolated between the bracketing setpoints,
     // through forward kinematics, against the program's own CT(u) - C(u).
+    let mut with_u: HashMap<u32, Vec<&Setpoint>> = HashMap::new();
+    for sp in sps.iter().filter(|s| s.u.is_some()) {
+        with_u.entry(sp.block).or_default().push(sp);
+    }
     let mut tool_dev = 0.0f64;
     for seg in &run.path.segments {
         let (Some((curve, _)), Tooling::Curve) = (seg.nurbs(), &seg.tooling) else {
             continue;
         };
-        let mine: Vec<&Setpoint> = sps
-            .iter()
-            .filter(|s| s.block == seg.block && s.u.is_some())
-            .collect();
+        let Some(mine) = with_u.get(&seg.block) else {
+            continue;
+        };
+        let u = |s: &Setpoint| s.u.unwrap_or(0.0);
+        let rising = mine.windows(2).all(|w| u(w[0]) <= u(w[1]));
         let mut knots: Vec<f64> = curve.knots().to_vec();
         knots.dedup();
         for &k in &knots {
-            let Some(w) = mine
-                .windows(2)
-                .find(|w| w[0].u.unwrap_or(0.0) <= k && k <= w[1].u.unwrap_or(0.0))
-            else {
+            // The first pair of setpoints that brackets the knot (a binary search where u
+            // only rises, as it does without holds).
+            let w = if rising {
+                let i = mine.partition_point(|s| u(s) < k).max(1) - 1;
+                mine.get(i..i + 2).filter(|w| u(w[0]) <= k && k <= u(w[1]))
+            } else {
+                mine.windows(2).find(|w| u(w[0]) <= k && k <= u(w[1]))
+            };
+            let Some(w) = w else {
                 continue;
             };
-            let (ua, ub) = (w[0].u.unwrap_or(0.0), w[1].u.unwrap_or(0.0));
+            let (ua, ub) = (u(w[0]), u(w[1]));
             let f = if ub > ua { (k - ua) / (ub - ua) } else { 0.0 };
             let j: [f64; 5] =
                 core::array::from_fn(|i| w[0].joints[i] + (w[1].joints[i] - w[0].joints[i]) * f);
