@@ -92,6 +92,33 @@ fn fit_refuses_bad_input_with_exit_2() {
     let _ = std::fs::remove_file(&src);
 }
 
+/// The program is read as `simulate` reads it: a UTF-8 byte-order mark is dropped (and the
+/// output has none), a byte that is not UTF-8 is refused at its line and column.
+#[test]
+fn fit_reads_the_encoding_as_simulate_does() {
+    let src = temp("fit-bom.nc");
+    let out = temp("fit-bom-out.nc");
+    let mut bytes = b"\xef\xbb\xbf".to_vec();
+    bytes.extend_from_slice(helix(100).as_bytes());
+    std::fs::write(&src, &bytes).unwrap();
+    let r = on_paper_machine("fit", &src, &["-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    let text = std::fs::read(&out).unwrap();
+    assert!(text.starts_with(b"%\n(helix)"), "{:?}", &text[..12]);
+    // Latin-1 in a comment on line 2, column 4.
+    std::fs::write(&src, b"%\n(ma\xdftab 1)\nG01 X1 F100\nM30\n").unwrap();
+    let r = on_paper_machine("fit", &src, &[]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("fit-bom.nc") && err.contains("2:4: byte 0xdf"),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(&src);
+    let _ = std::fs::remove_file(&out);
+}
+
 #[test]
 fn simulate_compresses_on_request_and_says_so() {
     let src = temp("fit-helix-compress.nc");

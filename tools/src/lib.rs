@@ -22,12 +22,26 @@ pub fn load_program(
     path: &Path,
     setup: &nc::parse::Setup,
 ) -> Result<nc::program::Program, InputError> {
+    let text = read_program(path)?;
+    parse_text(&text, &path.display().to_string(), setup)
+}
+
+/// Read an NC program's text (see [`program_text`]); errors name the file.
+pub fn read_program(path: &Path) -> Result<String, InputError> {
     let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|error| InputError::ReadProgram {
+    let mut bytes = std::fs::read(path).map_err(|error| InputError::ReadProgram {
         file: file.clone(),
         error,
     })?;
-    parse_program(&bytes, &file, setup)
+    let encoding = |message| InputError::Encoding {
+        file: file.clone(),
+        message,
+    };
+    let bom = program_text(&bytes).map_err(encoding)?.len() < bytes.len();
+    if bom {
+        bytes.drain(..3);
+    }
+    String::from_utf8(bytes).map_err(|e| encoding(e.to_string()))
 }
 
 /// Parse an NC program held in memory; `file` names it in errors.
@@ -40,6 +54,15 @@ pub fn parse_program(
         file: file.to_owned(),
         message,
     })?;
+    parse_text(text, file, setup)
+}
+
+/// Parse an NC program's text; `file` names it in errors.
+pub fn parse_text(
+    text: &str,
+    file: &str,
+    setup: &nc::parse::Setup,
+) -> Result<nc::program::Program, InputError> {
     nc::parse::parse_with(text, setup).map_err(|errors| InputError::Parse {
         file: file.to_owned(),
         errors,

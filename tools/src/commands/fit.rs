@@ -4,7 +4,7 @@
 use crate::exit::{InputError, Outcome};
 use crate::setup::MachineSetup;
 use crate::shop::parse_setup;
-use crate::{load_machine, program_text};
+use crate::{load_machine, parse_text, read_program};
 use anyhow::{bail, Context};
 use nc::fit::deviation::{measure, Deviation};
 use nc::fit::runs::{fit_program, Options, Summary};
@@ -58,18 +58,8 @@ pub fn fit(
     let mut parse = parse_setup(&machine, &shop);
     parse.work_offsets = [Some([0.0; 3]); 6];
     let file = program.display().to_string();
-    let bytes = std::fs::read(program).map_err(|error| InputError::ReadProgram {
-        file: file.clone(),
-        error,
-    })?;
-    let text = program_text(&bytes).map_err(|message| InputError::Encoding {
-        file: file.clone(),
-        message,
-    })?;
-    let input = nc::parse::parse_with(text, &parse).map_err(|errors| InputError::Parse {
-        file: file.clone(),
-        errors,
-    })?;
+    let text = read_program(program)?;
+    let input = parse_text(&text, &file, &parse)?;
     let in_path = nc::segment::build(&input, &setup.kin, &setup.build)
         .map_err(|e| InputError::program(program, e))?;
     let opts = Options {
@@ -81,7 +71,7 @@ pub fn fit(
         ..Options::default()
     };
     let t0 = Instant::now();
-    let out = fit_program(text, &input, &setup.kin, &opts);
+    let out = fit_program(&text, &input, &setup.kin, &opts);
     let fit_s = t0.elapsed().as_secs_f64();
     // The result, read back as `simulate` and `run` would read it.
     let fitted = nc::parse::parse_with(&out.text, &parse)
