@@ -7,7 +7,8 @@
 //! interpolates to the drives' rounding, within the velocity and acceleration limits by
 //! finite differences at the period, ending at the program's end; the spindle drive at its
 //! speed before the first feed move leaves; the spindle speeds and coolant valves in the
-//! order the program commands them, on during the cut and off at the end.
+//! order the program commands them, on during the cut and off at the end. The NX post runs
+//! once more with on-line compression on (`run --compress`), under the same checks.
 
 mod common;
 
@@ -94,7 +95,11 @@ type PerNode = Vec<Vec<drives::sim::Record>>;
 
 /// Runs `name` on simulated drives; a client thread resumes every operator stop. Returns the
 /// lines it resumed at, the run's report and the records of every node (per node, in order).
-fn run_post(name: &str, m: &config::Machine) -> (Vec<u32>, dnurbs_tools::report::Report, PerNode) {
+fn run_post(
+    name: &str,
+    m: &config::Machine,
+    compress: Option<bool>,
+) -> (Vec<u32>, dnurbs_tools::report::Report, PerNode) {
     let mut m = m.clone();
     m.realtime.feedback_timeout_s = 2.0;
     m.realtime.heartbeat_timeout_s = 5.0;
@@ -102,7 +107,7 @@ fn run_post(name: &str, m: &config::Machine) -> (Vec<u32>, dnurbs_tools::report:
     let (links, sim) = common::sim_drives(&m, |_| Default::default());
     let sock = common::temp(&format!("{name}.sock"));
     let opts = RunOptions {
-        shop: shop(),
+        shop: dnurbs_tools::shop::ShopOptions { compress, ..shop() },
         ..common::run_options(name, Some(sock.clone()))
     };
     let src = std::fs::read(posts(name)).unwrap();
@@ -142,13 +147,7 @@ fn resume_every_stop(sock: &Path) -> Vec<u32> {
 
 #[test]
 fn every_post_runs_on_simulated_drives_as_simulated_with_the_spindle_and_coolant_it_commands() {
-    let mut m = machine();
-    // A spindle slower to reach its speed (6 s to 12000 rpm) than the rapid moves between
-    // M03 and the first feed move take: the move must wait for it.
-    if let Some(s) = m.spindle.as_mut() {
-        s.acceleration_rpm_s = 2000.0;
-        s.at_speed_timeout_s = 20.0;
-    }
+    let m = slow_spindle_machine();
     // The five run at once (each in real time: the longest takes its 158 s of machining);
     // every failure is reported, post by post. `DNURBS_POSTS=nx` runs only the posts whose
     // file name starts with it.
@@ -160,7 +159,9 @@ fn every_post_runs_on_simulated_drives_as_simulated_with_the_spindle_and_coolant
             let m = m.clone();
             std::thread::Builder::new()
                 .name(name.into())
-                .spawn(move || check_run(name, &m))
+                .spawn(move || {
+                    check_run(name, &m, None);
+                })
                 .unwrap()
         })
         .collect();
@@ -169,6 +170,17 @@ fn every_post_runs_on_simulated_drives_as_simulated_with_the_spindle_and_coolant
         .filter_map(|h| h.join().err().map(|e| panic_text(&*e)))
         .collect();
     assert!(failed.is_empty(), "{}", failed.join("\n"));
+}
+
+/// The posts' machine with a spindle slower to reach its speed (6 s to 12000 rpm) than the
+/// rapid moves between M03 and the first feed move take: the move must wait for it.
+fn slow_spindle_machine() -> config::Machine {
+    let mut m = machine();
+    if let Some(s) = m.spindle.as_mut() {
+        s.acceleration_rpm_s = 2000.0;
+        s.at_speed_timeout_s = 20.0;
+    }
+    m
 }
 
 /// The message of a check that panicked (each names its post).
@@ -182,10 +194,16 @@ fn panic_text(e: &(dyn std::any::Any + Send)) -> String {
 /// One post on simulated drives: the operator resumes every stop, the axes' targets are the
 /// offline interpolation's setpoints, within the velocity and acceleration limits, and the
 /// spindle and coolant follow the program.
-fn check_run(name: &str, m: &config::Machine) {
-    let setup = MachineSetup::new(m);
+fn check_run(
+    name: &str,
+    m: &config::Machine,
+    compress: Option<bool>,
+) -> dnurbs_tools::report::Report {
+    let setup = MachineSetup::new(m).with_compress(compress);
     let parse = parse_setup(m, &shop());
     let prog = dnurbs_tools::load_program(&posts(name), &parse).unwrap();
+    // The program the planner plans, compressed where compression is on.
+    let prog = setup.prepare(prog).0;
     let stops: Vec<u32> = prog
         .blocks
         .iter()
@@ -195,7 +213,7 @@ fn check_run(name: &str, m: &config::Machine) {
         })
         .map(|p| p.line)
         .collect();
-    let (resumed, rep, records) = run_post(name, m);
+    let (resumed, rep, records) = run_post(name, m, compress);
     assert!(
         rep.exit_code == 0 || rep.exit_code == 5,
         "{name}: {}",
@@ -225,6 +243,33 @@ fn check_run(name: &str, m: &config::Machine) {
     let leave = spindle_at_speed_before_the_first_feed_move(name, m, &prog, &records);
     coolant_on_for_the_cut_and_off_at_the_end(name, m, &prog, &records, leave);
     spindle_and_coolant_as_programmed(name, m, &prog, &records);
+    rep
+}
+
+/// `run --compress` end to end: the NX post's swarf pass (63 G01 moves with A and C) runs
+/// fitted into a G06.5 block, and every check of the posts holds on what the drives
+/// received: the targets follow the compressed path `simulate --compress` interpolates,
+/// within the limits at the period, to the program's end; spindle, coolant and the operator
+/// stops as programmed. The report says what compression did.
+#[test]
+fn the_nx_post_runs_compressed_as_simulate_compresses_it() {
+    let name = "nx-5axis-g43-4.nc";
+    let m = slow_spindle_machine();
+    let rep = check_run(name, &m, Some(true));
+    let c = rep
+        .compressed
+        .expect("the report says what compression did");
+    assert_eq!(
+        (c.moves_in, c.moves_fitted, c.fitted_blocks),
+        (63, 60, 1),
+        "{c:?}"
+    );
+    assert!(rep
+        .text()
+        .contains("compressed         60 of 63 G01 moves into 1 G06.5 blocks"));
+    // Off, the report has no such line.
+    let plain = check_run(name, &m, Some(false));
+    assert!(plain.compressed.is_none());
 }
 
 /// Velocity and acceleration of every axis by finite differences of the targets at the

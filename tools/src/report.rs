@@ -54,6 +54,9 @@ pub struct Report {
     /// Spindle, coolant, tool, stop and dwell words of the program, one line each.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub program_words: Vec<String>,
+    /// What on-line compression did, when it was on.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compressed: Option<crate::simulate::Compression>,
 }
 
 /// Axis names in joint order.
@@ -88,6 +91,9 @@ impl Report {
             ));
         }
         s.push_str(&crate::words::text(&self.program_words));
+        if let Some(c) = &self.compressed {
+            s.push_str(&c.line());
+        }
         let what = if self.machine.is_empty() {
             self.program.clone()
         } else {

@@ -77,6 +77,8 @@ pub struct RunResult {
     pub hard_stops: u64,
     /// Spindle, coolant, tool, stop and dwell words of the program (`crate::words`).
     pub program_words: Vec<String>,
+    /// What on-line compression did, when it was on.
+    pub compressed: Option<crate::simulate::Compression>,
 }
 
 impl RunResult {
@@ -112,18 +114,27 @@ impl RunResult {
                 .collect(),
             latency: self.stats.summary(),
             program_words: self.program_words.clone(),
+            compressed: self.compressed,
         }
     }
 }
 
-/// The planner's output: the start, the chunks to stream, the end joints and the program's
-/// words without axes.
+/// The planner's output: the start, the chunks to stream, the end joints and what the
+/// report says about the program.
 type Planned = (
     Start,
     Vec<Box<nc::stream::Chunk>>,
     nc::kinematics::Joints,
-    Vec<String>,
+    Notes,
 );
+
+/// What the report says about the program: its words without axes and what on-line
+/// compression did to it.
+#[derive(Clone, Debug, Default)]
+struct Notes {
+    words: Vec<String>,
+    compressed: Option<crate::simulate::Compression>,
+}
 
 /// A program that stops for the operator (`M00`, `M01` with optional stop, `M06`) needs
 /// someone to resume it: without a control socket it is refused before anything moves.
@@ -150,8 +161,11 @@ fn plan_program(
     setup: &MachineSetup,
     shop: &nc::parse::Setup,
 ) -> Result<Planned, InputError> {
-    let (program, _) = setup.prepare(crate::parse_program(src, name, shop)?);
-    let words = crate::words::describe(&program);
+    let (program, compressed) = setup.prepare(crate::parse_program(src, name, shop)?);
+    let notes = Notes {
+        words: crate::words::describe(&program),
+        compressed: compressed.map(crate::simulate::Compression::from),
+    };
     let file = std::path::Path::new(name);
     let path =
         build(&program, &setup.kin, &setup.build).map_err(|e| InputError::program(file, e))?;
@@ -173,7 +187,7 @@ fn plan_program(
         None => path.start_joints,
     };
     let (start, list) = chunks(path, &profile);
-    Ok((start, list, end, words))
+    Ok((start, list, end, notes))
 }
 
 /// Every axis must have a drive for `run`.
@@ -290,8 +304,8 @@ pub fn run<L: CanLink + Send>(
                 let planned = plan_program(src, &opts.name, setup_ref, shop_ref)
                     .and_then(|p| operator_reachable(p, &opts.name, opts.control.is_some()));
                 let mut source = match planned {
-                    Ok((start, list, end, words)) => {
-                        let _ = ready_tx.send(Ok((start, end, words)));
+                    Ok((start, list, end, notes)) => {
+                        let _ = ready_tx.send(Ok((start, end, notes)));
                         list.into_iter()
                     }
                     Err(e) => {
@@ -306,7 +320,7 @@ pub fn run<L: CanLink + Send>(
                 feeder.feed(&mut std::iter::empty());
             })?;
         let ready = ready_rx.recv();
-        let (start, end_joints, program_words) = match ready {
+        let (start, end_joints, notes) = match ready {
             Ok(Ok(x)) => x,
             Ok(Err(e)) => {
                 finished.store(true, Ordering::Release);
@@ -401,7 +415,8 @@ pub fn run<L: CanLink + Send>(
             )
             .map(|r| RunResult {
                 started,
-                program_words,
+                program_words: notes.words,
+                compressed: notes.compressed,
                 ..r
             })
         })();
@@ -503,6 +518,7 @@ fn run_threads<L: CanLink + Send>(
             underruns: 0,
             hard_stops: 0,
             program_words: Vec::new(),
+            compressed: None,
         })
     })
     .map(|mut r| {

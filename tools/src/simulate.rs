@@ -400,26 +400,14 @@ impl Summary {
             .unwrap_or_default()
             + &self
                 .compressed
-                .map(|c| {
-                    format!(
-                        "compressed         {} of {} G01 moves into {} G06.5 blocks ({} motion blocks in, {} planned; runs left as G01: {}; largest fit deviation {:.2e} mm, {:.2e} deg)\n",
-                        c.moves_fitted,
-                        c.moves_in,
-                        c.fitted_blocks,
-                        c.blocks_in,
-                        c.blocks_out,
-                        c.runs_kept,
-                        c.fit_mm,
-                        c.fit_deg
-                    )
-                })
+                .map(|c| c.line())
                 .unwrap_or_default()
             + &crate::words::text(&self.program_words)
     }
 }
 
 /// [`nc::fit::compress::Compressed`] for the summary.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Compression {
     pub moves_in: usize,
     pub moves_fitted: usize,
@@ -429,6 +417,23 @@ pub struct Compression {
     pub blocks_out: usize,
     pub fit_mm: f64,
     pub fit_deg: f64,
+}
+
+impl Compression {
+    /// The summary's and the run report's line.
+    pub fn line(&self) -> String {
+        format!(
+            "compressed         {} of {} G01 moves into {} G06.5 blocks ({} motion blocks in, {} planned; runs left as G01: {}; largest fit deviation {:.2e} mm, {:.2e} deg)\n",
+            self.moves_fitted,
+            self.moves_in,
+            self.fitted_blocks,
+            self.blocks_in,
+            self.blocks_out,
+            self.runs_kept,
+            self.fit_mm,
+            self.fit_deg
+        )
+    }
 }
 
 impl From<nc::fit::compress::Compressed> for Compression {

@@ -51,6 +51,7 @@ pub fn latency(
         program: format!("latency, {} periods of {}", duration / period, show(period)),
         machine: String::new(),
         program_words: Vec::new(),
+        compressed: None,
         outcome: outcome.name(),
         exit_code: outcome.code(),
         stop_reason: None,
