@@ -28,7 +28,7 @@ use crate::kinematics::Tilt;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::program::SrcPos;
 use crate::scurve::{push_section, reachable, Motion, Phase};
-use crate::segment::{Geometry, Path, Segment};
+use crate::segment::{Geometry, Path, Segment, Tooling};
 use crate::verify::{
     check_from, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
 };
@@ -163,6 +163,67 @@ fn curvature(seg: &Segment, s: f64) -> f64 {
     }
 }
 
+/// Halvings of the station spacing over which [`end_rates`] follows a segment's ends.
+const END_HALVINGS: i32 = 10;
+
+/// A segment's joint rate dq/ds at one of its ends.
+struct EndRate {
+    /// At the end itself (the finest one-sided difference), signed.
+    at: [f64; 5],
+    /// The largest magnitude met from the station spacing down to the finest step.
+    peak: [f64; 5],
+}
+
+/// The joint rates at a segment's start and end, by one-sided differences over steps from
+/// the station spacing `h` down to `h / 2^END_HALVINGS`. A rate that peaks at an end (the
+/// tool axis leaving or reaching the vertical of an A/C table turns C fastest there) can be
+/// narrower than the stations, and a kink's velocity jump is the rate at the end itself.
+/// A line with a fixed tool axis moves every joint at a constant rate: its spacing is exact.
+fn end_rates(
+    seg: &Segment,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+    q: &[Joints],
+    h: f64,
+) -> (EndRate, EndRate) {
+    let n = q.len() - 1;
+    let grid = |i: usize, dir: f64| -> [f64; 5] {
+        let (a, b) = if dir > 0.0 { (i, i + 1) } else { (i - 1, i) };
+        core::array::from_fn(|j| (q[b][j] - q[a][j]) / h)
+    };
+    let exact = matches!(
+        (&seg.geometry, &seg.tooling),
+        (Geometry::Line { .. }, Tooling::Fixed(_))
+    );
+    let one = |from: &Joints, s: f64, dir: f64, coarse: [f64; 5]| {
+        let mut r = EndRate {
+            at: coarse,
+            peak: coarse.map(f64::abs),
+        };
+        if exact {
+            return r;
+        }
+        for m in 1..=END_HALVINGS {
+            let step = h * 0.5f64.powi(m);
+            let j = seg.pose(s + dir * step).joints(kin, from, &cfg.rotary);
+            for k in 0..5 {
+                let d = dir * (j[k] - from[k]) / step;
+                r.at[k] = d;
+                r.peak[k] = r.peak[k].max(d.abs());
+            }
+        }
+        r
+    };
+    (
+        one(&q[0], 0.0, 1.0, grid(0, 1.0)),
+        one(&q[n], seg.length, -1.0, grid(n, -1.0)),
+    )
+}
+
+fn max_abs(a: [f64; 5], b: [f64; 5]) -> [f64; 5] {
+    core::array::from_fn(|j| a[j].abs().max(b[j]))
+}
+
 /// Sample every segment; returns the stations and, per segment, the index of its first
 /// station (the joint with the previous segment) and the one-sided dq/ds at both ends.
 fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Station>, Vec<usize>) {
@@ -181,10 +242,18 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
             prev = j;
             q.push(j);
         }
+        let (start_rate, end_rate) = end_rates(seg, kin, cfg, &q, h);
         let mut last_d1 = [0.0; 5];
         for i in 0..=n {
             let s_loc = h * i as f64;
             let (d1, d2) = joint_derivatives(&q, h, i);
+            // At the segment's ends: the rate at the end itself (what jumps at a joint) and
+            // the largest on the way there (what bounds the section's limits).
+            let (d1, peak) = match i {
+                0 => (start_rate.at, max_abs(d1, start_rate.peak)),
+                _ if i == n => (end_rate.at, max_abs(d1, end_rate.peak)),
+                _ => (d1, d1.map(f64::abs)),
+            };
             if i == n {
                 last_d1 = d1;
             }
@@ -197,8 +266,8 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
                 v = v.min((cfg.path_acc / kappa).sqrt());
             }
             for (j, ax) in cfg.axes.iter().enumerate() {
-                if d1[j].abs() > 1e-15 {
-                    v = v.min(ax.velocity / d1[j].abs());
+                if peak[j] > 1e-15 {
+                    v = v.min(ax.velocity / peak[j]);
                 }
                 if d2[j].abs() > 1e-15 {
                     v = v.min((ax.acceleration / (2.0 * d2[j].abs())).sqrt());
@@ -207,7 +276,7 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
             let st = Station {
                 s: s0 + s_loc,
                 vlim: v.max(V_FLOOR),
-                dq: d1.map(f64::abs),
+                dq: peak,
             };
             if i == 0 {
                 if let Some(last) = out.last_mut() {

@@ -189,10 +189,13 @@ pub fn check(
             }
         }
     }
-    // The drives hold the start before and the last setpoint after.
+    // The drives hold the start before, and the last setpoint after where the run ended
+    // (done or stopped); a creeping run cut off by the loop's bound would go on moving.
     let mut q: Vec<Setpoint> = vec![sps[0]; 3];
     q.extend(sps.iter().copied());
-    q.extend([last; 2]);
+    if last.done || f.is_stopped() {
+        q.extend([last; 2]);
+    }
     for w in q.windows(4) {
         super::axes_hold(cfg, [&w[0], &w[1], &w[2], &w[3]], false, &ev, src)?;
     }
