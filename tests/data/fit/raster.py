@@ -2,8 +2,32 @@
 # surface, 1 mm step-overs (also 0.1 mm moves) between them, F3000.
 #   python3 raster.py 3axis   > raster-3axis.nc   (tool vertical)
 #   python3 raster.py 5axis   > raster-5axis.nc   (tool along the surface normal, I J K)
+#   python3 raster.py 5axis-ac [--linuxcnc] > raster-5axis-ac.nc
+#       the same tool axes as machine angles A C (degrees) for an xyzac-trt machine (A tilts
+#       about X, C turns the table; X Y Z stay the tool tip in the workpiece frame, RTCP).
+#       dnurbs: tool axis t = (-sin A sin C, sin A cos C, cos A). LinuxCNC's xyzac-trt-kins
+#       turns the table the other way, t = (sin A sin C, sin A cos C, cos A): --linuxcnc
+#       negates C. Of the two solutions (A, C) and (-A, C + 180) the one nearest the previous
+#       move's angles is taken (C unwrapped, |A| <= 110), as dnurbs itself does; a vertical
+#       tool keeps the previous C.
 import math, sys
 mode = sys.argv[1] if len(sys.argv) > 1 else "3axis"
+c_sign = -1.0 if "--linuxcnc" in sys.argv[2:] else 1.0
+def ac_angles(t, prev):
+    # (A, C) in degrees for unit tool axis t (dnurbs convention), nearest prev = (A, C)
+    rho = math.hypot(t[0], t[1])
+    a = math.degrees(math.atan2(rho, t[2]))
+    if rho < 1e-12:
+        return (-a if prev[0] < 0 else a, prev[1])
+    c1 = math.degrees(math.atan2(-t[0], t[1]))
+    best, cost_best = None, float("inf")
+    for ca, cc in ((a, c1), (-a, c1 + 180.0)):
+        near = cc + 360.0 * round((prev[1] - cc) / 360.0)
+        for c in (near, near - 360.0, near + 360.0):
+            cost = abs(ca - prev[0]) + abs(c - prev[1]) + (1e6 if abs(ca) > 110.0 else 0.0)
+            if cost < cost_best:
+                best, cost_best = (ca, c), cost
+    return best
 rows, length, step, over = 32, 60.0, 0.1, 1.0
 def z(x, y): return 2.0 * math.sin(x / 8.0) * math.cos(y / 10.0)
 def normal(x, y):
@@ -22,12 +46,16 @@ for r in range(rows):
             pts.append((xs[0], yy))
     pts += [(x, y) for x in xs]
 print("%%\n(finishing raster, %s, %d moves of %.1f mm, F3000)\nG90 G21 G94" % (mode, len(pts) - 1, step))
+prev = (0.0, 0.0)
 for k, (x, y) in enumerate(pts):
     w = "G01 " if k < 2 else ""
     f = " F3000" if k == 0 else ""
     if mode == "5axis":
         n = normal(x, y)
         print("%sX%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f%s" % (w, x, y, z(x, y), n[0], n[1], n[2], f))
+    elif mode == "5axis-ac":
+        prev = ac_angles(normal(x, y), prev)
+        print("%sX%.4f Y%.4f Z%.4f A%.6f C%.6f%s" % (w, x, y, z(x, y), prev[0], c_sign * prev[1], f))
     else:
         print("%sX%.4f Y%.4f Z%.4f%s" % (w, x, y, z(x, y), f))
 print("M30\n%")
