@@ -12,7 +12,7 @@
 //! rotary axes), and angle words suit the machine's tilt axis.
 
 use crate::arclen::ArcTable;
-use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt};
+use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt, VERTICAL_RHO};
 use crate::nurbs::DoubleNurbs;
 use crate::program::{
     Aux, Block, LengthMode, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait,
@@ -445,16 +445,61 @@ fn c_leaving_vertical(
     {
         return None;
     }
-    // Walk out from the start in decades until the tool has left the vertical.
-    let mut s = seg.length * 1e-9;
-    for _ in 0..10 {
-        let t = seg.pose(s).axis(kin);
-        if t.x.hypot(t.y) > 1e-7 {
-            return Some(kin.angles(&t, (prev[3], prev[4]), lim).1);
+    // Along the curve's own parameter where there is one: a cutter that starts at rest
+    // in u (a repeated first control point) makes s a power of u, too fine near 0 for the
+    // arc-length table.
+    let (span, pose): (f64, &dyn Fn(f64) -> Pose) = match &seg.geometry {
+        Geometry::Nurbs { curve, table } => {
+            let (u0, u1) = (table.u_of_s(curve, 0.0), table.u_of_s(curve, seg.length));
+            (u1 - u0, &move |x| seg.pose_u(curve, table, u0 + x))
         }
-        s *= 10.0;
+        Geometry::Line { .. } => (seg.length, &|x| seg.pose(x)),
+    };
+    let tilt = |x: f64| {
+        let t = pose(x).axis(kin);
+        t.x.hypot(t.y)
+    };
+    // Walk out from the start in decades until the tool has left the vertical.
+    let mut out = span * 1e-9;
+    while tilt(out) < VERTICAL_RHO {
+        if out >= span {
+            return None;
+        }
+        out = (out * 10.0).min(span);
     }
-    None
+    // C must start where the interpolator stops holding it: where the tilt first reaches
+    // VERTICAL_RHO (below it C is kept, above it C follows the tool). C taken where the
+    // tilt has grown measurable is off by what C turns on the way there, and the path
+    // would jump by that much where the segment starts (C turns fast off the vertical
+    // when the tool curve's first horizontal derivative is small: 5.6e-5 rad in the long
+    // run's seed 7 000 006). Halve down all the way (a tool can come back near the
+    // vertical before it leaves: the lowest crossing is the first), then bisect.
+    let (mut lo, mut hi) = (0.0, out);
+    let mut x = out;
+    for _ in 0..1100 {
+        x *= 0.5;
+        if x == 0.0 {
+            break;
+        }
+        if tilt(x) >= VERTICAL_RHO {
+            (lo, hi) = (0.0, x);
+        } else if lo == 0.0 {
+            lo = x;
+        }
+    }
+    for _ in 0..64 {
+        let mid = 0.5 * (lo + hi);
+        if lo == 0.0 || mid <= lo || mid >= hi {
+            break;
+        }
+        if tilt(mid) >= VERTICAL_RHO {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let t = pose(hi).axis(kin);
+    Some(kin.angles(&t, (prev[3], prev[4]), lim).1)
 }
 
 fn linear_tool(m: &LinearMove) -> Tool {

@@ -591,13 +591,7 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
     }
     // Through the real-time follower too, with a stop, pause, override or slow planner.
     let ev = hold::event(src);
-    let kind = match ev {
-        hold::Event::Stop { .. } => 0,
-        hold::Event::Pause { .. } => 1,
-        hold::Event::Override { .. } => 2,
-        hold::Event::Underrun { .. } => 3,
-    };
-    counts.held[kind].fetch_add(1, Ordering::Relaxed);
+    counts.held[ev.kind()].fetch_add(1, Ordering::Relaxed);
     hold::check(path, &profile, &cfg, kin, ev, src)
 }
 
@@ -695,13 +689,16 @@ fn run_half(half: u64, cases: u32) {
 }
 
 /// The faults the run through the follower found (see `hold.rs`), kept as they were
-/// generated: each text gives its event (a slow planner) by its own hash. The first three
-/// came from the CI seeds; `hold-c-accelerates-while-data-waits` from the long run (seed
-/// 7 000 012: a kink where C turns fastest, narrower than the planner's stations); the last
-/// is a slow creeping run that the check once ended with a stop the drives never got.
+/// generated: each text gives its event by its own hash. The first three came from the CI
+/// seeds; `hold-c-accelerates-while-data-waits` from the long run (seed 7 000 012: a kink
+/// where C turns fastest, narrower than the planner's stations); then a slow creeping run
+/// that the check once ended with a stop the drives never got; the last from the long run
+/// (seed 7 000 006: a G06.5 block whose tool leaves the vertical with C turning fast, where
+/// the path turned C to where the tilt reached 1e-7, not to where it starts, and jumped
+/// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration).
 #[test]
 fn the_hold_faults_found_stay_fixed() {
-    let cases: [(&str, hold::Event); 5] = [
+    let cases: [(&str, hold::Event); 6] = [
         (
             include_str!("adversarial/hold-creeps-off-the-vertical.nc"),
             hold::Event::Underrun {
@@ -737,6 +734,12 @@ fn the_hold_faults_found_stay_fixed() {
                 depth: 2,
             },
         ),
+        (
+            include_str!("adversarial/stop-at-a-vertical-g065-start.nc"),
+            hold::Event::Stop {
+                at: 0.43524834058136874,
+            },
+        ),
     ];
     for (src, want) in cases {
         assert_eq!(format!("{:?}", hold::event(src)), format!("{want:?}"));
@@ -745,6 +748,6 @@ fn the_hold_faults_found_stay_fixed() {
             panic!("{e}");
         }
         assert_eq!(counts.accepted.load(Ordering::Relaxed), 1, "{src}");
-        assert_eq!(counts.held[3].load(Ordering::Relaxed), 1);
+        assert_eq!(counts.held[want.kind()].load(Ordering::Relaxed), 1);
     }
 }

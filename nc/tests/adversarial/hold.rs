@@ -51,6 +51,18 @@ pub enum Event {
     },
 }
 
+impl Event {
+    /// Index of the event's kind in the counts: stop, pause, override, slow planner.
+    pub fn kind(&self) -> usize {
+        match self {
+            Event::Stop { .. } => 0,
+            Event::Pause { .. } => 1,
+            Event::Override { .. } => 2,
+            Event::Underrun { .. } => 3,
+        }
+    }
+}
+
 /// FNV-1a of the program text, then the splitmix64 finaliser (FNV's low bits depend only
 /// on the low bits of the bytes).
 fn hash(src: &str) -> u64 {
