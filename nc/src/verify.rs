@@ -15,7 +15,11 @@
 //!   changes direction within one period by design (the corner policy in `crate::plan`).
 //!   At such a junction the acceleration is also measured on the stencil centred on the
 //!   junction itself, its worst phase ([`corner`]): a hold or an override shifts the phase at
-//!   which the drives' setpoints meet a corner, and the limit must hold at any phase.
+//!   which the drives' setpoints meet a corner, and the limit must hold at any phase. And
+//!   the jerk is measured on each side of it, on the four setpoints that end on the
+//!   junction and the four that start there: the bound between phases ([`reserve`]) needs
+//!   the jerk within its limit up to the corner, and a step of a joint at the junction
+//!   (which no speed makes small) shows there.
 //! * chord error: the largest distance of the cutter path between two setpoints from the
 //!   straight chord between them (the drives interpolate linearly), measured at the quarter
 //!   points of a curve's parameter interval and at every segment junction the chord spans.
@@ -432,6 +436,19 @@ fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
                     ..violation(Quantity::Acceleration, j, &w[1..], acc, acc_limit)
                 };
                 keep(v, &mut found);
+            }
+            for side in c.sides.iter().flatten() {
+                let [k0, k1, k2, k3] = side.q.map(|x| x[j]);
+                let jerk = ((k3 - 3.0 * k2 + 3.0 * k1 - k0) / (ts * ts * ts)).abs();
+                m.jerk[j] = m.jerk[j].max(jerk / ax.jerk);
+                if jerk > ax.jerk * (1.0 + SLACK) || jerk.is_nan() {
+                    let v = Violation {
+                        s: side.s,
+                        v: side.v,
+                        ..violation(Quantity::Jerk, j, w, jerk, ax.jerk)
+                    };
+                    keep(v, &mut found);
+                }
             }
         }
         if jerk_ok {

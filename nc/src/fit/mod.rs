@@ -160,6 +160,13 @@ pub fn fit(points: &[Point], tol: Tolerance, degree: usize) -> Option<Fitted> {
                 split.push(i);
             }
         };
+        // Measured at each point's foot on this curve, as the independent check measures
+        // the written block (the nearest point and the tool axis there): the parameters
+        // the last solve used are the feet on the curve before it, and the tool axis a
+        // little along the curve from the foot can be over the angle tolerance where the
+        // one at the foot is not (0.0166 deg against 0.01657 on a generated curve).
+        let mut u = u.clone();
+        project(&curve, points, &mut u);
         for (k, pt) in points.iter().enumerate() {
             let (c, t) = curve.eval(u[k]);
             let e = (c - pt.p).norm();
