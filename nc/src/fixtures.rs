@@ -58,6 +58,26 @@ pub fn small_mill(period: f64) -> (PlanConfig, BuildLimits) {
     (plan, build)
 }
 
+/// The machine of the generated-program suite (`nc/tests/adversarial.rs`): the small mill
+/// with A within +-95 degrees, C endless, and X Y Z travel +-300, +-250, +-200 mm.
+pub fn adversarial_mill(period: f64) -> (PlanConfig, BuildLimits) {
+    let (mut cfg, mut bl) = small_mill(period);
+    let rotary = RotaryLimits {
+        tilt: ((-95f64).to_radians(), 95f64.to_radians()),
+        c: (f64::NEG_INFINITY, f64::INFINITY),
+    };
+    cfg.rotary = rotary;
+    bl.rotary = rotary;
+    cfg.travel = [
+        (-300.0, 300.0),
+        (-250.0, 250.0),
+        (-200.0, 200.0),
+        rotary.tilt,
+        rotary.c,
+    ];
+    (cfg, bl)
+}
+
 /// A G01 program through `points` (cutter, tool axis), written as a post-processor writes
 /// it: four decimals for positions, six for the unit axis; the first point is the start.
 pub fn g01_program(points: &[(Vector3<f64>, Vector3<f64>)], feed_mm_min: f64) -> String {

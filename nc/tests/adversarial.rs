@@ -15,7 +15,7 @@
 
 use nalgebra::Vector3;
 use nc::interp::{Interpolator, Method, Setpoint};
-use nc::kinematics::{Kinematics, MachineKinematics, RotaryLimits};
+use nc::kinematics::{Kinematics, MachineKinematics};
 use nc::plan::{plan, PlanConfig};
 use nc::segment::{build, BuildLimits, Geometry, Path};
 use proptest::prelude::*;
@@ -31,20 +31,7 @@ const PERIOD: f64 = 0.002;
 const MAX_TEST_CYCLES: f64 = 400_000.0;
 
 fn machine() -> (PlanConfig, BuildLimits, MachineKinematics) {
-    let (mut cfg, mut bl) = nc::fixtures::small_mill(PERIOD);
-    let rotary = RotaryLimits {
-        tilt: ((-95f64).to_radians(), 95f64.to_radians()),
-        c: (f64::NEG_INFINITY, f64::INFINITY),
-    };
-    cfg.rotary = rotary;
-    bl.rotary = rotary;
-    cfg.travel = [
-        (-300.0, 300.0),
-        (-250.0, 250.0),
-        (-200.0, 200.0),
-        rotary.tilt,
-        rotary.c,
-    ];
+    let (cfg, bl) = nc::fixtures::adversarial_mill(PERIOD);
     (cfg, bl, MachineKinematics::Paper)
 }
 

@@ -110,7 +110,7 @@ pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
 
 #[cfg(test)]
 mod tests {
-    use crate::kinematics::{Kinematics, MachineKinematics, RotaryLimits};
+    use crate::kinematics::{Kinematics, MachineKinematics};
     use crate::plan::{plan, PlanErrorKind};
     use crate::segment::{build, Tooling};
     use crate::verify::Quantity;
@@ -124,14 +124,7 @@ mod tests {
     #[test]
     fn a_step_of_c_just_after_a_junction_is_refused() {
         let src = include_str!("../../tests/adversarial/stop-at-a-vertical-g065-start.nc");
-        // The machine of the generated-program suite: A within +-95 degrees, C endless.
-        let (mut cfg, mut bl) = crate::fixtures::small_mill(0.002);
-        let rotary = RotaryLimits {
-            tilt: ((-95f64).to_radians(), 95f64.to_radians()),
-            c: (f64::NEG_INFINITY, f64::INFINITY),
-        };
-        (cfg.rotary, bl.rotary) = (rotary, rotary);
-        (cfg.travel[3], cfg.travel[4]) = (rotary.tilt, rotary.c);
+        let (cfg, bl) = crate::fixtures::adversarial_mill(0.002);
         let kin = MachineKinematics::Paper;
         let program = crate::parse::parse(src).expect("parses");
         let mut path = build(&program, &kin, &bl).expect("builds");
