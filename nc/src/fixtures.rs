@@ -2,9 +2,10 @@
 //! the paper's double-NURBS block (docs/paper.md) and a small 5-axis mill. Not part of
 //! the interpolator; kept public so `tests/` and `benches/` use the same values.
 
-use crate::kinematics::RotaryLimits;
-use crate::plan::{AxisLimit, PlanConfig};
-use crate::segment::BuildLimits;
+use crate::interp::{Interpolator, Method, Setpoint};
+use crate::kinematics::{MachineKinematics, RotaryLimits};
+use crate::plan::{AxisLimit, FeedProfile, PlanConfig};
+use crate::segment::{BuildLimits, Path};
 use nalgebra::Vector3;
 
 /// Degree of the paper's block (`G06.5 P3`).
@@ -150,4 +151,27 @@ pub fn blade(t: f64) -> (Vector3<f64>, Vector3<f64>) {
     let sw = t + 30f64.to_radians() * t.sin();
     let a = Vector3::new(lean.sin() * sw.cos(), lean.sin() * sw.sin(), lean.cos());
     (p, a)
+}
+
+/// Every setpoint of `path` planned as `profile`, interpolated offline by `method` at
+/// `cfg.period`, up to the one that ends the program; `None` if it has not ended after
+/// `max` periods.
+pub fn interpolate(
+    path: &Path,
+    profile: &FeedProfile,
+    kin: MachineKinematics,
+    cfg: &PlanConfig,
+    method: Method,
+    max: usize,
+) -> Option<Vec<Setpoint>> {
+    let mut ip = Interpolator::new(path, profile, kin, cfg.rotary, method, cfg.period, 0.0);
+    let mut out = Vec::new();
+    while out.len() < max {
+        let sp = ip.step();
+        out.push(sp);
+        if sp.done {
+            return Some(out);
+        }
+    }
+    None
 }

@@ -2,9 +2,16 @@
 //! interpolator through preallocated `heapless` SPSC queues, with feed hold.
 //!
 //! The planner plans the feed over the whole program (look-ahead over everything it has read)
-//! and cuts the result into [`Chunk`]s: one segment with its arc-length table and the profile
-//! phases that cover it. Chunks travel as `Box`es, so a queue moves pointers: the real-time
-//! side allocates nothing and frees nothing. A second queue carries consumed chunks back to
+//! and cuts the result into [`Chunk`]s: a run of consecutive segments with their arc-length
+//! tables and the profile phases that cover them. Chunks travel as `Box`es, so a queue moves
+//! pointers: the real-time side allocates nothing and frees nothing.
+//!
+//! **Look-ahead in distance.** The interpolator holds at most `depth` chunks (and at most
+//! [`LOOKAHEAD`]), so a chunk is cut at least [`chunk_length`] long: the distance to stop
+//! from the plan's top speed, shared out over the chunks held, with a quarter to spare.
+//! Whatever the programmed moves' length (a CAM program of 0.05 mm moves, or shorter), the
+//! path that has arrived then covers a stop, and a planner that keeps up never makes the
+//! tool hold. A second queue carries consumed chunks back to
 //! the planner thread, which frees them. The planner keeps at most `depth` chunks alive (in
 //! the queues or held by the interpolator); `depth` comes from the machine file.
 //!
@@ -53,25 +60,30 @@ pub const QUEUE_N: usize = MAX_DEPTH + 1;
 /// Chunks the interpolator looks ahead over (taken from the queue as they arrive).
 pub const LOOKAHEAD: usize = 64;
 
-/// One segment with its share of the feed plan.
+/// A run of consecutive segments with its share of the feed plan.
 #[derive(Debug)]
 pub struct Chunk {
-    /// 0-based segment index.
+    /// 0-based chunk index.
     pub index: usize,
-    pub segment: Segment,
-    /// Path position of the segment's start and end.
+    /// Index of its first segment in the path.
+    pub first_segment: usize,
+    /// The segments, in path order (at least one).
+    pub segments: Vec<Segment>,
+    /// Path position where each segment starts.
+    pub starts: Vec<f64>,
+    /// Path position of the chunk's start and end.
     pub s0: f64,
     pub s1: f64,
-    /// The profile's phases that cover the segment (absolute time and path position).
+    /// The profile's phases that cover the chunk (absolute time and path position).
     pub phases: Vec<Phase>,
-    /// Time at which the plan leaves the segment.
+    /// Time at which the plan leaves the chunk.
     pub t_end: f64,
-    /// Time at which the plan arrives at the segment's start (at rest there when the
+    /// Time at which the plan arrives at the chunk's start (at rest there when its first
     /// segment is a stop; before its dwell, if it has one).
     pub t_start: f64,
     /// Highest planned speed over `phases`.
     pub vmax: f64,
-    /// Time at which the plan arrives at the segment's end (the next one's `t_start`).
+    /// Time at which the plan arrives at the chunk's end (the next one's `t_start`).
     pub t_arrive: f64,
     /// The plan is at rest where it arrives at the segment's end (an exact stop: at most
     /// the floor speed, [`V_FLOOR`]).
@@ -90,6 +102,25 @@ pub struct Start {
     pub margins: Margins,
 }
 
+impl Chunk {
+    /// The segment that holds path position `s` (the earlier one where two meet) and the
+    /// path position where it starts. By bisection: allocation-free, at most 13 steps.
+    ///
+    /// Real-time thread.
+    pub fn segment_at(&self, s: f64) -> Option<(&Segment, f64)> {
+        let i = self.starts.partition_point(|&b| b < s).saturating_sub(1);
+        let seg = self.segments.get(i).or_else(|| self.segments.last())?;
+        let s0 = self.starts.get(i).or_else(|| self.starts.last())?;
+        Some((seg, *s0))
+    }
+
+    /// The chunk's first segment: where the path waits for the operator or the spindle,
+    /// if it does in this chunk.
+    pub fn first(&self) -> Option<&Segment> {
+        self.segments.first()
+    }
+}
+
 fn phase_vmax(p: &Phase) -> f64 {
     let mut v = p.v0.max(p.end().v);
     // Constant jerk: v is quadratic in time, with an extremum where a = 0.
@@ -102,22 +133,69 @@ fn phase_vmax(p: &Phase) -> f64 {
     v.max(0.0)
 }
 
-/// Cut a planned path into chunks (outside the real-time thread). Boxed, because the boxes
-/// travel through the queues as pointers.
+/// Most segments one chunk carries: the real-time side finds the segment at a path position
+/// by bisection over them, at most 13 steps.
+pub const MAX_CHUNK_SEGMENTS: usize = 4096;
+
+/// Look-ahead in distance: how long each chunk must be (mm, or degrees along a rotary-only
+/// path), merging consecutive segments until it is. The interpolator holds when the path
+/// that has arrived ends within the distance it needs to stop ([`Follower`]); with the
+/// chunks it can hold (`depth`, at most [`LOOKAHEAD`]) each at least this long, what has
+/// arrived always covers a stop from the plan's highest speed, with a quarter to spare and
+/// two chunks in transit (the one being left and the one the planner is about to push), so a
+/// planner that keeps up never makes the tool hold, however short the program's moves.
+pub fn chunk_length(profile: &FeedProfile, hold: &HoldConfig, depth: usize) -> f64 {
+    let vmax = profile.phases.iter().map(phase_vmax).fold(0.0, f64::max);
+    if vmax <= 0.0 || !vmax.is_finite() {
+        return 0.0;
+    }
+    let axes = AxisHold::new(hold, &profile.margins);
+    let held = depth.clamp(MIN_DEPTH, MAX_DEPTH).min(LOOKAHEAD);
+    let spare = held.saturating_sub(2).max(1) as f64;
+    1.25 * hold::stop_bound(hold, &axes, vmax) / spare
+}
+
+/// Cut a planned path into chunks (outside the real-time thread) for an interpolator that
+/// holds `depth` of them: runs of consecutive segments at least [`chunk_length`] long (fewer
+/// if [`MAX_CHUNK_SEGMENTS`] come first). A segment where the path waits for the operator or
+/// the spindle starts a chunk. Boxed, because the boxes travel through the queues as
+/// pointers.
 #[allow(clippy::vec_box)]
-pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
+pub fn chunks(
+    path: Path,
+    profile: &FeedProfile,
+    hold: &HoldConfig,
+    depth: usize,
+) -> (Start, Vec<Box<Chunk>>) {
+    let min_len = chunk_length(profile, hold, depth);
+    // The runs of segments, [a, b).
+    let n = path.segments.len();
+    let mut runs = Vec::new();
+    let mut a = 0;
+    for (i, seg) in path.segments.iter().enumerate().skip(1) {
+        let waits = seg.wait.operator.is_some() || seg.wait.spindle;
+        let long = profile.seg_start[i] - profile.seg_start[a] >= min_len;
+        if waits || long || i - a >= MAX_CHUNK_SEGMENTS {
+            runs.push((a, i));
+            a = i;
+        }
+    }
+    if n > 0 {
+        runs.push((a, n));
+    }
     let start = Start {
         pose: path.start,
         joints: path.start_joints,
-        chunks: path.segments.len(),
+        chunks: runs.len(),
         margins: profile.margins,
     };
-    let mut out = Vec::with_capacity(path.segments.len());
+    let mut out = Vec::with_capacity(runs.len());
     let eps = 1e-9 * profile.length.max(1.0);
     let mut first = 0;
-    for (index, segment) in path.segments.into_iter().enumerate() {
-        let s0 = profile.seg_start[index];
-        let s1 = profile.seg_start[index + 1];
+    let mut segments = path.segments.into_iter();
+    for (index, &(a, b)) in runs.iter().enumerate() {
+        let s0 = profile.seg_start[a];
+        let s1 = profile.seg_start[b];
         // Phases are in time order and s never decreases: skip those that end before s0.
         while first + 1 < profile.phases.len() && profile.phases[first].end().s < s0 - eps {
             first += 1;
@@ -139,7 +217,9 @@ pub fn chunks(path: Path, profile: &FeedProfile) -> (Start, Vec<Box<Chunk>>) {
             .map_or(0.0, |p| if p.s0 >= s0 - eps { p.t0 } else { p.t0 + p.dur });
         out.push(Box::new(Chunk {
             index,
-            segment,
+            first_segment: a,
+            segments: segments.by_ref().take(b - a).collect(),
+            starts: profile.seg_start[a..b].to_vec(),
             s0,
             s1,
             phases,
@@ -454,7 +534,10 @@ impl<'q> Follower<'q> {
 
     /// Source line of the block being machined (0 before the first has arrived).
     pub fn line(&self) -> u32 {
-        self.local.front().map_or(0, |c| c.segment.src.line)
+        self.local
+            .front()
+            .and_then(|c| c.segment_at(self.motion.s))
+            .map_or(0, |(seg, _)| seg.src.line)
     }
 
     /// Fraction of the program's chunks finished, 0..=1.
@@ -650,18 +733,16 @@ impl<'q> Follower<'q> {
         let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
         // An operator stop ahead: the plan is at rest where it arrives there; hold it there
         // (paused) until the operator resumes. Only the next boundary can hold one.
-        let gate = self
-            .local
-            .iter()
-            .take(2)
-            .find(|c| c.index >= self.gate_from && c.segment.wait.operator.is_some());
+        let gate = self.local.iter().take(2).find(|c| {
+            c.index >= self.gate_from && c.first().is_some_and(|g| g.wait.operator.is_some())
+        });
         if let Some(c) = gate {
             if tau >= c.t_start {
                 tau = c.t_start.max(self.tau);
                 self.k = 0.0;
                 self.r = 0.0;
                 self.paused = true;
-                self.awaiting = c.segment.wait.operator.map(|p| p.line);
+                self.awaiting = c.first().and_then(|g| g.wait.operator).map(|p| p.line);
                 self.gate_from = c.index + 1;
             }
         }
@@ -669,19 +750,18 @@ impl<'q> Follower<'q> {
         // command that move's speed there and hold until the drive reports it.
         self.awaiting_spindle = None;
         let mut gate_aux = None;
-        let spindle = self
-            .local
-            .iter()
-            .take(2)
-            .find(|c| c.index >= self.spindle_gate_from && c.segment.wait.spindle);
+        let spindle = self.local.iter().take(2).find(|c| {
+            c.index >= self.spindle_gate_from && c.first().is_some_and(|g| g.wait.spindle)
+        });
+        let spindle = spindle.and_then(|c| Some((c, c.first()?)));
         // Paused (the operator's stop at the same place, or a pause on the way there) it
         // holds there too, but the spindle keeps its command until the run resumes: it never
         // starts while the operator changes the tool.
-        if let Some(c) = spindle {
+        if let Some((c, g)) = spindle {
             if tau >= c.t_start {
-                let rpm = c.segment.aux.spindle_rpm;
+                let rpm = g.aux.spindle_rpm;
                 if !self.paused {
-                    gate_aux = Some(c.segment.aux);
+                    gate_aux = Some(g.aux);
                 }
                 if !self.paused && (!self.spindle_gates || self.spindle_at == Some(rpm)) {
                     self.spindle_gate_from = c.index + 1;
@@ -690,7 +770,7 @@ impl<'q> Follower<'q> {
                     self.k = 0.0;
                     self.r = 0.0;
                     if !self.paused {
-                        self.awaiting_spindle = Some(c.segment.src.line);
+                        self.awaiting_spindle = Some(g.src.line);
                     }
                 }
             }
@@ -749,7 +829,7 @@ impl<'q> Follower<'q> {
         self.motion = m;
         self.aux = match (gate_aux, self.local.front()) {
             (Some(a), _) => a,
-            (None, Some(c)) => c.segment.aux,
+            (None, Some(c)) => c.segment_at(m.s).map_or(self.aux, |(seg, _)| seg.aux),
             (None, None) => self.aux,
         };
         self.pending = Pending::Pose(cycle);
@@ -786,20 +866,18 @@ impl<'q> Follower<'q> {
             .iter()
             .find(|c| s <= c.s1)
             .or_else(|| self.local.back());
-        match chunk {
-            Some(c) => {
-                c.segment
-                    .pose(s.min(c.s1) - c.s0)
-                    .joints(&self.kin, &self.joints, &self.lim)
-            }
+        let s = chunk.map_or(s, |c| s.min(c.s1));
+        match chunk.and_then(|c| c.segment_at(s)) {
+            Some((seg, s0)) => seg.pose(s - s0).joints(&self.kin, &self.joints, &self.lim),
             None => self.joints,
         }
     }
 
     fn pose_setpoint(&mut self, cycle: u64) -> Setpoint {
-        if let Some(c) = self.local.front() {
-            self.block = c.segment.block;
-            self.pose = c.segment.pose(self.motion.s - c.s0);
+        let s = self.motion.s;
+        if let Some((seg, s0)) = self.local.front().and_then(|c| c.segment_at(s)) {
+            self.block = seg.block;
+            self.pose = seg.pose(s - s0);
         }
         self.joints = self.pose.joints(&self.kin, &self.joints, &self.lim);
         if self.done {
@@ -826,298 +904,4 @@ impl<'q> Follower<'q> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::interp::tests::{machine, paper_program};
-    use crate::interp::{Interpolator, Method};
-    use crate::plan::plan;
-    use crate::segment::build;
-
-    fn planned(src: Option<&str>) -> (Path, FeedProfile, HoldConfig) {
-        let (kin, cfg, bl) = machine();
-        let program = match src {
-            Some(s) => crate::parse::parse(s).unwrap(),
-            None => paper_program(),
-        };
-        let path = build(&program, &kin, &bl).unwrap();
-        let profile = plan(&path, &kin, &cfg).unwrap();
-        (path, profile, HoldConfig::from_plan(&cfg))
-    }
-
-    const TWO: &str = include_str!("../../tests/data/two-blocks-g2.nc");
-    const G01: &str = include_str!("../../tests/data/g01-5axis.nc");
-
-    /// Run with the planner pushing `per_push` chunks every `every` periods (0: all at once).
-    fn stream(
-        src: Option<&str>,
-        depth: usize,
-        every: u64,
-        stop_at: Option<u64>,
-    ) -> (Vec<Setpoint>, StreamCounters, Path) {
-        let (path, profile, hold) = planned(src);
-        let (kin, cfg, _) = machine();
-        let keep = path.clone();
-        let (start, all) = chunks(path, &profile);
-        let mut source = all.into_iter();
-        let mut q = Queues::new();
-        let (mut feeder, inlet) = q.split(depth);
-        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
-        let mut out = Vec::new();
-        feeder.feed(&mut source.by_ref().take(1));
-        for i in 0..400_000u64 {
-            if every == 0 || i % every == 0 {
-                let mut one = source
-                    .by_ref()
-                    .take(if every == 0 { usize::MAX } else { 1 });
-                feeder.feed(&mut one);
-            }
-            if stop_at == Some(i) {
-                f.request_stop();
-            }
-            let sp = f.step();
-            out.push(sp);
-            if sp.done || (stop_at.is_some() && f.is_stopped()) {
-                break;
-            }
-        }
-        feeder.feed(&mut std::iter::empty());
-        (out, f.counters(), keep)
-    }
-
-    #[test]
-    fn with_all_data_at_hand_it_follows_the_plan_like_the_interpolator() {
-        for src in [None, Some(TWO), Some(G01)] {
-            let (path, profile, _) = planned(src);
-            let (kin, cfg, _) = machine();
-            let mut ip = Interpolator::new(
-                &path,
-                &profile,
-                kin,
-                cfg.rotary,
-                Method::ArcLength,
-                cfg.period,
-                0.0,
-            );
-            let (sps, counters, _) = stream(src, 16, 0, None);
-            let mut n = 0;
-            for sp in &sps {
-                let want = ip.step();
-                assert!(
-                    (sp.p - want.p).norm() < 1e-9,
-                    "cycle {}: {} vs {}",
-                    sp.cycle,
-                    sp.p,
-                    want.p
-                );
-                for j in 0..5 {
-                    assert!((sp.joints[j] - want.joints[j]).abs() < 1e-9);
-                }
-                assert_eq!(sp.done, want.done, "cycle {}", sp.cycle);
-                n += 1;
-            }
-            assert!(sps.last().unwrap().done && n > 100);
-            assert_eq!(counters, StreamCounters::default());
-        }
-    }
-
-    #[test]
-    fn a_rehearsal_changes_nothing_and_lands_where_the_next_step_goes() {
-        for src in [None, Some(TWO), Some(G01)] {
-            let (plain, _, _) = stream(src, 16, 0, None);
-            let (path, profile, hold) = planned(src);
-            let (kin, cfg, _) = machine();
-            let (start, all) = chunks(path, &profile);
-            let mut source = all.into_iter();
-            let mut q = Queues::new();
-            let (mut feeder, inlet) = q.split(16);
-            let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
-            feeder.feed(&mut source.by_ref().take(1));
-            // Summed over the run: how far the rehearsal, and the previous setpoint, are from
-            // the step that follows.
-            let (mut off, mut moved) = (0.0, 0.0);
-            let mut prev = start.joints;
-            for want in &plain {
-                feeder.feed(&mut source.by_ref());
-                let guess = f.rehearse();
-                let sp = f.step();
-                assert_eq!(sp, *want, "a rehearsal changed the setpoint");
-                for j in 0..5 {
-                    off += (guess[j] - sp.joints[j]).abs();
-                    moved += (prev[j] - sp.joints[j]).abs();
-                }
-                prev = sp.joints;
-            }
-            feeder.feed(&mut std::iter::empty());
-            assert!(off < 0.01 * moved, "rehearsed {off} away, moved {moved}");
-        }
-    }
-
-    /// Path distance per period, and its first and second differences.
-    fn check_smooth(sps: &[Setpoint], hold: &HoldConfig, vmax: f64, acc: f64) {
-        let ts = hold.period;
-        let d: Vec<f64> = sps.windows(2).map(|w| (w[1].p - w[0].p).norm()).collect();
-        for (i, x) in d.iter().enumerate() {
-            assert!(
-                *x <= vmax * ts * (1.0 + 1e-6) + 1e-12,
-                "jump of {x} mm at {i}"
-            );
-        }
-        for (i, w) in d.windows(2).enumerate() {
-            // Chord lengths approximate arc lengths to well under 1e-6 mm here.
-            let a = (w[1] - w[0]).abs() / (ts * ts);
-            assert!(
-                a <= acc + 1e-3 / (ts * ts) * 1e-3,
-                "path acceleration {a} at {i}"
-            );
-        }
-    }
-
-    #[test]
-    fn an_underrunning_planner_makes_the_tool_hold_on_the_path_and_resume() {
-        let (_, _, hold) = planned(Some(G01));
-        let (_, cfg, _) = machine();
-        // One chunk every 400 periods (0.8 s): slower than the program needs.
-        let (sps, counters, path) = stream(Some(G01), 4, 400, None);
-        assert!(counters.underruns >= 2, "{counters:?}");
-        assert!(counters.hold_periods > 100, "{counters:?}");
-        assert_eq!(counters.hard_stops, 0);
-        assert_eq!(counters.leaked, 0);
-        let last = sps.last().unwrap();
-        assert!(last.done);
-        let seg = path.segments.last().unwrap();
-        assert!((last.p - seg.pose(seg.length).p).norm() < 1e-9);
-        // At rest somewhere mid-program (a hold), not only at the ends.
-        let stops = sps
-            .windows(2)
-            .skip(5)
-            .filter(|w| (w[1].p - w[0].p).norm() < 1e-12 && !w[1].done)
-            .count();
-        assert!(stops > 100, "{stops} periods at rest");
-        let vmax = path.segments.iter().map(|s| s.feed).fold(0.0, f64::max);
-        check_smooth(&sps, &hold, vmax, 1.5 * cfg.path_acc + hold.acc);
-    }
-
-    #[test]
-    fn a_stop_request_decelerates_along_the_path_and_stays() {
-        let (_, cfg, _) = machine();
-        let (_, _, hold) = planned(None);
-        let (sps, counters, path) = stream(None, 8, 0, Some(3000));
-        let last = sps.last().unwrap();
-        assert!(
-            !last.done && sps.len() > 3000 && sps.len() < 3300,
-            "{}",
-            sps.len()
-        );
-        assert_eq!(counters.underruns, 0);
-        // The stop point is on the curve.
-        let (curve, _) = path.segments[0].nurbs().unwrap();
-        let c = curve.cutter(last.u.unwrap(), 0);
-        assert!((c.p - last.p).norm() < 1e-9);
-        let v = 400.0 / 60.0;
-        check_smooth(&sps, &hold, v, 1.5 * cfg.path_acc + hold.acc);
-    }
-
-    #[test]
-    fn an_operator_pause_override_and_resume_stay_on_the_path_within_the_hold_limits() {
-        let (_, cfg, _) = machine();
-        let (path, profile, hold) = planned(None);
-        let (kin, _, _) = machine();
-        let keep = path.clone();
-        let (start, all) = chunks(path, &profile);
-        let mut source = all.into_iter();
-        let mut q = Queues::new();
-        let (mut feeder, inlet) = q.split(16);
-        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
-        feeder.feed(&mut source);
-        let mut sps = Vec::new();
-        let mut paused_at_rest = 0;
-        for i in 0..100_000u64 {
-            match i {
-                1000 => f.pause(),
-                2500 => f.resume(),
-                3000 => f.set_override(0.3),
-                5000 => f.set_override(1.0),
-                _ => {}
-            }
-            let sp = f.step();
-            if (1500..2500).contains(&i) {
-                assert_eq!(sp.feed, 0.0, "paused, still moving at {i}");
-                paused_at_rest += 1;
-            }
-            if (4000..5000).contains(&i) {
-                assert!(sp.feed <= 0.3 * 400.0 / 60.0 + 1e-9, "{} at {i}", sp.feed);
-            }
-            sps.push(sp);
-            if sp.done {
-                break;
-            }
-        }
-        feeder.feed(&mut std::iter::empty());
-        assert_eq!(paused_at_rest, 1000);
-        assert!(
-            sps.last().unwrap().done,
-            "the program finished after the resume"
-        );
-        assert_eq!(f.counters().hard_stops, 0);
-        // Every setpoint on the curve, the end reached.
-        let (curve, _) = keep.segments[0].nurbs().unwrap();
-        for sp in &sps[1..] {
-            let c = curve.cutter(sp.u.unwrap(), 0);
-            assert!((c.p - sp.p).norm() < 1e-9);
-        }
-        check_smooth(&sps, &hold, 400.0 / 60.0, 1.5 * cfg.path_acc + hold.acc);
-    }
-
-    /// A tool change and a spindle start before the same feed move: the path waits for the
-    /// operator with the spindle still stopped, then for the spindle at its speed, then
-    /// goes on; nothing moves while it waits.
-    #[test]
-    fn the_spindle_starts_only_after_the_tool_change_and_the_move_waits_for_its_speed() {
-        let src = "G00 X0 Y0 Z50\nG01 X5 F600\nT2 M06\nS8000 M03 M08\nG01 X20 F600\nM05 M09\n";
-        let (path, profile, hold) = planned(Some(src));
-        let (kin, cfg, _) = machine();
-        let (start, all) = chunks(path, &profile);
-        let mut source = all.into_iter();
-        let mut q = Queues::new();
-        let (mut feeder, inlet) = q.split(16);
-        let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
-        f.wait_for_spindle(true);
-        feeder.feed(&mut source);
-        let (mut for_operator, mut for_spindle) = (0, 0);
-        let mut last = f.step();
-        for i in 0..20_000u64 {
-            if f.awaiting().is_some() {
-                for_operator += 1;
-                assert_eq!(
-                    last.aux.spindle_rpm, 0.0,
-                    "the spindle started during the tool change"
-                );
-                if for_operator == 100 {
-                    f.resume();
-                }
-            }
-            if let Some(line) = f.awaiting_spindle() {
-                assert_eq!(line, 5);
-                assert_eq!((last.aux.spindle_rpm, last.aux.flood), (8000.0, true));
-                for_spindle += 1;
-                // The drive reports the speed after 200 periods.
-                f.spindle_at_speed((for_spindle >= 200).then_some(8000.0));
-            }
-            let waiting =
-                |f: &Follower<'_>| f.awaiting().is_some() || f.awaiting_spindle().is_some();
-            let before = waiting(&f);
-            let sp = f.step();
-            if before && waiting(&f) {
-                assert_eq!(sp.p, last.p, "moved while waiting at {i}");
-            }
-            last = sp;
-            if sp.done {
-                break;
-            }
-        }
-        feeder.feed(&mut std::iter::empty());
-        assert!(last.done);
-        assert_eq!((for_operator, for_spindle), (100, 200));
-        assert_eq!(last.p.x, 20.0);
-    }
-}
+mod tests;

@@ -3,7 +3,7 @@
 //! end, and streams through the real-time `Follower` exactly as it interpolates offline.
 //! The real-time side still sees only pieces of at most `MAX_CTRL` points.
 
-use nc::interp::{Interpolator, Method, Setpoint};
+use nc::interp::Method;
 use nc::kinematics::MachineKinematics;
 use nc::program::MAX_CTRL;
 use nc::segment::{build, Geometry};
@@ -87,24 +87,8 @@ fn a_ten_thousand_point_block_plans_runs_and_streams() {
     // 210 mm at 100 mm/s is 2.1 s; allow the ramps, refuse a stop at every piece.
     assert!(profile.duration < 3.0, "{} s", profile.duration);
 
-    let mut ip = Interpolator::new(
-        &path,
-        &profile,
-        kin,
-        cfg.rotary,
-        Method::ArcLength,
-        PERIOD,
-        0.0,
-    );
-    let mut offline: Vec<Setpoint> = Vec::new();
-    loop {
-        let sp = ip.step();
-        offline.push(sp);
-        if sp.done {
-            break;
-        }
-        assert!(offline.len() < 1_000_000, "no end");
-    }
+    let offline = nc::fixtures::interpolate(&path, &profile, kin, &cfg, Method::ArcLength, 1 << 20)
+        .expect("an end");
     let last = offline[offline.len() - 1].p;
     let miss =
         ((last.x - end[0]).powi(2) + (last.y - end[1]).powi(2) + (last.z - end[2]).powi(2)).sqrt();
@@ -113,7 +97,7 @@ fn a_ten_thousand_point_block_plans_runs_and_streams() {
     // Streamed: the planner thread keeps the queue full; the real-time Follower takes the
     // pieces as they come (64 in flight, as `run` does with the default depth).
     let hold = HoldConfig::from_plan(&cfg);
-    let (start, all) = chunks(path.clone(), &profile);
+    let (start, all) = chunks(path.clone(), &profile, &hold, 64);
     let mut source = all.into_iter();
     let mut q = Queues::new();
     let (mut feeder, inlet) = q.split(64);

@@ -148,7 +148,7 @@ fn the_real_time_follower_streams_the_turning_arc_as_interpolated() {
     let (cfg, _) = nc::fixtures::small_mill(PERIOD);
     let kin = MachineKinematics::Paper;
     let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, all) = chunks(path, &profile);
+    let (start, all) = chunks(path, &profile, &HoldConfig::from_plan(&cfg), 64);
     let mut source = all.into_iter();
     let mut q = Queues::new();
     let (mut feeder, inlet) = q.split(64);

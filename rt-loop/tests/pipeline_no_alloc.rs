@@ -47,7 +47,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
     let program = nc::parse::parse(PAPER).unwrap();
     let path = nc::segment::build(&program, &kin, &bl).unwrap();
     let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, list) = chunks(path, &profile);
+    let (start, list) = chunks(path, &profile, &HoldConfig::from_plan(&cfg), 4);
     let mut source = list.into_iter();
 
     let (bus, sim) = common::sim_bus(link, drive_end, PERIOD, [1e4, 1e4, 1e4, 1e3, 1e3]);

@@ -141,7 +141,8 @@ struct Notes {
 #[allow(clippy::vec_box)]
 fn operator_reachable(planned: Planned, name: &str, control: bool) -> Result<Planned, InputError> {
     if !control {
-        if let Some(pos) = planned.1.iter().find_map(|c| c.segment.wait.operator) {
+        let waits = planned.1.iter().flat_map(|c| &c.segments);
+        if let Some(pos) = waits.clone().find_map(|s| s.wait.operator) {
             return Err(InputError::Usage(format!(
                 "{}:{pos}: the program stops here for the operator (M00, M01 or M06) and \
                  only the control socket can resume it: run with --control SOCKET (or the \
@@ -160,6 +161,7 @@ fn plan_program(
     name: &str,
     setup: &MachineSetup,
     shop: &nc::parse::Setup,
+    depth: usize,
 ) -> Result<Planned, InputError> {
     let (program, compressed) = setup.prepare(crate::parse_program(src, name, shop)?);
     let notes = Notes {
@@ -186,7 +188,8 @@ fn plan_program(
         }
         None => path.start_joints,
     };
-    let (start, list) = chunks(path, &profile);
+    let hold = nc::stream::HoldConfig::from_plan(&setup.plan);
+    let (start, list) = chunks(path, &profile, &hold, depth);
     Ok((start, list, end, notes))
 }
 
@@ -301,7 +304,7 @@ pub fn run<L: CanLink + Send>(
         let planner = std::thread::Builder::new()
             .name("dnurbs-planner".into())
             .spawn_scoped(scope, move || {
-                let planned = plan_program(src, &opts.name, setup_ref, shop_ref)
+                let planned = plan_program(src, &opts.name, setup_ref, shop_ref, rtc.queue_depth)
                     .and_then(|p| operator_reachable(p, &opts.name, opts.control.is_some()));
                 let mut source = match planned {
                     Ok((start, list, end, notes)) => {

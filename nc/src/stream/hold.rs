@@ -100,6 +100,18 @@ impl AxisHold {
     }
 }
 
+/// Upper bound of the distance the follower needs to stop from the full plan at speed `v`:
+/// [`super::Follower`]'s stop distance at override 1, its rate as high as it may be.
+pub(super) fn stop_bound(hold: &HoldConfig, axes: &AxisHold, v: f64) -> f64 {
+    let ts = hold.period;
+    let rmax = hold.acc / v;
+    let jmax = hold.jerk / v;
+    let rise = rmax + jmax * ts;
+    let ramps = (2.0 * rmax / jmax).min(2.0 * (1.0 / jmax).sqrt());
+    let t = rise / jmax + axes.time_to_zero(1.0, rmax) + ramps + 3.0 * ts;
+    v * t
+}
+
 impl HoldConfig {
     /// Half the path's acceleration and jerk limits.
     pub fn from_plan(cfg: &crate::plan::PlanConfig) -> Self {

@@ -44,7 +44,8 @@ pub enum Event {
         k: f64,
         periods: u64,
     },
-    /// The planner pushes one chunk every `every` periods into a queue `depth` deep.
+    /// The planner pushes one chunk (cut for the default depth) every `every` periods into
+    /// a queue `depth` deep.
     Underrun {
         every: u64,
         depth: usize,
@@ -107,13 +108,15 @@ pub fn check(
     src: &str,
 ) -> Result<(), TestCaseError> {
     let end = path.segments.last().map(|s| s.pose(s.length).p);
-    let (start, all) = chunks(path, profile);
-    let mut source = all.into_iter();
-    let mut q = Queues::new();
     let depth = match ev {
         Event::Underrun { depth, .. } => depth,
         _ => 64,
     };
+    // Cut for the default depth, so that a shallower queue fed slowly starves the follower
+    // as a slow planner does.
+    let (start, all) = chunks(path, profile, &HoldConfig::from_plan(cfg), 64);
+    let mut source = all.into_iter();
+    let mut q = Queues::new();
     let (mut feeder, inlet) = q.split(depth);
     let mut f = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(cfg));
     let planned = (profile.duration / PERIOD).ceil() as u64;

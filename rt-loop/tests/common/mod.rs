@@ -106,7 +106,7 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     let program = nc::parse::parse(src).unwrap();
     let path = nc::segment::build(&program, &kin, &bl).unwrap();
     let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, list) = chunks(path, &profile);
+    let (start, list) = chunks(path, &profile, &HoldConfig::from_plan(&cfg), 64);
     let mut source = list.into_iter();
     let (link, drive_end) = MemLink::pair(1024);
     let (bus, sim) = sim_bus_with(
