@@ -29,7 +29,8 @@ pub const TABLE: &str = "Exit codes (every subcommand):
   2  bad input: NC program, machine file or command-line value (nothing moved)
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
-  4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path
+  4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,
+     or before anything moved (a stop while `run` plans or sets up the drives)
   5  completed, with real-time overruns (missed deadlines: see the report)";
 
 /// How a command that ran ended.
@@ -98,6 +99,15 @@ pub enum InputError {
     Start(#[from] rt_loop::pipeline::PipelineError),
 }
 
+/// A stop requested (SIGINT, SIGTERM) before anything moved: while the program was planned
+/// or the drives were set up (exit code 4, like a stop along the path).
+#[derive(Debug, thiserror::Error)]
+#[error("stop requested (SIGINT/SIGTERM) while {stage}: nothing moved, no drive was enabled")]
+pub struct StoppedBeforeMotion {
+    /// What was under way: "planning the program", "setting up the drives".
+    pub stage: &'static str,
+}
+
 /// `file:line:col: message` per error, and a last line when the parse stopped early.
 fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
     let mut out: Vec<String> = e.errors.iter().map(|x| format!("{file}:{x}")).collect();
@@ -127,10 +137,13 @@ impl InputError {
     }
 }
 
-/// The exit code for an error: 2 for the user's input, 1 for everything else.
+/// The exit code for an error: 2 for the user's input, 4 for a stop before motion, 1 for
+/// everything else.
 pub fn code_of(e: &anyhow::Error) -> u8 {
     if e.downcast_ref::<InputError>().is_some() {
         BAD_INPUT
+    } else if e.downcast_ref::<StoppedBeforeMotion>().is_some() {
+        STOPPED_OPERATOR
     } else {
         FAILED
     }

@@ -10,6 +10,7 @@
 //!   `latency.hlog`, prints progress on stderr when that is a terminal, and at the end prints
 //!   and writes the latency report.
 
+use crate::exit::StoppedBeforeMotion;
 use crate::report::{DriveEnd, Report, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
@@ -193,6 +194,46 @@ fn plan_program(
     Ok((start, list, end, notes))
 }
 
+/// Plans the program in a thread of its own while this one watches for SIGINT and SIGTERM:
+/// a stop requested while it plans ends `run` at once, before any drive is touched (the
+/// planning thread is left to finish alone; the process's exit ends it).
+fn plan_in_background(
+    src: &[u8],
+    setup: &MachineSetup,
+    shop: &nc::parse::Setup,
+    opts: &RunOptions,
+    rtc: &config::Realtime,
+) -> anyhow::Result<Planned> {
+    let (tx, rx) = std::sync::mpsc::sync_channel(1);
+    let src: std::sync::Arc<[u8]> = src.into();
+    let (name, setup, shop) = (opts.name.clone(), setup.clone(), shop.clone());
+    let (depth, control) = (rtc.queue_depth, opts.control.is_some());
+    std::thread::Builder::new()
+        .name("dnurbs-plan".into())
+        .spawn(move || {
+            let planned = plan_program(&src, &name, &setup, &shop, depth)
+                .and_then(|p| operator_reachable(p, &name, control));
+            // The receiver is gone if a stop ended the run meanwhile.
+            let _ = tx.send(planned);
+        })?;
+    let stop = os::stop_requested();
+    loop {
+        match rx.recv_timeout(Duration::from_millis(20)) {
+            Ok(planned) => return Ok(planned?),
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if stop.load(Ordering::Relaxed) {
+                    Err(StoppedBeforeMotion {
+                        stage: "planning the program",
+                    })?;
+                }
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                anyhow::bail!("the planner thread ended without a result")
+            }
+        }
+    }
+}
+
 /// Every axis must have a drive for `run`.
 fn check_drives(m: &Machine) -> Result<(), InputError> {
     for (j, (name, _)) in m.axes.all().iter().enumerate() {
@@ -280,7 +321,6 @@ pub fn run<L: CanLink + Send>(
         None => None,
     };
     let finished = AtomicBool::new(false);
-    let (ready_tx, ready_rx) = std::sync::mpsc::sync_channel(1);
     let log = match &opts.report {
         Some(dir) => {
             std::fs::create_dir_all(dir)
@@ -295,46 +335,30 @@ pub fn run<L: CanLink + Send>(
     };
     os::install_stop_handler()?;
     let stop = os::stop_requested();
+    let (start, list, end_joints, notes) = plan_in_background(src, &setup, &shop, opts, rtc)?;
+    // Checked before each bus is set up and before the real-time thread starts.
+    let stop_before_motion = || -> anyhow::Result<()> {
+        if stop.load(Ordering::Relaxed) {
+            Err(StoppedBeforeMotion {
+                stage: "setting up the drives",
+            })?;
+        }
+        Ok(())
+    };
 
     std::thread::scope(|scope| -> anyhow::Result<RunResult> {
         let finished = &finished;
-        let setup_ref = &setup;
-        let shop_ref = &shop;
-        // The planner thread.
+        // The planner thread streams the plan.
+        let mut source = list.into_iter();
         let planner = std::thread::Builder::new()
             .name("dnurbs-planner".into())
             .spawn_scoped(scope, move || {
-                let planned = plan_program(src, &opts.name, setup_ref, shop_ref, rtc.queue_depth)
-                    .and_then(|p| operator_reachable(p, &opts.name, opts.control.is_some()));
-                let mut source = match planned {
-                    Ok((start, list, end, notes)) => {
-                        let _ = ready_tx.send(Ok((start, end, notes)));
-                        list.into_iter()
-                    }
-                    Err(e) => {
-                        let _ = ready_tx.send(Err(e));
-                        return;
-                    }
-                };
                 while !finished.load(Ordering::Acquire) {
                     feeder.feed(&mut source);
                     std::thread::sleep(Duration::from_millis(1));
                 }
                 feeder.feed(&mut std::iter::empty());
             })?;
-        let ready = ready_rx.recv();
-        let (start, end_joints, notes) = match ready {
-            Ok(Ok(x)) => x,
-            Ok(Err(e)) => {
-                finished.store(true, Ordering::Release);
-                return Err(e.into());
-            }
-            Err(_) => {
-                finished.store(true, Ordering::Release);
-                let _ = planner.join();
-                anyhow::bail!("the planner thread ended without a result");
-            }
-        };
         let result = (|| -> anyhow::Result<RunResult> {
             // Drive set-up on every bus (SDO, PDO mapping, NMT start).
             let mut sopts = SetupOptions::new(period);
@@ -345,7 +369,9 @@ pub fn run<L: CanLink + Send>(
                 feedback_timeout_cycles: (rtc.feedback_timeout_s / period).ceil() as u32,
             };
             let mut buses = Vec::new();
+            stop_before_motion()?;
             for (bi, mut link) in open_links()?.into_iter().enumerate() {
+                stop_before_motion()?;
                 let drives: Vec<config::bus::Drive> = machine
                     .drives
                     .iter()
@@ -370,6 +396,7 @@ pub fn run<L: CanLink + Send>(
                 }
                 buses.push(bus);
             }
+            stop_before_motion()?;
             let end_counts: Vec<Option<i32>> = buses
                 .iter()
                 .flat_map(|b| b.drives.iter())
