@@ -210,10 +210,11 @@ pub fn chunks(
             .map_or(profile.duration, |p| p.t0 + p.dur)
             .min(profile.duration);
         let vmax = phases.iter().map(phase_vmax).fold(0.0, f64::max);
+        // The first phase that ends at or after s0: `first`, unless none does.
         let t_start = profile
             .phases
-            .iter()
-            .find(|p| p.end().s >= s0 - eps)
+            .get(first)
+            .filter(|p| p.end().s >= s0 - eps)
             .map_or(0.0, |p| if p.s0 >= s0 - eps { p.t0 } else { p.t0 + p.dur });
         out.push(Box::new(Chunk {
             index,
