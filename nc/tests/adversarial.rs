@@ -685,7 +685,7 @@ fn run_half(half: u64, cases: u32) {
 /// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration).
 #[test]
 fn the_hold_faults_found_stay_fixed() {
-    let cases: [(&str, hold::Event); 6] = [
+    let cases: [(&str, hold::Event); 7] = [
         (
             include_str!("adversarial/hold-creeps-off-the-vertical.nc"),
             hold::Event::Underrun {
@@ -725,6 +725,17 @@ fn the_hold_faults_found_stay_fixed() {
             include_str!("adversarial/stop-at-a-vertical-g065-start.nc"),
             hold::Event::Stop {
                 at: 0.43524834058136874,
+            },
+        ),
+        // The long run on f8c5fa5 (seed 7 000 009): a slow planner's hold ran out of data
+        // after a 15 um arc and stopped the tool at its end (a hard stop). Chunks now carry
+        // the arc with its neighbours and it passes; with one segment a chunk it still
+        // hard-stops: the follower's stop distance misjudges such a segment (open).
+        (
+            include_str!("adversarial/hold-hard-stop-after-a-tiny-arc.nc"),
+            hold::Event::Underrun {
+                every: 59,
+                depth: 4,
             },
         ),
     ];
