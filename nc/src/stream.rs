@@ -4,26 +4,29 @@
 //! The planner plans the feed over the whole program (look-ahead over everything it has read)
 //! and cuts the result into [`Chunk`]s: a run of consecutive segments with their arc-length
 //! tables and the profile phases that cover them. Chunks travel as `Box`es, so a queue moves
-//! pointers: the real-time side allocates nothing and frees nothing.
+//! pointers: the real-time side allocates nothing and frees nothing. A second queue carries
+//! consumed chunks back to the planner thread, which frees them. The planner keeps at most
+//! `depth` chunks alive (in the queues or held by the interpolator); `depth` comes from the
+//! machine file.
 //!
 //! **Look-ahead in distance.** The interpolator holds at most `depth` chunks (and at most
 //! [`LOOKAHEAD`]), so a chunk is cut at least [`chunk_length`] long: the distance to stop
 //! from the plan's top speed, shared out over the chunks held, with a quarter to spare.
 //! Whatever the programmed moves' length (a CAM program of 0.05 mm moves, or shorter), the
 //! path that has arrived then covers a stop, and a planner that keeps up never makes the
-//! tool hold. A second queue carries consumed chunks back to
-//! the planner thread, which frees them. The planner keeps at most `depth` chunks alive (in
-//! the queues or held by the interpolator); `depth` comes from the machine file.
+//! tool hold.
 //!
 //! **Feed hold.** The interpolator follows the plan in plan time `tau`, advanced by
 //! `k * Ts` each period. The override `k` in [0, 1] is driven by a rate- and jerk-limited
 //! tracker toward 1, or toward 0 when the path that has arrived ends within the distance
 //! needed to stop (an underrun: the planner fell behind), or when a stop is requested
-//! (SIGINT, a fault), or toward the operator's override (0 while paused). Geometry is untouched, so the tool slows along the path and stops on
-//! it, then resumes the plan where it left off; the position never jumps. The tracker's rate
-//! is limited to `hold_acc / v` and its rate of change to `hold_jerk / v`, with `v` the
-//! highest planned speed of the chunks at hand, so holding adds at most `hold_acc` of path
-//! acceleration and `hold_jerk` of path jerk to the plan's own.
+//! (SIGINT, a fault), or toward the operator's override (0 while paused). Geometry is
+//! untouched, so the tool slows along the path and stops on it, then resumes the plan where
+//! it left off; the position never jumps. The tracker's rate is limited to `hold_acc / v`
+//! and its rate of change to `hold_jerk / v`, with `v` the highest planned speed from the
+//! chunk at hand to the program's end ([`Chunk::vmax_ahead`]), so holding adds at most
+//! `hold_acc` of path acceleration and `hold_jerk` of path jerk to the plan's own. `v` never
+//! rises while the tool moves on, so neither limit ever tightens under a hold in progress.
 //!
 //! **Every axis's acceleration holds during a hold.** With the plan's joint trajectory
 //! q(tau) and tau advancing at the rate k, an axis moves at `k q'` and accelerates at
@@ -65,8 +68,6 @@ pub const LOOKAHEAD: usize = 64;
 pub struct Chunk {
     /// 0-based chunk index.
     pub index: usize,
-    /// Index of its first segment in the path.
-    pub first_segment: usize,
     /// The segments, in path order (at least one).
     pub segments: Vec<Segment>,
     /// Path position where each segment starts.
@@ -83,6 +84,10 @@ pub struct Chunk {
     pub t_start: f64,
     /// Highest planned speed over `phases`.
     pub vmax: f64,
+    /// Highest planned speed from this chunk to the program's end: what the interpolator's
+    /// holds are scaled by. It never rises as chunks arrive, so a hold in progress never
+    /// finds its limits tightened under it by a faster chunk coming in.
+    pub vmax_ahead: f64,
     /// Time at which the plan arrives at the chunk's end (the next one's `t_start`).
     pub t_arrive: f64,
     /// The plan is at rest where it arrives at the segment's end (an exact stop: at most
@@ -167,7 +172,14 @@ pub fn chunks(
     hold: &HoldConfig,
     depth: usize,
 ) -> (Start, Vec<Box<Chunk>>) {
-    let min_len = chunk_length(profile, hold, depth);
+    cut(path, profile, chunk_length(profile, hold, depth))
+}
+
+/// Cut a planned path into chunks at least `min_len` long (0: one segment a chunk, as a
+/// planner that pushes each segment as soon as it is planned). [`chunks`] with the length
+/// its depth needs.
+#[allow(clippy::vec_box)]
+pub fn cut(path: Path, profile: &FeedProfile, min_len: f64) -> (Start, Vec<Box<Chunk>>) {
     // The runs of segments, [a, b).
     let n = path.segments.len();
     let mut runs = Vec::new();
@@ -218,7 +230,6 @@ pub fn chunks(
             .map_or(0.0, |p| if p.s0 >= s0 - eps { p.t0 } else { p.t0 + p.dur });
         out.push(Box::new(Chunk {
             index,
-            first_segment: a,
             segments: segments.by_ref().take(b - a).collect(),
             starts: profile.seg_start[a..b].to_vec(),
             s0,
@@ -227,9 +238,13 @@ pub fn chunks(
             t_end,
             t_start,
             vmax,
+            vmax_ahead: vmax,
             t_arrive: t_end,
             rests_at_end: false,
         }));
+    }
+    for i in (1..out.len()).rev() {
+        out[i - 1].vmax_ahead = out[i - 1].vmax.max(out[i].vmax_ahead);
     }
     for i in 1..out.len() {
         let t = out[i].t_start;
@@ -667,11 +682,15 @@ impl<'q> Follower<'q> {
             self.pending = Pending::Fixed(cycle, 0.0);
             return;
         }
+        // The hold's scale: the highest planned speed from here to the end, not only over
+        // the chunks at hand. A faster chunk arriving mid-hold would otherwise lower the
+        // hold's jerk under a rate built with the old one, which could then not be undone
+        // before the data ran out.
         let vb = self
             .local
-            .iter()
-            .map(|c| c.vmax)
-            .fold(1e-9, f64::max)
+            .front()
+            .map_or(1e-9, |c| c.vmax_ahead)
+            .max(1e-9)
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
         let mut jmax = self.hold.jerk / vb;

@@ -509,6 +509,11 @@ fn axes_hold(
 
 /// Run the case: Ok(()) when refused with a position or when every limit holds.
 fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
+    check_with(src, counts, hold::event(src))
+}
+
+/// [`check`] with the hold event given.
+fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCaseError> {
     let (cfg, bl, kin) = machine();
     let program = match nc::parse::parse(src) {
         Ok(p) => p,
@@ -577,7 +582,6 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
         );
     }
     // Through the real-time follower too, with a stop, pause, override or slow planner.
-    let ev = hold::event(src);
     counts.held[ev.kind()].fetch_add(1, Ordering::Relaxed);
     hold::check(path, &profile, &cfg, kin, ev, src)
 }
@@ -691,6 +695,7 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 67,
                 depth: 5,
+                single: false,
             },
         ),
         (
@@ -698,6 +703,7 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 131,
                 depth: 6,
+                single: true,
             },
         ),
         (
@@ -705,6 +711,7 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 171,
                 depth: 2,
+                single: true,
             },
         ),
         (
@@ -712,6 +719,7 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 228,
                 depth: 6,
+                single: false,
             },
         ),
         (
@@ -719,6 +727,7 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 178,
                 depth: 2,
+                single: false,
             },
         ),
         (
@@ -736,16 +745,32 @@ fn the_hold_faults_found_stay_fixed() {
             hold::Event::Underrun {
                 every: 59,
                 depth: 4,
+                single: false,
             },
         ),
     ];
     for (src, want) in cases {
         assert_eq!(format!("{:?}", hold::event(src)), format!("{want:?}"));
-        let counts = Counts::default();
-        if let Err(e) = check(src, &counts) {
-            panic!("{e}");
+        // A slow planner's case with its chunks cut both ways.
+        let other = match want {
+            hold::Event::Underrun {
+                every,
+                depth,
+                single,
+            } => Some(hold::Event::Underrun {
+                every,
+                depth,
+                single: !single,
+            }),
+            _ => None,
+        };
+        for ev in [Some(want), other].into_iter().flatten() {
+            let counts = Counts::default();
+            if let Err(e) = check_with(src, &counts, ev) {
+                panic!("{e}");
+            }
+            assert_eq!(counts.accepted.load(Ordering::Relaxed), 1, "{src}");
+            assert_eq!(counts.held[want.kind()].load(Ordering::Relaxed), 1);
         }
-        assert_eq!(counts.accepted.load(Ordering::Relaxed), 1, "{src}");
-        assert_eq!(counts.held[want.kind()].load(Ordering::Relaxed), 1);
     }
 }

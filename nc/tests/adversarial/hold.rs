@@ -24,7 +24,7 @@ use nc::interp::Setpoint;
 use nc::kinematics::MachineKinematics;
 use nc::plan::{FeedProfile, PlanConfig};
 use nc::segment::Path;
-use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use nc::stream::{chunks, cut, Follower, HoldConfig, Queues};
 use proptest::prelude::*;
 
 /// One event during the run, at `at` (a fraction of the plan's duration).
@@ -44,11 +44,13 @@ pub enum Event {
         k: f64,
         periods: u64,
     },
-    /// The planner pushes one chunk (cut for the default depth) every `every` periods into
-    /// a queue `depth` deep.
+    /// The planner pushes one chunk every `every` periods into a queue `depth` deep. The
+    /// chunks are cut for the default depth, or `single` segments (a planner that pushes
+    /// each segment as it is planned: the least look-ahead per chunk).
     Underrun {
         every: u64,
         depth: usize,
+        single: bool,
     },
 }
 
@@ -94,6 +96,7 @@ pub fn event(src: &str) -> Event {
         _ => Event::Underrun {
             every: 1 + (h >> 24) % 400,
             depth: 2 + ((h >> 40) % 7) as usize,
+            single: (h >> 48) & 1 == 1,
         },
     }
 }
@@ -112,9 +115,12 @@ pub fn check(
         Event::Underrun { depth, .. } => depth,
         _ => 64,
     };
-    // Cut for the default depth, so that a shallower queue fed slowly starves the follower
-    // as a slow planner does.
-    let (start, all) = chunks(path, profile, &HoldConfig::from_plan(cfg), 64);
+    // Cut for the default depth (or one segment a chunk), so that a shallower queue fed
+    // slowly starves the follower as a slow planner does.
+    let (start, all) = match ev {
+        Event::Underrun { single: true, .. } => cut(path, profile, 0.0),
+        _ => chunks(path, profile, &HoldConfig::from_plan(cfg), 64),
+    };
     let mut source = all.into_iter();
     let mut q = Queues::new();
     let (mut feeder, inlet) = q.split(depth);
