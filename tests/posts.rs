@@ -361,17 +361,34 @@ fn the_offline_interpolation(
     let start = (0..got.len().saturating_sub(1))
         .find(|&k| close(&got[k]) && !close(&got[k + 1]))
         .unwrap_or_else(|| panic!("{name}: never at the program's start {first:?}"));
+    // A target is one period's travel along the path on from the last. That travel is at
+    // most the last period's plus what the axes' accelerations add in a period (the speed
+    // along the path is continuous, also through a corner, where the axes' velocities jump),
+    // and at most twice the chord from the last target on a curve (an arc of up to 180
+    // degrees is at most pi/2 times its chord); plus rounding. Through a sharp corner the
+    // path is many times the chord: there only the first bound holds.
+    let gain: f64 = m
+        .drives
+        .iter()
+        .map(|d| setup.limits[d.axis].acceleration * d.counts_per_unit * m.period_s * m.period_s)
+        .sum();
+    let along: Vec<f64> = std::iter::once(0.0)
+        .chain(path.windows(2).scan(0.0, |s, w| {
+            *s += (w[1] - w[0]).norm();
+            Some(*s)
+        }))
+        .collect();
     let mut at = 0;
     let mut worst = 0.0f64;
     let mut prev = Vec5::from_iterator(got[start].iter().map(|&x| f64::from(x)));
+    let (mut pos, mut step) = (0.0, 0.0);
     for (i, c) in got[start..].iter().enumerate() {
         let q = Vec5::from_iterator(c.iter().map(|&x| f64::from(x)));
-        // A target is one period's travel on from the last: along the path at most twice
-        // its chord (an arc of up to 180 degrees is at most pi/2 times its chord), plus
-        // rounding.
-        let (k, d) = nearest(&path, at, &q, 2.0 * (q - prev).norm() + 4.0 * ROUNDING);
-        prev = q;
-        at = k;
+        let ahead = (2.0 * (q - prev).norm()).max(step + gain) + 4.0 * ROUNDING;
+        // The window is walked from the start of the last match's segment.
+        let (k, s, d) = nearest(&path, at, &q, ahead + pos - along[at]);
+        let here = along[k] + s * (along[(k + 1).min(path.len() - 1)] - along[k]);
+        (prev, at, step, pos) = (q, k, here - pos, here);
         worst = worst.max(d);
         assert!(
             d <= ROUNDING,
@@ -401,10 +418,11 @@ const FINER: f64 = 4.0;
 const ROUNDING: f64 = 1.118_034;
 
 /// The segment of the polyline `pts` nearest to `q`, searched from segment `from` on, at
-/// most `ahead` counts of path further: its index and the distance.
-fn nearest(pts: &[Vec5], from: usize, q: &Vec5, ahead: f64) -> (usize, f64) {
+/// most `ahead` counts of path further: its index, the nearest point's fraction of it and
+/// the distance.
+fn nearest(pts: &[Vec5], from: usize, q: &Vec5, ahead: f64) -> (usize, f64, f64) {
     let last = pts.len() - 1;
-    let mut best = (from, f64::INFINITY);
+    let mut best = (from, 0.0, f64::INFINITY);
     let mut walked = 0.0;
     for k in from..last.max(from + 1) {
         let (a, b) = (pts[k], pts[(k + 1).min(last)]);
@@ -415,8 +433,8 @@ fn nearest(pts: &[Vec5], from: usize, q: &Vec5, ahead: f64) -> (usize, f64) {
             0.0
         };
         let d = (a + ab * s - q).norm();
-        if d < best.1 {
-            best = (k, d);
+        if d < best.2 {
+            best = (k, s, d);
         }
         walked += ab.norm();
         if walked > ahead {

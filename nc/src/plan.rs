@@ -1,7 +1,8 @@
 //! Feed planning with look-ahead over the whole path, done once outside the real-time thread.
 //!
 //! 1. **Stations.** Each segment is sampled at stations about one period of travel apart
-//!    (16..=4096 per segment). At each station the machine joints q(s) are computed through
+//!    (16..=4096 per segment; 2 or more along a line with a fixed tool axis, whose joints
+//!    move at constant rates). At each station the machine joints q(s) are computed through
 //!    the kinematics (with rotary continuity), and dq/ds, d2q/ds2 by finite differences.
 //! 2. **Velocity ceiling** at each station, the least of: the programmed feed; the chord-error
 //!    limit `2 sqrt(2 rho delta - delta^2) / Ts` (rho = 1/curvature, delta = tolerance); the
@@ -12,7 +13,10 @@
 //! 3. **Corners.** Where segments meet with a kink in some axis (dq/ds jumps by d_j), the
 //!    joint is passed at `min_j amax_j Ts / d_j`: each axis's velocity then changes by at
 //!    most one period's worth of its acceleration. A G2-continuous joint has d = 0 and is
-//!    passed at speed. The path starts and ends at rest.
+//!    passed at speed. Where the cutter path turns by phi there, also at most
+//!    `2 tol / (Ts sin(phi / 2))`: the chord that straddles the corner then keeps the
+//!    tolerance whatever the sampling phase (after a hold, too). The path starts and ends
+//!    at rest.
 //! 4. **S-curves between critical points.** Critical points are the start, the end, the
 //!    joints and the local minima of the ceiling. Backward and forward passes make each
 //!    point's speed reachable from its neighbours; then each section gets a jerk-limited
@@ -32,6 +36,7 @@ use crate::segment::{Geometry, Path, Segment, Tooling};
 use crate::verify::{
     check_from, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
 };
+use nalgebra::Vector3;
 
 /// Limits of one machine axis, in mm or radians and seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -163,6 +168,50 @@ fn curvature(seg: &Segment, s: f64) -> f64 {
     }
 }
 
+/// The cutter path's unit tangent at a segment's start or end, if it has one.
+fn end_tangent(seg: &Segment, at_end: bool) -> Option<Vector3<f64>> {
+    let d = match &seg.geometry {
+        Geometry::Line { from, to } => to - from,
+        Geometry::Nurbs { curve, table } => {
+            let s = if at_end { seg.length } else { 0.0 };
+            curve.cutter(table.u_of_s(curve, s), 1).d1
+        }
+    };
+    let n = d.norm();
+    (n > 1e-12 && n.is_finite()).then(|| d / n)
+}
+
+/// Highest speed at which a junction whose cutter path turns from `t0` to `t1` keeps the
+/// chord error within `tol` whatever the sampling phase: a chord of one period's travel
+/// `L = v Ts` that straddles the corner passes it at most `(L / 2) sin(phi / 2)` away
+/// (phi the turn, reached with the corner midway), so the corner's speed is at most
+/// `2 tol / (Ts sin(phi / 2))`, with [`CORNER_CHORD_SHARE`] of it taken. The setpoint check
+/// measures the chord at the plan's actual phase; a cap found from that phase alone would
+/// move with every change of the plan's timing before it, and the replanning rounds would
+/// chase it from corner to corner along a long program.
+fn corner_chord_speed(t0: &Vector3<f64>, t1: &Vector3<f64>, tol: f64, ts: f64) -> f64 {
+    let half = 0.5 * t0.dot(t1).clamp(-1.0, 1.0).acos();
+    let sin = half.sin();
+    if sin <= 1e-12 {
+        f64::INFINITY
+    } else {
+        CORNER_CHORD_SHARE * 2.0 * tol / (ts * sin)
+    }
+}
+
+/// Share of the chord tolerance a corner's speed is planned for: the chord straddling a
+/// corner is one period's travel only at a steady speed.
+const CORNER_CHORD_SHARE: f64 = 0.97;
+
+/// Whether every joint moves at a constant rate along `seg`: a line with a fixed tool axis
+/// (the rotary joints stand still, and the linear ones follow the line rotated).
+fn constant_rates(seg: &Segment) -> bool {
+    matches!(
+        (&seg.geometry, &seg.tooling),
+        (Geometry::Line { .. }, Tooling::Fixed(_))
+    )
+}
+
 /// Halvings of the station spacing over which [`end_rates`] follows a segment's ends.
 const END_HALVINGS: i32 = 10;
 
@@ -178,7 +227,7 @@ struct EndRate {
 /// the station spacing `h` down to `h / 2^END_HALVINGS`. A rate that peaks at an end (the
 /// tool axis leaving or reaching the vertical of an A/C table turns C fastest there) can be
 /// narrower than the stations, and a kink's velocity jump is the rate at the end itself.
-/// A line with a fixed tool axis moves every joint at a constant rate: its spacing is exact.
+/// Along a [`constant_rates`] segment the station spacing is exact.
 fn end_rates(
     seg: &Segment,
     kin: &MachineKinematics,
@@ -191,10 +240,7 @@ fn end_rates(
         let (a, b) = if dir > 0.0 { (i, i + 1) } else { (i - 1, i) };
         core::array::from_fn(|j| (q[b][j] - q[a][j]) / h)
     };
-    let exact = matches!(
-        (&seg.geometry, &seg.tooling),
-        (Geometry::Line { .. }, Tooling::Fixed(_))
-    );
+    let exact = constant_rates(seg);
     let one = |from: &Joints, s: f64, dir: f64, coarse: [f64; 5]| {
         let mut r = EndRate {
             at: coarse,
@@ -232,9 +278,14 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
     let mut prev = path.start_joints;
     let mut s0 = 0.0;
     let mut prev_end: Option<([f64; 5], bool)> = None;
+    let mut prev_seg: Option<&Segment> = None;
     for seg in &path.segments {
-        let n =
-            ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize).clamp(16, 4096);
+        // A line with a fixed tool axis moves every joint at a constant rate, so its ceiling
+        // is the same all along: its two ends and a midpoint say all there is (a dense CAM
+        // program of such moves would otherwise carry 16 stations a move).
+        let fewest = if constant_rates(seg) { 2 } else { 16 };
+        let n = ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize)
+            .clamp(fewest, 4096);
         let h = seg.length / n as f64;
         let mut q = Vec::with_capacity(n + 1);
         for i in 0..=n {
@@ -288,6 +339,12 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
                         // a NURBS block: stop between.
                         vc = 0.0;
                     }
+                    let tangents = prev_seg
+                        .filter(|p| !p.rotary_only && !seg.rotary_only)
+                        .and_then(|p| Some((end_tangent(p, true)?, end_tangent(seg, false)?)));
+                    if let Some((t0, t1)) = tangents {
+                        vc = vc.min(corner_chord_speed(&t0, &t1, cfg.chord_tol, cfg.period));
+                    }
                     for (j, ax) in cfg.axes.iter().enumerate() {
                         let jump = (d1[j] - pd1[j]).abs();
                         if jump > 1e-9 {
@@ -304,6 +361,7 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
             out.push(st);
         }
         prev_end = Some((last_d1, seg.rotary_only));
+        prev_seg = Some(seg);
         s0 += seg.length;
     }
     (out, starts)
