@@ -296,7 +296,10 @@ fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Stat
         let (start_rate, end_rate) = end_rates(seg, kin, cfg, &q, h);
         let mut last_d1 = [0.0; 5];
         for i in 0..=n {
-            let s_loc = h * i as f64;
+            // The last station is the joint: exactly where the next segment starts (h n
+            // can differ from the length in the last bit, and a cap at the joint would then
+            // fall on the station before it too).
+            let s_loc = if i == n { seg.length } else { h * i as f64 };
             let (d1, d2) = joint_derivatives(&q, h, i);
             // At the segment's ends: the rate at the end itself (what jumps at a joint) and
             // the largest on the way there (what bounds the section's limits).

@@ -118,20 +118,27 @@ fn a_blade_sweep_of_3000_moves_shrinks_tenfold_within_the_tolerances() {
     assert!(dev.path_mm <= 2e-3, "{dev:?}");
 }
 
-#[test]
-fn a_raster_keeps_its_corners() {
-    // Rows of 0.1 mm moves along a gentle wave, 1 mm step-over moves at 90 degrees.
+/// Rows of `steps` moves of 0.1 mm along a gentle wave, joined by 1 mm step-over moves at
+/// 90 degrees.
+fn raster(rows: u32, steps: u32) -> Vec<(Vector3<f64>, Vector3<f64>)> {
     let mut points = Vec::new();
-    let rows = 6;
+    let length = f64::from(steps) * 0.1;
     for r in 0..rows {
         let y = f64::from(r);
-        for k in 0..=300 {
+        for k in 0..=steps {
             let x = f64::from(k) * 0.1;
-            let x = if r % 2 == 0 { x } else { 30.0 - x };
+            let x = if r % 2 == 0 { x } else { length - x };
             let z = 0.5 * (x / 5.0).sin() + 0.1 * y;
             points.push((Vector3::new(x, y, z), Vector3::new(0.0, 0.0, 1.0)));
         }
     }
+    points
+}
+
+#[test]
+fn a_raster_keeps_its_corners() {
+    let rows = 6;
+    let points = raster(rows, 300);
     let src = g01(&points, 3000.0);
     let opts = Options::default();
     let (out, dev) = fit_and_measure(&src, &opts);
@@ -294,4 +301,71 @@ fn compressing_a_program_keeps_its_points_and_its_words() {
     let t_in = nc::plan::plan(&a, &KIN, &cfg).unwrap().duration;
     let t_out = nc::plan::plan(&b, &KIN, &cfg).unwrap().duration;
     assert!(t_out < t_in, "{t_out} s compressed, {t_in} s as G01");
+}
+
+/// A compressed raster slows into each row end and leaves it without creeping: the speed
+/// ten periods' travel (at the corner's speed) before and after a corner is above the
+/// corner's. Before, the planner's station at the end of a NURBS segment lay a rounding
+/// error short of the segment's end (`h n` for the length), so the check's cap at the corner
+/// also fell on the station before it: the path crept at the corner's speed over a whole
+/// station, one period's travel at the feed (about 20 ms a row end of the 3-axis raster).
+#[test]
+fn a_compressed_row_end_is_passed_without_creeping() {
+    // 1 ms and a chord tolerance of 2 um, as on the xyzac-trt-mill: the corner's speed is
+    // then set by the axes' acceleration (a velocity jump of a Ts), not by its chord.
+    let period = 0.001;
+    let (mut cfg, bl) = nc::fixtures::small_mill(period);
+    cfg.chord_tol = 0.002;
+    // Rows of several lengths: whether `h n` misses the length depends on it.
+    for steps in [150, 223, 300, 417, 600] {
+        let src = g01(&raster(4, steps), 3000.0);
+        let program = nc::parse::parse(&src).unwrap();
+        let (small, c) = nc::fit::compress::compress(&program, &KIN, &Options::default());
+        assert_eq!(c.fitted_blocks, 4, "{c:?}");
+        let path = build(&small, &KIN, &bl).unwrap();
+        let profile = nc::plan::plan(&path, &KIN, &cfg).unwrap();
+        // The time at which the path passes position s (s grows with t).
+        let time_at = |s: f64| {
+            let (mut lo, mut hi) = (0.0, profile.duration);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if profile.motion_at(mid).s < s {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            hi
+        };
+        let point = |s: f64| {
+            let k = profile
+                .seg_start
+                .partition_point(|&b| b <= s)
+                .saturating_sub(1);
+            let k = k.min(path.segments.len() - 1);
+            let seg = &path.segments[k];
+            seg.pose((s - profile.seg_start[k]).clamp(0.0, seg.length))
+                .p
+        };
+        let mut corners = 0;
+        for k in 1..path.segments.len() {
+            let s = profile.seg_start[k];
+            let (a, b, c) = (point(s - 0.01), point(s), point(s + 0.01));
+            if (b - a).angle(&(c - b)) < 45f64.to_radians() {
+                continue;
+            }
+            corners += 1;
+            let vc = profile.motion_at(time_at(s)).v;
+            let d = 10.0 * vc * period;
+            for side in [s - d, s + d] {
+                let v = profile.motion_at(time_at(side)).v;
+                assert!(
+                    v > 1.05 * vc,
+                    "rows of {steps} moves: corner at s = {s:.4} passed at {vc:.3} mm/s, \
+                     {v:.3} mm/s at s = {side:.4}"
+                );
+            }
+        }
+        assert_eq!(corners, 6, "three row ends, two corners each");
+    }
 }
