@@ -1,4 +1,5 @@
-//! Feed planning with look-ahead over the whole path, done once outside the real-time thread.
+//! Feed planning outside the real-time thread, in windows of bounded look-ahead
+//! ([`window`]: each window runs the steps below over its own stretch of path).
 //!
 //! 1. **Stations.** Each segment is sampled at stations about one period of travel apart
 //!    (16..=4096 per segment; 2 or more along a line with a fixed tool axis, whose joints
@@ -33,10 +34,10 @@ use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::program::SrcPos;
 use crate::scurve::{push_section, reachable, Motion, Phase};
 use crate::segment::{Geometry, Path, Segment, Tooling};
-use crate::verify::{
-    check_from, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
-};
+use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
 use nalgebra::Vector3;
+
+mod window;
 
 /// Limits of one machine axis, in mm or radians and seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,6 +89,8 @@ pub struct FeedProfile {
     pub phases: Vec<Phase>,
     /// Path position where each segment starts (segment k spans seg_start[k]..seg_start[k+1]).
     pub seg_start: Vec<f64>,
+    /// Where the plan ends: the path's length (while the planner checks a window, the
+    /// window's end, where it stops).
     pub length: f64,
     pub duration: f64,
     /// The largest axis velocity, acceleration, jerk and chord error the setpoints reach,
@@ -592,99 +595,40 @@ fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64) {
 /// setpoints at the period ([`crate::verify::check`]). Where a limit is broken the ceiling
 /// there drops by the factor the measurement asks for and the plan is made again; a limit
 /// that slowing cannot bring within its bound (travel, a step at rest, a violation at the
-/// slowest feed) refuses the program with the position of its block.
+/// slowest feed) refuses the program with the position of its block. The path is planned
+/// in windows of bounded length ([`window`]), each checked as it is planned.
 pub fn plan(
     path: &Path,
     kin: &MachineKinematics,
     cfg: &PlanConfig,
 ) -> Result<FeedProfile, PlanError> {
-    let mut seg_start = Vec::with_capacity(path.segments.len() + 1);
-    let mut total = 0.0;
-    for seg in &path.segments {
-        seg_start.push(total);
-        total += seg.length;
-    }
-    seg_start.push(total);
-    let smooth = crate::verify::smooth_junctions(path, kin, cfg);
-    let (mut st, starts) = if path.segments.is_empty() {
-        (Vec::new(), Vec::new())
-    } else {
-        stations(path, kin, cfg)
-    };
-    let mut round = 0;
-    // The last round's schedule, check and trace. A schedule that the caps did not change
-    // would measure the same violations again, round after round; one they changed is
-    // re-measured from where it first differs.
-    let mut last: Option<(Vec<Phase>, Checked, Trace)> = None;
-    loop {
-        let phases = if st.is_empty() {
-            Vec::new()
-        } else {
-            with_dwells(schedule(&st, &starts, cfg), path, &seg_start)
-        };
-        if let Some((prev, checked, _)) = &last {
-            if *prev == phases {
-                return Err(refuse(path, kin, cfg, &checked.violations[0]));
-            }
-        }
-        let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
-        if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
-            return Err(too_long(path, &seg_start, &phases, duration, cfg.period));
-        }
-        let mut profile = FeedProfile {
-            phases,
-            seg_start: seg_start.clone(),
-            length: total,
-            duration,
-            margins: Margins::default(),
-        };
-        let earlier = last.as_ref().map(|(phases, checked, trace)| Earlier {
-            phases,
-            checked,
-            trace,
-        });
-        let (checked, trace) = check_from(path, &profile, kin, cfg, &smooth, earlier);
-        if checked.violations.is_empty() {
-            profile.margins = checked.margins;
-            return Ok(profile);
-        }
-        // Travel: slowing cannot help. Report the farthest excursion of the first block
-        // that leaves the travel.
-        let travel = checked
-            .violations
-            .iter()
-            .filter(|v| v.quantity == Quantity::Travel);
-        if let Some(first) = travel.clone().next() {
-            let worst = travel
-                .filter(|v| v.segment == first.segment)
-                .fold(first, |w, v| {
-                    if (v.value - v.limit).abs() > (w.value - w.limit).abs() {
-                        v
-                    } else {
-                        w
-                    }
-                });
-            return Err(refuse(path, kin, cfg, worst));
-        }
-        for v in &checked.violations {
-            let factor = match v.speed_factor() {
-                Some(f) if v.v > V_FLOOR * 1.01 && round + 1 < VERIFY_ROUNDS && f.is_finite() => f,
-                _ => return Err(refuse(path, kin, cfg, v)),
-            };
-            cap_stations(&mut st, v.s, v.v * factor * CAP_MARGIN);
-        }
-        last = Some((profile.phases, checked, trace));
-        round += 1;
-    }
+    window::plan_in_windows(path, kin, cfg, None)
 }
 
-/// The dwells (`G04`) as rest phases: a segment that waits starts at rest (it is a stop),
-/// and the plan stays there for the dwell before it goes on; later phases shift in time.
-fn with_dwells(phases: Vec<Phase>, path: &Path, seg_start: &[f64]) -> Vec<Phase> {
-    let mut waits = path
-        .segments
+/// [`plan`] with windows that look ahead just `reach` (path units) past what they commit,
+/// however much the stop at their end slows the plan: short windows for the tests, which
+/// stop and start more often, and must hold every limit all the same.
+pub fn plan_looking_ahead(
+    path: &Path,
+    kin: &MachineKinematics,
+    cfg: &PlanConfig,
+    reach: f64,
+) -> Result<FeedProfile, PlanError> {
+    window::plan_in_windows(path, kin, cfg, Some(reach))
+}
+
+/// The dwells (`G04`) of segments `segs` as rest phases: a segment that waits starts at rest
+/// (it is a stop), and the plan stays there for the dwell before it goes on; later phases
+/// shift in time.
+fn with_dwells(
+    phases: Vec<Phase>,
+    path: &Path,
+    seg_start: &[f64],
+    segs: core::ops::Range<usize>,
+) -> Vec<Phase> {
+    let mut waits = path.segments[segs.clone()]
         .iter()
-        .zip(seg_start)
+        .zip(&seg_start[segs])
         .filter(|(seg, _)| seg.wait.dwell_s > 0.0)
         .map(|(seg, &at)| (at, seg.wait.dwell_s))
         .peekable();
@@ -692,7 +636,7 @@ fn with_dwells(phases: Vec<Phase>, path: &Path, seg_start: &[f64]) -> Vec<Phase>
         return phases;
     }
     let eps = 1e-9 * seg_start.last().copied().unwrap_or(0.0).max(1.0);
-    let mut out = Vec::with_capacity(phases.len() + path.segments.len());
+    let mut out = Vec::with_capacity(2 * phases.len());
     let mut shift = 0.0;
     for p in phases {
         while let Some(&(at, dwell)) = waits.peek() {
@@ -718,12 +662,19 @@ fn with_dwells(phases: Vec<Phase>, path: &Path, seg_start: &[f64]) -> Vec<Phase>
     out
 }
 
-/// The S-curve phases through the stations' ceilings.
-fn schedule(st: &[Station], starts: &[usize], cfg: &PlanConfig) -> Vec<Phase> {
-    let last = st.len() - 1;
+/// The S-curve phases through the stations' ceilings from station `from`, reached at time
+/// `t0` at speed `v0` with no acceleration (a joint, or the start), to station `last`, where
+/// the path comes to rest. None if the stations ahead cannot be reached from `v0`.
+fn schedule(
+    st: &[Station],
+    starts: &[usize],
+    cfg: &PlanConfig,
+    (from, t0, v0): (usize, f64, f64),
+    last: usize,
+) -> Option<Vec<Phase>> {
     // Critical points: (station index, speed).
-    let mut crit: Vec<(usize, f64)> = vec![(0, 0.0)];
-    for i in 1..last {
+    let mut crit: Vec<(usize, f64)> = vec![(from, v0)];
+    for i in from + 1..last {
         let is_joint = starts.binary_search(&i).is_ok();
         let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
         if is_joint || is_min {
@@ -744,13 +695,19 @@ fn schedule(st: &[Station], starts: &[usize], cfg: &PlanConfig) -> Vec<Phase> {
             let (a, j) = limits[k];
             crit[k].1 = crit[k].1.min(reachable(crit[k + 1].1, len, a, j));
         }
+        // The start's speed is the committed plan's: it cannot drop. (A rounding's worth
+        // is given back; the setpoint check measures the join either way.)
+        if crit[0].1 < v0 * (1.0 - 1e-12) {
+            return None;
+        }
+        crit[0].1 = v0;
         for k in 1..crit.len() {
             let len = st[crit[k].0].s - st[crit[k - 1].0].s;
             let (a, j) = limits[k - 1];
             crit[k].1 = crit[k].1.min(reachable(crit[k - 1].1, len, a, j));
         }
         phases.clear();
-        let mut t = 0.0;
+        let mut t = t0;
         let mut inserts = Vec::new();
         for (k, w) in crit.windows(2).enumerate() {
             let ((ia, va), (ib, vb)) = (w[0], w[1]);
@@ -791,5 +748,5 @@ fn schedule(st: &[Station], starts: &[usize], cfg: &PlanConfig) -> Vec<Phase> {
             crit.insert(pos, (i, st[i].vlim));
         }
     }
-    phases
+    Some(phases)
 }

@@ -1,9 +1,9 @@
 //! Streaming: planned segments handed from the non-real-time planner thread to the real-time
 //! interpolator through preallocated `heapless` SPSC queues, with feed hold.
 //!
-//! The planner plans the feed over the whole program (look-ahead over everything it has read)
-//! and cuts the result into [`Chunk`]s: a run of consecutive segments with their arc-length
-//! tables and the profile phases that cover them. Chunks travel as `Box`es, so a queue moves
+//! The planner plans the feed (in windows of bounded look-ahead, `crate::plan`) and cuts
+//! the result into [`Chunk`]s: a run of consecutive segments with their arc-length tables
+//! and the profile phases that cover them. Chunks travel as `Box`es, so a queue moves
 //! pointers: the real-time side allocates nothing and frees nothing. A second queue carries
 //! consumed chunks back to the planner thread, which frees them. The planner keeps at most
 //! `depth` chunks alive (in the queues or held by the interpolator); `depth` comes from the

@@ -176,13 +176,22 @@ pub fn check(
 }
 
 /// Periods between two [`Trace`] marks.
-const MARK_EVERY: u64 = 2048;
+const MARK_EVERY: u64 = 256;
 
 /// A check's state every [`MARK_EVERY`] periods, to start the next round's check where the
 /// replanned profile first differs ([`check_from`]).
 #[derive(Clone, Debug, Default)]
 pub struct Trace {
     marks: Vec<TraceMark>,
+}
+
+impl Trace {
+    /// Forget the marks no later check will start from: all but the last before time `t`,
+    /// when the plan before `t` is final (the planner's committed windows).
+    pub fn forget_before(&mut self, t: f64) {
+        let n = self.marks.partition_point(|m| m.win[3].t < t);
+        self.marks.drain(..n.saturating_sub(1));
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -197,6 +206,10 @@ struct TraceMark {
 
 /// A check of an earlier profile of the same path: its phases, result and trace.
 pub struct Earlier<'a> {
+    /// Phases before this index are the same in both profiles (the planner's committed
+    /// windows), so the comparison starts there.
+    pub offset: usize,
+    /// The earlier profile's phases from `offset` on.
     pub phases: &'a [Phase],
     pub checked: &'a Checked,
     pub trace: &'a Trace,
@@ -248,14 +261,10 @@ fn check_marked(
     out.margins.cycles = 1;
     check_travel(&first, cfg, &mut out);
     if let Some(e) = earlier {
-        let same = e
-            .phases
-            .iter()
-            .zip(&profile.phases)
-            .take_while(|(a, b)| a == b)
-            .count();
+        let now = profile.phases.get(e.offset..).unwrap_or(&[]);
+        let same = e.phases.iter().zip(now).take_while(|(a, b)| a == b).count();
         let t0 = |p: &[Phase]| p.get(same).map_or(f64::INFINITY, |x| x.t0);
-        let changed = t0(e.phases).min(t0(&profile.phases));
+        let changed = t0(e.phases).min(t0(now));
         // The mark's own and earlier setpoints were computed before the change.
         let usable = e
             .trace

@@ -39,7 +39,10 @@ fn run(method: Method) -> (Vec<Setpoint>, nc::segment::Path) {
             "axis {j}: {m:?}"
         );
     }
-    let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, PERIOD, 0.0);
+    // The Taylor methods integrate the speed, so they may fall a rounding short of the end
+    // when the plan has stopped; they finish at the creep speed `simulate` gives them.
+    let creep = cfg.path_acc * PERIOD;
+    let mut ip = Interpolator::new(&path, &profile, kin, cfg.rotary, method, PERIOD, creep);
     let mut out = Vec::new();
     loop {
         let sp = ip.step();

@@ -65,6 +65,7 @@ fn a_resumed_check_measures_what_the_full_check_measures() {
         for from in 0..profile.phases.len() {
             let next = changed(&profile, from);
             let earlier = Earlier {
+                offset: 0,
                 phases: &profile.phases,
                 checked: &first,
                 trace: &trace,
