@@ -23,7 +23,7 @@ use super::{
     PlanError, Station, CAP_MARGIN, VERIFY_ROUNDS, V_FLOOR,
 };
 use crate::kinematics::MachineKinematics;
-use crate::scurve::{reachable, Phase};
+use crate::scurve::{change_dist, reachable, Phase};
 use crate::segment::Path;
 use crate::verify::{check_from, Checked, Earlier, Margins, Quantity, Trace, MAX_CYCLES};
 
@@ -58,15 +58,6 @@ impl WindowPlan {
     }
 }
 
-/// Distance to stop from `v` with a jerk-limited profile of acceleration `a` and jerk `j`.
-fn stop_distance(v: f64, a: f64, j: f64) -> f64 {
-    if v * j >= a * a {
-        0.5 * v * (v / a + a / j)
-    } else {
-        v * (v / j).sqrt()
-    }
-}
-
 /// The look-ahead distance: a stop from the highest ceiling of any station, at the path's
 /// acceleration and jerk shared as the sections share them (`super::section_limits`).
 fn reach(st: &[Station], cfg: &PlanConfig) -> f64 {
@@ -79,7 +70,7 @@ fn reach(st: &[Station], cfg: &PlanConfig) -> f64 {
             j = j.min(ax.jerk / (2.0 * dq));
         }
     }
-    stop_distance(vtop, a.max(1e-3), j.max(1e-3))
+    change_dist(vtop, 0.0, a.max(1e-3), j.max(1e-3))
 }
 
 /// The first joint after joint `starts[kc]` far enough ahead that a stop there does not
