@@ -12,12 +12,13 @@
 //! rotary axes), and angle words suit the machine's tilt axis.
 
 use crate::arclen::ArcTable;
-use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, Tilt, VERTICAL_RHO};
+use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits, VERTICAL_RHO};
 use crate::nurbs::DoubleNurbs;
-use crate::program::{
-    Aux, Block, LengthMode, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait,
-};
+use crate::program::{Aux, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos, Wait};
 use nalgebra::Vector3;
+
+mod builder;
+pub use builder::Builder;
 
 /// Smallest allowed |CT(u) - C(u)| along a G06.5 block, mm.
 pub const MIN_TOOL_VECTOR_MM: f64 = 1e-3;
@@ -259,115 +260,20 @@ pub fn build(
     kin: &MachineKinematics,
     limits: &BuildLimits,
 ) -> Result<Path, BuildError> {
-    let err = |pos, kind| BuildError { pos, kind };
-    let machine = match kin.tilt_kind() {
-        Tilt::A => 'A',
-        Tilt::B => 'B',
-    };
-    if let Some((word, pos)) = program.tilt_word {
-        if word != machine {
-            return Err(err(pos, BuildErrorKind::WrongTilt { word, machine }));
-        }
-    }
-    let first = match program.blocks.first() {
-        None => return Err(err(SrcPos::default(), BuildErrorKind::NoStart)),
-        Some(Block::Nurbs(b)) => return Err(err(b.pos, BuildErrorKind::NurbsFirst)),
-        Some(Block::Linear(m)) => m,
-    };
-    let lim = &limits.rotary;
-    let mut pose = Pose {
-        p: Vector3::from(first.end),
-        tool: linear_tool(first),
-        u: None,
-        z: first.tooling.tool_length,
-    };
-    let mut joints = pose.joints(kin, &[0.0; 5], lim);
-    let start = pose;
-    let mut start_joints = joints;
-    let mut segments: Vec<Segment> = Vec::with_capacity(program.blocks.len());
-    // A wait before a block that moves nothing goes to the next segment.
-    let mut wait = Wait::default();
-    // Spindle and coolant: the words up to each block apply along it; the first feed move
-    // after the spindle is started or changes speed waits for it to be at speed.
-    let mut aux = Aux::default();
-    let mut spindle_wait = false;
+    let mut builder = Builder::new(kin, limits);
+    builder.tilt_word(program.tilt_word)?;
+    let mut segments = Vec::with_capacity(program.blocks.len());
     let mut actions = program.actions.iter().peekable();
     for (i, block) in program.blocks.iter().enumerate() {
         while let Some(a) = actions.next_if(|a| a.before_block <= i) {
-            spindle_wait = aux.apply(&a.kind) || (spindle_wait && aux.spindle_rpm != 0.0);
+            builder.action(a);
         }
-        if i == 0 {
-            continue;
-        }
-        let index = (i + 1) as u32;
-        let (tooling, pos) = match block {
-            Block::Linear(m) => (m.tooling, m.pos),
-            Block::Nurbs(b) => (b.tooling, b.pos),
-        };
-        if tooling.mode == LengthMode::Rtcp && *kin == MachineKinematics::Paper {
-            return Err(err(pos, BuildErrorKind::RtcpUnsupported));
-        }
-        wait = merge(wait, tooling.wait);
-        let mut segs: Vec<Segment> = match block {
-            Block::Linear(m) => linear(index, m, &pose, &joints, kin, limits)?
-                .into_iter()
-                .collect(),
-            Block::Nurbs(b) => {
-                if b.tooling.tool_length != pose.z {
-                    let kind = BuildErrorKind::LengthChangeOnCurve {
-                        from: pose.z,
-                        to: b.tooling.tool_length,
-                    };
-                    return Err(err(b.pos, kind));
-                }
-                nurbs(index, b, &pose, &joints, kin, limits)?
-            }
-        };
-        if let Some(first) = segs.first_mut() {
-            first.wait = core::mem::take(&mut wait);
-            first.stop |= first.wait.is_some();
-        }
-        for mut seg in segs {
-            seg.aux = aux;
-            if spindle_wait && !seg.rapid {
-                seg.wait.spindle = true;
-                seg.stop = true;
-                spindle_wait = false;
-            }
-            // With a vertical tool C is free: choose it where the path leaves the vertical.
-            if let Some(c) = c_leaving_vertical(&seg, kin, &joints, lim) {
-                if segments.is_empty() {
-                    start_joints[4] = c;
-                    joints[4] = c;
-                } else if (c - joints[4]).abs() > 1e-9 {
-                    segments.push(turn_c(&seg, &joints, c));
-                    joints[4] = c;
-                    // The turn waits where the segment would have: not a second time.
-                    seg.wait = Wait::default();
-                }
-            }
-            // The joints at the end are those the interpolator arrives with: follow the
-            // segment, so the next block starts from the rotary branch the path really took.
-            let at_start = joints;
-            joints = follow(&seg, kin, &joints, lim);
-            if tooling.mode == LengthMode::Length && matches!(kin, MachineKinematics::Trt { .. }) {
-                let turned = |j: &Joints| j[3].abs() > 1e-9 || j[4].abs() > 1e-9;
-                let bad = [at_start, joints].into_iter().find(turned);
-                if let Some(j) = bad {
-                    let kind = BuildErrorKind::RotaryWithoutRtcp {
-                        tilt_deg: j[3].to_degrees(),
-                        c_deg: j[4].to_degrees(),
-                    };
-                    return Err(err(seg.src, kind));
-                }
-            }
-            pose = seg.pose(seg.length);
-            segments.push(seg);
-        }
+        builder.block(i, block, &mut segments)?;
     }
+    let (start, start_src, start_joints) = builder.start()?;
     Ok(Path {
         start,
-        start_src: first.pos,
+        start_src,
         start_joints,
         segments,
     })

@@ -82,6 +82,14 @@ impl fmt::Display for Context {
 /// Which rule was broken, with the offending values.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub enum ParseErrorKind {
+    // ---- reading the source -------------------------------------------------------------
+    #[error("byte 0x{byte:02x} is not UTF-8: save the program as UTF-8 (or ASCII)")]
+    NotUtf8 { byte: u8 },
+    #[error("the line is longer than {max} bytes: no NC line is, so this is not an NC program")]
+    LineTooLong { max: usize },
+    #[error("the program could not be read on from here: {kind}")]
+    Unreadable { kind: std::io::ErrorKind },
+
     // ---- lexical rules -----------------------------------------------------------------
     #[error("unexpected character {ch:?}: expected a word (a letter and a number), a comment, or `\\` at the end of the line")]
     UnexpectedChar { ch: char },

@@ -8,6 +8,7 @@
 //! for an `f64`, which is an error.
 
 use super::error::{ParseError, ParseErrorKind};
+use super::source::LineSource;
 use crate::program::SrcPos;
 
 /// One word: an (upper-cased) letter and the number that follows it.
@@ -21,30 +22,24 @@ pub(super) struct Word {
 }
 
 /// Splits the source into logical lines.
-pub(super) struct Lexer<'a> {
-    lines: core::iter::Enumerate<core::str::Lines<'a>>,
-    /// Position just past the last character of the source (for errors at end of file).
-    eof: SrcPos,
+pub(super) struct Lexer<S> {
+    lines: S,
     /// Skip lines that start with `/` (else the `/` is dropped).
     block_delete: bool,
 }
 
-impl<'a> Lexer<'a> {
-    pub fn new(src: &'a str, block_delete: bool) -> Self {
-        let (count, last) = src.lines().enumerate().last().unwrap_or((0, ""));
-        let eof = SrcPos {
-            line: to_u32(count + 1),
-            col: to_u32(last.chars().count() + 1),
-        };
+impl<S: LineSource> Lexer<S> {
+    pub fn new(lines: S, block_delete: bool) -> Self {
         Lexer {
-            lines: src.lines().enumerate(),
-            eof,
+            lines,
             block_delete,
         }
     }
 
+    /// Position just past the last character of the source (for errors at end of file),
+    /// once the source is read to its end.
     pub fn eof(&self) -> SrcPos {
-        self.eof
+        self.lines.eof()
     }
 
     /// Reads the next logical line into `words` (cleared first). Returns `false` at the end
@@ -53,13 +48,13 @@ impl<'a> Lexer<'a> {
         words.clear();
         let mut continued_at: Option<SrcPos> = None;
         loop {
-            let Some((index, text)) = self.lines.next() else {
+            let Some(next) = self.lines.next_line() else {
                 return match continued_at {
                     Some(pos) => Err(ParseErrorKind::ContinuationAtEof.at(pos)),
                     None => Ok(false),
                 };
             };
-            let line = to_u32(index + 1);
+            let (line, text) = next?;
             if continued_at.is_none() && text.trim() == "%" {
                 return Ok(true);
             }
@@ -189,9 +184,4 @@ pub const fn word_limit(letter: char) -> f64 {
         'A' | 'B' | 'C' | 'F' | 'R' => 1e6,
         _ => f64::MAX,
     }
-}
-
-/// Line and column numbers saturate instead of overflowing on absurdly large inputs.
-fn to_u32(n: usize) -> u32 {
-    u32::try_from(n).unwrap_or(u32::MAX)
 }

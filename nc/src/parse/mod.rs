@@ -81,6 +81,8 @@ mod modal;
 mod moves;
 mod nurbs;
 mod parser;
+mod source;
+mod stream;
 #[cfg(test)]
 mod tests;
 
@@ -90,6 +92,8 @@ pub use error::{Context, Motion, ParseError, ParseErrorKind};
 pub use lexer::word_limit;
 pub use modal::{Setup, MAX_DWELL_S, MAX_ERRORS, MM_PER_INCH};
 pub use parser::{MIN_FEED_MM_MIN, MIN_WEIGHT};
+pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
+pub use stream::{Entries, Entry};
 
 use crate::program::Program;
 
@@ -128,40 +132,34 @@ pub fn parse(src: &str) -> Result<Program, ParseError> {
 /// [`MAX_ERRORS`]). After an error the line is skipped (a NURBS block with it), so later
 /// errors may follow from the first one.
 pub fn parse_with(src: &str, setup: &Setup) -> Result<Program, ParseErrors> {
-    let mut lexer = lexer::Lexer::new(src, setup.block_delete);
-    let mut parser = parser::Parser::new(setup);
-    let mut words = Vec::new();
+    parse_lines(StrLines::new(src), setup)
+}
+
+/// [`parse_with`] from any source of lines ([`ReadLines`] reads a file as it goes).
+pub fn parse_lines<S: LineSource>(lines: S, setup: &Setup) -> Result<Program, ParseErrors> {
+    let mut entries = Entries::new(lines, setup);
+    let mut program = Program::default();
     let mut errors = Vec::new();
-    loop {
-        if errors.len() >= MAX_ERRORS {
-            return Err(ParseErrors { errors, more: true });
-        }
-        match lexer.next_line(&mut words) {
-            Ok(false) => break,
-            Ok(true) => {
-                if let Err(e) = parser.line(&words) {
-                    errors.push(e);
-                    parser.recover();
-                }
-            }
+    while let Some(entry) = entries.next() {
+        match entry {
+            Ok(Entry::Block(_, block)) => program.blocks.push(block),
+            Ok(Entry::Action(action)) => program.actions.push(action),
             Err(e) => {
                 errors.push(e);
-                parser.recover();
+                if errors.len() >= MAX_ERRORS {
+                    let more = !entries.is_finished();
+                    return Err(ParseErrors { errors, more });
+                }
             }
         }
     }
-    match parser.finish(lexer.eof()) {
-        Ok(program) if errors.is_empty() => Ok(program),
-        Ok(_) => Err(ParseErrors {
+    if !errors.is_empty() {
+        return Err(ParseErrors {
             errors,
             more: false,
-        }),
-        Err(e) => {
-            errors.push(e);
-            Err(ParseErrors {
-                errors,
-                more: false,
-            })
-        }
+        });
     }
+    program.end = entries.end();
+    program.tilt_word = entries.tilt_word();
+    Ok(program)
 }

@@ -11,8 +11,8 @@ use super::line::{Line, MOVE_WORDS};
 use super::modal::{Modal, Setup, MAX_DWELL_S};
 use super::nurbs::{Frame, OpenNurbs};
 use crate::program::{
-    Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation,
-    Program, SrcPos, Wait,
+    Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation, SrcPos,
+    Wait,
 };
 
 /// Tool-vector length below which `I J K` is rejected (it has no direction).
@@ -30,8 +30,11 @@ const MAX_RPM: f64 = 1e6;
 pub(super) struct Parser<'s> {
     pub setup: &'s Setup,
     pub modal: Modal,
+    /// Blocks and actions not yet taken by [`super::stream::Entries`].
     pub blocks: Vec<Block>,
     pub actions: Vec<Action>,
+    /// Blocks taken out of `blocks` so far.
+    pub drained: usize,
     /// Modal motion mode (G00 G01 G02 G03; NURBS modes are not modal).
     pub mode: Option<Motion>,
     /// Modal feed, mm/min (`G94`).
@@ -64,6 +67,7 @@ impl<'s> Parser<'s> {
             modal,
             blocks: Vec::new(),
             actions: Vec::new(),
+            drained: 0,
             mode: None,
             feed: None,
             here: None,
@@ -159,17 +163,17 @@ impl<'s> Parser<'s> {
         matches!(line.code_of_group(1), Some((Code::Dwell, _)))
     }
 
-    /// Ends the program: fails if a NURBS block is still open at `eof`.
-    pub fn finish(self, eof: SrcPos) -> Result<Program, ParseError> {
+    /// At the end of the source: fails if a NURBS block is still open at `eof`.
+    pub fn check_end(&self, eof: SrcPos) -> Result<(), ParseError> {
         match &self.open {
             Some(open) => Err(open.incomplete(eof)),
-            None => Ok(Program {
-                blocks: self.blocks,
-                end: self.end,
-                actions: self.actions,
-                tilt_word: self.rotary,
-            }),
+            None => Ok(()),
         }
+    }
+
+    /// Where `M02`/`M30` stood, if read.
+    pub fn end(&self) -> Option<SrcPos> {
+        self.end
     }
 
     /// The modal codes of a line other than motion and stops. `motion` is the line's
@@ -372,7 +376,7 @@ impl<'s> Parser<'s> {
     pub(super) fn act(&mut self, pos: SrcPos, kind: ActionKind) {
         self.actions.push(Action {
             pos,
-            before_block: self.blocks.len(),
+            before_block: self.drained + self.blocks.len(),
             kind,
         });
     }

@@ -8,8 +8,10 @@ use super::PAPER;
 use crate::parse::parse;
 use crate::program::{Block, MAX_CTRL};
 
-/// Checks the result of parsing `src` beyond "did not panic".
+/// Checks the result of parsing `src` beyond "did not panic", and that streaming gives
+/// the same (see `source.rs`).
 fn check(src: &str) {
+    super::source::streams_alike(src);
     match parse(src) {
         Ok(program) => {
             for block in &program.blocks {

@@ -1,9 +1,11 @@
 //! Parser tests: the programs in `tests/data`, accepted syntax, modal resolution (here), one
-//! test per error rule (`errors`) and the no-panic property tests (`fuzz`).
+//! test per error rule (`errors`), the no-panic property tests (`fuzz`) and reading as a
+//! stream (`source`).
 
 mod errors;
 mod fuzz;
 mod posts;
+mod source;
 
 use super::parse;
 use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};
