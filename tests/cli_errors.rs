@@ -24,43 +24,47 @@ fn block(degree: &str, weight3: &str, knots: [&str; 9]) -> String {
 
 const GOOD_K: [&str; 9] = ["0", "0", "0", "0", "0.5046", "1", "1", "1", "1"];
 
+/// `simulate` and the pre-pass (`check`) both refuse `program` at `want_pos` with
+/// `want_text`, exit 2 and print nothing on standard output.
 fn check(name: &str, program: &str, want_pos: &str, want_text: &str) {
     let path = temp(&format!("{name}.nc"));
     std::fs::write(&path, program).unwrap();
     let mach = machine("paper-ac-table.toml");
-    let out = dnurbs(&[
-        "simulate",
-        path.to_str().unwrap(),
-        "--machine",
-        mach.to_str().unwrap(),
-    ]);
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    for command in ["simulate", "check"] {
+        let out = dnurbs(&[
+            command,
+            path.to_str().unwrap(),
+            "--machine",
+            mach.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{command} {name}: exit {:?}, stderr {stderr}",
+            out.status.code()
+        );
+        // `want_pos` is `line:col`, or just `line` where the column is pinned by the
+        // parser's own unit tests; a column must be there either way.
+        let prefix = if want_pos.contains(':') {
+            format!("{}:{want_pos}: ", path.display())
+        } else {
+            format!("{}:{want_pos}:", path.display())
+        };
+        assert!(
+            stderr.contains(&prefix),
+            "{command} {name}: expected `{prefix}` in\n{stderr}"
+        );
+        assert!(
+            stderr.contains(want_text),
+            "{command} {name}: expected `{want_text}` in\n{stderr}"
+        );
+        assert!(
+            out.stdout.is_empty(),
+            "{command} {name}: printed a summary despite the error"
+        );
+    }
     let _ = std::fs::remove_file(&path);
-    assert_eq!(
-        out.status.code(),
-        Some(2),
-        "{name}: exit {:?}, stderr {stderr}",
-        out.status.code()
-    );
-    // `want_pos` is `line:col`, or just `line` where the column is pinned by the parser's
-    // own unit tests; a column must be there either way.
-    let prefix = if want_pos.contains(':') {
-        format!("{}:{want_pos}: ", path.display())
-    } else {
-        format!("{}:{want_pos}:", path.display())
-    };
-    assert!(
-        stderr.contains(&prefix),
-        "{name}: expected `{prefix}` in\n{stderr}"
-    );
-    assert!(
-        stderr.contains(want_text),
-        "{name}: expected `{want_text}` in\n{stderr}"
-    );
-    assert!(
-        out.stdout.is_empty(),
-        "{name}: printed a summary despite the error"
-    );
 }
 
 #[test]
@@ -386,4 +390,38 @@ fn angle_words_for_another_machine_are_refused() {
         "2:9",
         "tilting axis is A",
     );
+}
+
+#[test]
+fn the_pre_pass_passes_the_examples_and_refuses_a_point_outside_the_travel() {
+    let mach = machine("paper-ac-table.toml");
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/paper-example.nc"
+    );
+    let out = dnurbs(&["check", example, "--machine", mach.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}");
+    assert!(
+        stdout.contains("23 lines, 2 motion blocks, 1 segments"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("lines/s"), "{stdout}");
+    // X400 on a machine whose X travel is +-300: refused at its block, before any plan.
+    let path = temp("x400.nc");
+    std::fs::write(&path, "G00 X0 Y0 Z10\nG01 X100 F500\n  G01 X400\nM30\n").unwrap();
+    let out = dnurbs(&[
+        "check",
+        path.to_str().unwrap(),
+        "--machine",
+        mach.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    let want = format!(
+        "{}:3:3: the programmed point puts the X axis at 400.0000 mm, outside its travel -300 .. 300 mm",
+        path.display()
+    );
+    assert!(stderr.contains(&want), "expected `{want}` in\n{stderr}");
 }

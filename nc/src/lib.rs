@@ -11,6 +11,9 @@
 //!                       -> tool axis -> A/C and machine XYZ (kinematics) -> Setpoint
 //! ```
 //!
+//! `parse::Entries` and `segment::Builder` do the first two steps a line and a block at a
+//! time, for a program of any length (`prepass` checks one that way before anything moves).
+//!
 //! Everything left of `step` runs outside the real-time thread and may allocate; `step`
 //! itself allocates nothing (proved by `tests/no_alloc.rs`) and has bounded loops.
 #![forbid(unsafe_code)]
@@ -23,6 +26,7 @@ pub mod kinematics;
 pub mod nurbs;
 pub mod parse;
 pub mod plan;
+pub mod prepass;
 pub mod program;
 pub mod scurve;
 pub mod segment;

@@ -17,6 +17,7 @@ use nalgebra::Vector3;
 use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::{Kinematics, MachineKinematics};
 use nc::plan::{plan, PlanConfig};
+use nc::prepass::Refused;
 use nc::segment::{build, BuildLimits, Geometry, Path};
 use proptest::prelude::*;
 use std::fmt::Write;
@@ -415,6 +416,8 @@ struct Counts {
     /// Accepted programs with an arc that turns the tool (`A C` words).
     turning_arcs: AtomicU64,
     refused: AtomicU64,
+    /// Programs the pre-pass refused for a programmed point outside the travel.
+    prepass_travel: AtomicU64,
     long: AtomicU64,
     /// Accepted programs run through the follower with a stop, a pause, an override change,
     /// a slow planner ([`hold::Event`]).
@@ -515,18 +518,61 @@ fn check(src: &str, counts: &Counts) -> Result<(), TestCaseError> {
 /// [`check`] with the hold event given.
 fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCaseError> {
     let (cfg, bl, kin) = machine();
+    // The pre-pass, over the same text as a stream: it refuses what parse and build refuse,
+    // with the same first error (or a programmed point outside the travel before it), and
+    // whatever it refuses for travel the planner refuses too.
+    let pre = nc::prepass::check(
+        nc::parse::StrLines::new(src),
+        &nc::parse::Setup::default(),
+        &kin,
+        &bl,
+        &cfg.travel,
+    );
+    let travel_before =
+        |line: u32| matches!(&pre, Err(Refused::Travel { pos, .. }) if pos.line <= line);
     let program = match nc::parse::parse(src) {
         Ok(p) => p,
-        Err(e) => return refused("parse", e.pos.line, &e, src, counts),
+        Err(e) => {
+            let first = match &pre {
+                Err(Refused::Parse(p)) => p.first().copied(),
+                _ => None,
+            };
+            prop_assert_eq!(first, Some(e), "the pre-pass: {:?}", pre);
+            return refused("parse", e.pos.line, &e, src, counts);
+        }
     };
     let path = match build(&program, &kin, &bl) {
         Ok(p) => p,
-        Err(e) => return refused("build", e.pos.line, &e, src, counts),
+        Err(e) => {
+            let same = matches!(&pre, Err(Refused::Build(b)) if *b == e);
+            prop_assert!(
+                same || travel_before(e.pos.line),
+                "the pre-pass: {:?} for {}",
+                pre,
+                e
+            );
+            return refused("build", e.pos.line, &e, src, counts);
+        }
     };
+    prop_assert!(
+        matches!(pre, Ok(_) | Err(Refused::Travel { .. })),
+        "the pre-pass: {:?}",
+        pre
+    );
     let profile = match plan(&path, &kin, &cfg) {
         Ok(p) => p,
-        Err(e) => return refused("plan", e.pos.line, &e, src, counts),
+        Err(e) => {
+            if pre.is_err() {
+                counts.prepass_travel.fetch_add(1, Ordering::Relaxed);
+            }
+            return refused("plan", e.pos.line, &e, src, counts);
+        }
     };
+    prop_assert!(
+        pre.is_ok(),
+        "the planner accepts what the pre-pass refused: {:?}",
+        pre
+    );
     if profile.duration / PERIOD > MAX_TEST_CYCLES {
         counts.long.fetch_add(1, Ordering::Relaxed);
         return Ok(());
@@ -651,12 +697,13 @@ fn run_half(half: u64, cases: u32) {
         counts.refused.load(Ordering::Relaxed),
         counts.long.load(Ordering::Relaxed),
     );
+    let pre = counts.prepass_travel.load(Ordering::Relaxed);
     let held: Vec<u64> = counts
         .held
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}), refused with a position {refd}, too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
     if let Err(e) = result {
         panic!("{e}");
     }

@@ -146,6 +146,29 @@ pub enum Command {
         #[command(flatten)]
         shop: crate::shop::ShopArgs,
     },
+    /// Check a program before anything moves, without planning it (the pre-pass).
+    ///
+    /// Reads the program as a stream, in the memory of one line whatever its length, and
+    /// checks every rule of the NC language (every error, up to 50), the geometry the
+    /// builder checks (NURBS tool vectors, tool-axis steps, angle words for the machine),
+    /// and that the machine's axes at every programmed point (the start pose and the end
+    /// of every block, through the machine's kinematics) lie within their travel. Not
+    /// checked: the feeds, and the path between programmed points (a curve's bulge, an
+    /// arc), against the axis limits: `dnurbs simulate` plans them. Prints the lines read
+    /// per second.
+    #[command(after_help = crate::exit::TABLE)]
+    Check {
+        /// NC program.
+        program: PathBuf,
+        /// Machine file (TOML), e.g. config/machines/paper-ac-table.toml.
+        #[arg(long, short)]
+        machine: PathBuf,
+        /// Print the result as one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+        #[command(flatten)]
+        shop: crate::shop::ShopArgs,
+    },
     /// Simulate a machine's drives on a CAN interface (tests without hardware).
     ///
     /// Boot-up, NMT slave, SDO server, PDO mapping, CiA-402 state machine, CSP motor model,

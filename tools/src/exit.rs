@@ -85,6 +85,13 @@ pub enum InputError {
         file: String,
         error: nc::plan::ProgramError,
     },
+    /// Refused by the pre-pass (`dnurbs check`): geometry or a programmed point outside
+    /// the travel.
+    #[error("{file}:{error}")]
+    Checked {
+        file: String,
+        error: nc::prepass::Refused,
+    },
     #[error(transparent)]
     Machine(#[from] config::ConfigError),
     /// The machine file is valid but cannot serve this command (no drive for an axis,

@@ -2,11 +2,13 @@
 //! kind picks the exit code ([`crate::exit`]).
 //!
 //! * [`offline`]: `simulate`, `compare`, `busload` (no bus, no real time);
+//! * [`check`]: `check` (the pre-pass alone);
 //! * [`fit`]: `fit` (G01 runs into G06.5 blocks);
 //! * [`machine`]: `run` and `demo` (drives, real-time thread, report);
 //! * [`latency`]: `latency` (the real-time loop alone);
 //! * [`ctl`]: `ctl` (the client of a run's control socket).
 
+pub mod check;
 pub mod ctl;
 pub mod fit;
 pub mod latency;
@@ -59,6 +61,12 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             json,
             &shop,
         ),
+        Command::Check {
+            program,
+            machine,
+            json,
+            shop,
+        } => check::check(&program, &machine, json, &shop),
         Command::Compare {
             programs,
             machine,

@@ -1,0 +1,115 @@
+//! The pre-pass (`dnurbs check`, `nc::prepass`) over long programs: lines read per second
+//! and the process's peak resident memory, per size. A wiggly G01 path of 0.05 mm moves
+//! (the bench `linear`'s, as `nc::fixtures::g01_program` writes it: `N`, `X Y Z`, `I J K`)
+//! is written to a file in the temporary directory line by line, then read back through
+//! the pre-pass on the paper machine. The peak is reset before each size
+//! (`/proc/self/clear_refs`), so it is the pre-pass's own; it should not grow with the
+//! program, and the time should grow as the program (10x the lines, at most 11x the time).
+//!
+//! Run: `cargo bench -p dnurbs-tools --bench prepass` (10^5 and 10^6 moves);
+//! `BENCH_MOVES=100000,1000000,10000000` for 10^7 (a 700 MB file, deleted afterwards).
+
+use dnurbs_tools::setup::MachineSetup;
+use nc::parse::{ReadLines, Setup};
+use std::io::{BufWriter, Write};
+use std::time::Instant;
+
+const MACHINE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../config/machines/paper-ac-table.toml"
+);
+
+/// Writes n moves of 0.05 mm along a sine in XY, in rows of 580 mm inside the paper
+/// machine's travel, as `g01_program` would (the bench `linear`'s path up to 10^6 moves;
+/// beyond, its rows would leave the travel, so they start over).
+fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
+    let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
+    w.write_all(b"%\nG90 G21 G94\n")?;
+    for k in 0..=n {
+        let d = k as f64 * 0.05;
+        let x = -290.0 + d % 580.0;
+        // Rows 2 mm apart, starting over after 120 rows (240 mm: the Y travel is +-250).
+        let y = 2.0 * ((d / 580.0).floor() % 120.0) + 0.5 * (x / 2.0).sin();
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 { " F3000" } else { "" };
+        writeln!(
+            w,
+            "N{} {g}X{x:.4} Y{y:.4} Z{:.4} I{:.6} J{:.6} K{:.6}{f}",
+            10 * (k + 1),
+            0.0,
+            0.0,
+            0.0,
+            1.0
+        )?;
+    }
+    w.write_all(b"M30\n%\n")?;
+    w.flush()
+}
+
+/// The process's peak resident memory since the last reset (VmHWM), in MB.
+fn peak_mb() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
+    if !std::env::args().any(|a| a == "--bench") {
+        return;
+    }
+    let sizes: Vec<usize> = std::env::var("BENCH_MOVES")
+        .unwrap_or_else(|_| "100000,1000000".into())
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse()
+                .expect("BENCH_MOVES: sizes separated by commas")
+        })
+        .collect();
+    let machine = config::load(std::path::Path::new(MACHINE)).expect("the paper machine loads");
+    let setup = MachineSetup::new(&machine);
+    println!("the pre-pass on {} sizes, paper-ac-table:", sizes.len());
+    let mut before: Option<(usize, f64)> = None;
+    for &n in &sizes {
+        let path =
+            std::env::temp_dir().join(format!("dnurbs-prepass-{}-{n}.nc", std::process::id()));
+        write_wiggle(&path, n).expect("the program is written");
+        let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+        // Reset the peak: what follows is the pre-pass's alone.
+        let _ = std::fs::write("/proc/self/clear_refs", "5");
+        let clock = Instant::now();
+        let file = std::fs::File::open(&path).expect("the program opens");
+        let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file));
+        let passed = nc::prepass::check(
+            lines,
+            &Setup::default(),
+            &setup.kin,
+            &setup.build,
+            &setup.plan.travel,
+        )
+        .expect("the wiggle passes");
+        let secs = clock.elapsed().as_secs_f64();
+        let peak = peak_mb();
+        let _ = std::fs::remove_file(&path);
+        assert_eq!(passed.blocks, n + 1, "every move is read");
+        print!(
+            "{n:>9} moves ({:.0} MB, {} lines): {secs:.3} s, {:.2} M lines/s, peak resident {peak:.1} MB",
+            bytes as f64 / 1e6,
+            passed.lines,
+            f64::from(passed.lines) / secs / 1e6
+        );
+        if let Some((m, t)) = before {
+            print!(
+                " ({:.1}x the time for {:.0}x)",
+                secs / t,
+                n as f64 / m as f64
+            );
+        }
+        println!();
+        before = Some((n, secs));
+    }
+}
