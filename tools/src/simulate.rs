@@ -171,10 +171,16 @@ struct BlockSegs<'a> {
 }
 
 impl<'a> BlockSegs<'a> {
-    fn index(path: &'a Path) -> HashMap<u32, BlockSegs<'a>> {
-        let mut map: HashMap<u32, BlockSegs<'a>> = HashMap::new();
+    /// Indexed by block number (blocks are numbered from 1 in program order, so the
+    /// setpoints walk it in order: no hashing, no cache miss per setpoint).
+    fn index(path: &'a Path) -> Vec<BlockSegs<'a>> {
+        let n = path.segments.iter().map(|s| s.block as usize + 1).max();
+        let mut map: Vec<BlockSegs<'a>> = Vec::new();
+        map.resize_with(n.unwrap_or(0), BlockSegs::default);
         for s in &path.segments {
-            let b = map.entry(s.block).or_default();
+            let Some(b) = map.get_mut(s.block as usize) else {
+                continue;
+            };
             match s.nurbs() {
                 Some((c, _)) => b.pieces.push(c),
                 None if s.rotary_only => b.turns = true,
@@ -214,7 +220,7 @@ pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
     // (no u) belong to the block's straight move.
     let index = BlockSegs::index(&run.path);
     let none = BlockSegs::default();
-    let seg_of = |block: u32| index.get(&block).unwrap_or(&none);
+    let seg_of = |block: u32| index.get(block as usize).unwrap_or(&none);
     let (mut fmax, mut fsq, mut fn_) = (0.0f64, 0.0f64, 0u64);
     let mut chord = 0.0f64;
     for w in sps.windows(2) {
