@@ -126,6 +126,46 @@ impl FeedProfile {
         let mut i = self.phases.partition_point(|p| p.t0 <= t).saturating_sub(1);
         self.at(t, &mut i)
     }
+
+    /// The phases over times `lo..=hi`, for many random accesses there: each searches
+    /// those phases alone, not the whole plan's (a search over millions of phases per
+    /// access missed the cache at every step and made the check n log n).
+    pub fn near(&self, lo: f64, hi: f64) -> Near<'_> {
+        let i0 = self
+            .phases
+            .partition_point(|p| p.t0 <= lo)
+            .saturating_sub(1);
+        let i1 = self.phases.partition_point(|p| p.t0 <= hi);
+        Near {
+            profile: self,
+            i0,
+            i1: i1.max(i0),
+            lo,
+            hi,
+        }
+    }
+}
+
+/// [`FeedProfile::near`].
+pub struct Near<'a> {
+    profile: &'a FeedProfile,
+    i0: usize,
+    i1: usize,
+    lo: f64,
+    hi: f64,
+}
+
+impl Near<'_> {
+    /// [`FeedProfile::motion_at`], the same to the bit: no phase before `i0` starts after
+    /// `lo`, none from `i1` on starts before `hi`.
+    pub fn motion_at(&self, t: f64) -> Motion {
+        if !(t >= self.lo && t <= self.hi) {
+            return self.profile.motion_at(t);
+        }
+        let local = self.profile.phases[self.i0..self.i1].partition_point(|p| p.t0 <= t);
+        let mut i = (self.i0 + local).saturating_sub(1);
+        self.profile.at(t, &mut i)
+    }
 }
 
 fn joint_derivatives(q: &[Joints], h: f64, i: usize) -> ([f64; 5], [f64; 5]) {
@@ -674,8 +714,14 @@ fn schedule(
 ) -> Option<Vec<Phase>> {
     // Critical points: (station index, speed).
     let mut crit: Vec<(usize, f64)> = vec![(from, v0)];
+    // The joints walked in step with the stations (a search per station over the whole
+    // program's joints made the plan n log n).
+    let mut joint = starts.partition_point(|&x| x <= from);
     for i in from + 1..last {
-        let is_joint = starts.binary_search(&i).is_ok();
+        while starts.get(joint).is_some_and(|&x| x < i) {
+            joint += 1;
+        }
+        let is_joint = starts.get(joint) == Some(&i);
         let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
         if is_joint || is_min {
             crit.push((i, st[i].vlim));

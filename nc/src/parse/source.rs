@@ -2,9 +2,9 @@
 //! reader, one line at a time ([`ReadLines`]), so a program of any length is parsed in the
 //! memory of its longest line.
 //!
-//! Both give the same lines: split at `\n` or `\r\n`, the ending dropped, numbered from 1;
-//! a leading byte-order mark is dropped by the reader (a `&str` has none by then). A line
-//! over [`MAX_LINE_BYTES`] is an error in both, so neither reads without bound.
+//! Both give the same lines: split at `\n` or `\r\n`, the ending dropped, numbered from 1,
+//! a byte-order mark at the very start dropped (columns count from after it). A line over
+//! [`MAX_LINE_BYTES`] is an error in both, so neither reads without bound.
 
 use super::error::{ParseError, ParseErrorKind};
 use crate::program::SrcPos;
@@ -62,8 +62,11 @@ impl LineSource for StrLines<'_> {
         if self.failed {
             return None;
         }
-        let text = self.lines.next()?;
+        let mut text = self.lines.next()?;
         self.count += 1;
+        if self.count == 1 {
+            text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        }
         self.last = text;
         if text.len() >= MAX_LINE_BYTES {
             self.failed = true;

@@ -59,18 +59,19 @@ pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
     if hi.partial_cmp(&lo) != Some(core::cmp::Ordering::Greater) {
         return None;
     }
+    let ts = ctx.cfg.period;
+    let near = profile.near(lo - 4.0 * ts, hi + 4.0 * ts);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if profile.motion_at(mid).s < s_j {
+        if near.motion_at(mid).s < s_j {
             lo = mid;
         } else {
             hi = mid;
         }
     }
-    let ts = ctx.cfg.period;
-    let before = joints_at(ctx, profile.motion_at(hi - ts).s, &w[1].q)?;
+    let before = joints_at(ctx, near.motion_at(hi - ts).s, &w[1].q)?;
     let on = joints_at(ctx, s_j, &w[1].q)?;
-    let after = joints_at(ctx, profile.motion_at(hi + ts).s, &w[2].q)?;
+    let after = joints_at(ctx, near.motion_at(hi + ts).s, &w[2].q)?;
     // A side is one-sided only if no other kink lies within its three periods.
     let kink_between = |s0: f64, s1: f64| {
         let seg = |s: f64| profile.seg_start.partition_point(|&x| x <= s);
@@ -78,13 +79,13 @@ pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
         (a..b).any(|i| i != k && !smooth.get(i).copied().unwrap_or(false))
     };
     let side = |dir: f64| -> Option<Side> {
-        let s3 = profile.motion_at(hi + dir * 3.0 * ts).s;
+        let s3 = near.motion_at(hi + dir * 3.0 * ts).s;
         if kink_between(s_j, s3) {
             return None;
         }
         let (mut prev, mut q, mut v) = (on, [on; 4], 0.0f64);
         for (i, x) in q.iter_mut().enumerate() {
-            let m = profile.motion_at(hi + dir * i as f64 * ts);
+            let m = near.motion_at(hi + dir * i as f64 * ts);
             v = v.max(m.v);
             if i > 0 {
                 prev = joints_at(ctx, m.s, &prev)?;
@@ -104,7 +105,7 @@ pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
         q: [before, on, after],
         sides: [side(-1.0), side(1.0)],
         s: s_j,
-        v: profile.motion_at(hi).v,
+        v: near.motion_at(hi).v,
     })
 }
 
