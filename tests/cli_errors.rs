@@ -224,8 +224,17 @@ fn bad_machine_files_and_missing_files_exit_2() {
 #[test]
 fn degenerate_programs_are_errors_or_stand_still_never_panics() {
     // A NURBS block whose control points all coincide has no length.
-    let dot = "G01 X1 Y2 Z3 F100\nG06.2 P2 K0 X1 Y2 Z3\nK0 X1 Y2 Z3\nK1 X1 Y2 Z3\nK1 K1\n";
+    let dot = "G01 X1 Y2 Z3 F100\nG06.2 P2 K0 X1 Y2 Z3\nK0 X1 Y2 Z3\nK0.5 X1 Y2 Z3\nK1 K1\n";
     check("zero-length-nurbs", dot, "2:1", "has length");
+    // An end knot repeated past degree + 1 leaves an empty span: refused with the knot,
+    // not evaluated (it once gave NaN, reported as a position outside the travel).
+    let knots = "G01 X0 Y0 Z0 F100\nG06.2 P2 K0 X0 Y0 Z0\nK0 X1 Y2 Z3\nK1 X2 Y0 Z3\nK1 K1\n";
+    check(
+        "end-knot-thrice",
+        knots,
+        "2:1",
+        "end knot 1 is repeated 3 times",
+    );
     // A program that is only its start pose: one setpoint, at rest, exit 0.
     let path = temp("start-only.nc");
     std::fs::write(&path, "G01 X1 Y2 Z3 F100\nM30\n").unwrap();

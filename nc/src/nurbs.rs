@@ -53,6 +53,12 @@ pub enum CurveError {
         mult: usize,
         degree: usize,
     },
+    #[error("the end knot {knot} is repeated {mult} times: a clamped curve of degree {degree} repeats it exactly {} times, a control point past them would have no span", degree + 1)]
+    EndKnots {
+        knot: f64,
+        mult: usize,
+        degree: usize,
+    },
 }
 
 /// Largest ratio of the weights within one block: beyond it the curve's parametric speed
@@ -121,6 +127,18 @@ pub(crate) fn validate_net(
         && knots[n + degree] - knots[0] > 1e-9 * knots[0].abs().max(knots[n + degree].abs());
     if !ok {
         return Err(CurveError::Knots);
+    }
+    // Clamped means exactly degree + 1 at each end: one more leaves an empty first or last
+    // span, where A2.3 divides 0 by 0 (measured: NaN at the block's start, then reported
+    // as a travel error).
+    let (first, last) = (knots[0], knots[n + degree]);
+    for (knot, mult) in [
+        (first, knots.iter().take_while(|&&k| k == first).count()),
+        (last, knots.iter().rev().take_while(|&&k| k == last).count()),
+    ] {
+        if mult > degree + 1 {
+            return Err(CurveError::EndKnots { knot, mult, degree });
+        }
     }
     // An interior knot repeated more than the degree breaks the curve in two.
     let mut i = degree + 1;
@@ -437,6 +455,25 @@ pub(crate) mod tests {
             Err(CurveError::Discontinuous {
                 knot: 0.5,
                 mult: 3,
+                degree: 2
+            })
+        );
+        // One more knot at either end: an empty first or last span.
+        let k = [0.0, 0.0, 0.0, 0.0, 0.5, 0.7, 1.0, 1.0, 1.0];
+        assert_eq!(
+            DoubleNurbs::new(2, &c, &[], &[1.0; 6], &k),
+            Err(CurveError::EndKnots {
+                knot: 0.0,
+                mult: 4,
+                degree: 2
+            })
+        );
+        let k = [0.0, 0.0, 0.0, 0.3, 0.5, 1.0, 1.0, 1.0, 1.0];
+        assert_eq!(
+            DoubleNurbs::new(2, &c, &[], &[1.0; 6], &k),
+            Err(CurveError::EndKnots {
+                knot: 1.0,
+                mult: 4,
                 degree: 2
             })
         );
