@@ -19,6 +19,7 @@
 #![forbid(unsafe_code)]
 
 pub mod arclen;
+pub mod bezier;
 pub mod fit;
 pub mod fixtures;
 pub mod interp;

@@ -243,6 +243,11 @@ impl DoubleNurbs {
         &self.knots
     }
 
+    /// The homogeneous cutter control points (w x, w y, w z, w).
+    pub(crate) fn cutter_net(&self) -> &[Vector4<f64>] {
+        &self.cw
+    }
+
     /// Parameter range [u_min, u_max].
     pub fn range(&self) -> (f64, f64) {
         let k = &self.knots;
