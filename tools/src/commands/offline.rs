@@ -3,10 +3,14 @@
 use crate::exit::{InputError, Outcome};
 use crate::setup::MachineSetup;
 use crate::shop::{parse_setup, ShopArgs};
-use crate::simulate::{run, summarize, write_trace};
+use crate::simulate::{
+    each_setpoint, run, summarize, write_trace_header, write_trace_row, Summarizer,
+};
 use crate::{load_machine, load_program};
 use anyhow::Context;
 use nc::interp::Method;
+use nc::plan::{plan, ProgramError};
+use nc::segment::build;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -27,22 +31,41 @@ pub fn simulate(
     let setup = MachineSetup::new(&machine).with_compress(shop.compress);
     let (prog, compressed) = setup.prepare(prog);
     let method = method.unwrap_or(setup.method);
-    let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
-    if let Some(path) = &trace {
-        let file = std::fs::File::create(path)
-            .with_context(|| format!("{}: cannot create the trace", path.display()))?;
-        let mut w = std::io::BufWriter::new(file);
-        write_trace(&mut w, &result.setpoints)
+    let refused = |e: ProgramError| InputError::program(program, e);
+    let path = build(&prog, &setup.kin, &setup.build).map_err(|e| refused(e.into()))?;
+    let profile = plan(&path, &setup.kin, &setup.plan).map_err(|e| refused(e.into()))?;
+    // The setpoints go to the summary (and the trace) as they are made: none is kept.
+    let mut trace = match &trace {
+        Some(file) => {
+            let f = std::fs::File::create(file)
+                .with_context(|| format!("{}: cannot create the trace", file.display()))?;
+            let mut w = std::io::BufWriter::new(f);
+            write_trace_header(&mut w)
+                .with_context(|| format!("{}: cannot write the trace", file.display()))?;
+            Some((file, w, Ok(())))
+        }
+        None => None,
+    };
+    let mut summarizer = Summarizer::new(&path, &setup);
+    each_setpoint(&path, &profile, &setup, method, |sp| {
+        summarizer.push(sp);
+        if let Some((_, w, result @ Ok(()))) = &mut trace {
+            *result = write_trace_row(w, sp);
+        }
+    })
+    .map_err(refused)?;
+    if let Some((file, mut w, result)) = trace {
+        result
             .and_then(|_| w.flush())
-            .with_context(|| format!("{}: cannot write the trace", path.display()))?;
+            .with_context(|| format!("{}: cannot write the trace", file.display()))?;
     }
-    let mut summary = summarize(&result, &setup, prog.blocks.len());
+    let mut summary = summarizer.finish(&profile, method, prog.blocks.len());
     summary.program_words = crate::words::describe(&prog);
     summary.compressed = compressed.map(crate::simulate::Compression::from);
     summary.spindle_waits = machine
         .spindle
         .as_ref()
-        .map(|s| crate::simulate::SpindleWaits::of(&result.path, s.acceleration_rpm_s));
+        .map(|s| crate::simulate::SpindleWaits::of(&path, s.acceleration_rpm_s));
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
