@@ -474,7 +474,7 @@ pub enum PlanErrorKind {
         max: f64,
         t: f64,
     },
-    #[error("the rotary axes would change solution in one period at t = {t:.3} s, for the same tool axis: {tilt} {from_tilt:.3} -> {to_tilt:.3} deg, C {from_c:.3} -> {to_c:.3} deg; following the tool axis on would leave the travel of {tilt} ({tilt_min} .. {tilt_max} deg) or C ({c_min} .. {c_max} deg)")]
+    #[error("the rotary axes would change solution in one period at t = {t:.3} s, for the same tool axis: {tilt} {from_tilt:.3} -> {to_tilt:.3} deg, C {from_c:.3} -> {to_c:.3} deg; following the tool axis on would leave the travel of {tilt} ({}) or C ({})", travel(*.tilt_min, *.tilt_max, "deg"), travel(*.c_min, *.c_max, "deg"))]
     Branch {
         tilt: char,
         from_tilt: f64,
@@ -500,6 +500,17 @@ pub enum PlanErrorKind {
         path_unit: &'static str,
         hint: &'static str,
     },
+}
+
+/// An axis's travel for a message: an axis without limits (a C that turns endlessly has
+/// -inf .. inf) says so, not "-inf .. inf".
+pub(crate) fn travel(min: f64, max: f64, unit: &str) -> String {
+    match (min.is_finite(), max.is_finite()) {
+        (true, true) => format!("{min} .. {max} {unit}"),
+        (true, false) => format!("from {min} {unit}, no upper limit"),
+        (false, true) => format!("up to {max} {unit}, no lower limit"),
+        (false, false) => "no travel limit".to_string(),
+    }
 }
 
 fn subject(axis: Option<char>) -> String {
