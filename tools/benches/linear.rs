@@ -1,14 +1,17 @@
 //! Is `dnurbs simulate` linear in the program? A wiggly G01 path of 0.05 mm moves (the
 //! dense CAM program of issue 12) through each stage on the paper machine: parse, build
-//! (segments), plan (S-curves and the setpoint check's rounds), interpolate, summarize.
-//! Prints each stage's time (the best of `BENCH_REPEAT` runs, default 3) per size, and the
-//! ratio to the size before: 10x the moves should cost at most 11x.
+//! (segments), plan (S-curves and the setpoint check's rounds), and interpolate with the
+//! summary streamed as simulate does it. Prints each stage's time (the best of
+//! `BENCH_REPEAT` runs, default 3) per size, the ratio to the size before (10x the moves
+//! should cost at most 11x), and the peak resident memory from the parse on.
 //!
 //! Run: `cargo bench -p dnurbs-tools --bench linear` (10 000 and 100 000 moves);
-//! `BENCH_MOVES=10000,100000,1000000` for other sizes (1 000 000 needs about 2 GB).
+//! `BENCH_MOVES=10000,100000,1000000` for other sizes (1 000 000 needs about 0.8 GB).
 
 use dnurbs_tools::setup::MachineSetup;
-use dnurbs_tools::simulate::{interpolate, summarize, Run};
+mod common;
+
+use dnurbs_tools::simulate::{each_setpoint, Summarizer};
 use nalgebra::Vector3;
 use nc::interp::Method;
 use std::time::{Duration, Instant};
@@ -18,13 +21,11 @@ const MACHINE: &str = concat!(
     "/../config/machines/paper-ac-table.toml"
 );
 
-/// n moves of 0.05 mm along a sine in XY, in rows of 580 mm inside the paper machine's travel.
+/// The n-move wiggle ([`common::wiggle_point`]) as a G01 program.
 fn wiggle(n: usize) -> String {
     let points: Vec<_> = (0..=n)
         .map(|k| {
-            let d = k as f64 * 0.05;
-            let x = -290.0 + d % 580.0;
-            let y = 2.0 * (d / 580.0).floor() + 0.5 * (x / 2.0).sin();
+            let (x, y) = common::wiggle_point(k);
             (Vector3::new(x, y, 0.0), Vector3::z())
         })
         .collect();
@@ -36,24 +37,25 @@ struct Times {
     parse: Duration,
     build: Duration,
     plan: Duration,
-    interpolate: Duration,
-    summarize: Duration,
+    run: Duration,
+    /// Peak resident memory from the parse on, MB (the program text, already read, in it).
+    peak_mb: f64,
 }
 
 impl Times {
-    fn stages(&self) -> [(&'static str, Duration); 5] {
+    fn stages(&self) -> [(&'static str, Duration); 4] {
         [
             ("parse", self.parse),
             ("build", self.build),
             ("plan", self.plan),
-            ("interpolate", self.interpolate),
-            ("summarize", self.summarize),
+            ("interpolate+summarize", self.run),
         ]
     }
 }
 
 fn once(src: &str, setup: &MachineSetup) -> Times {
     let mut t = Times::default();
+    common::reset_peak();
     let clock = Instant::now();
     let program = nc::parse::parse(src).expect("the wiggle parses");
     t.parse = clock.elapsed();
@@ -63,18 +65,16 @@ fn once(src: &str, setup: &MachineSetup) -> Times {
     let clock = Instant::now();
     let profile = nc::plan::plan(&path, &setup.kin, &setup.plan).expect("it plans");
     t.plan = clock.elapsed();
+    // As `dnurbs simulate` does it: each setpoint into the summary as it is made.
     let clock = Instant::now();
-    let setpoints = interpolate(&path, &profile, setup, Method::ArcLength).expect("it ends");
-    t.interpolate = clock.elapsed();
-    let run = Run {
-        path,
-        profile,
-        setpoints,
-        method: Method::ArcLength,
-    };
-    let clock = Instant::now();
-    let summary = summarize(&run, setup, program.blocks.len());
-    t.summarize = clock.elapsed();
+    let mut summary = Summarizer::new(&path, setup);
+    each_setpoint(&path, &profile, setup, Method::ArcLength, |sp| {
+        summary.push(sp)
+    })
+    .expect("it ends");
+    let summary = summary.finish(&profile, Method::ArcLength, program.blocks.len());
+    t.run = clock.elapsed();
+    t.peak_mb = common::peak_mb();
     assert!(
         summary.end_position_error_mm < 1e-3,
         "the run ends at the program's end"
@@ -87,15 +87,7 @@ fn main() {
     if !std::env::args().any(|a| a == "--bench") {
         return;
     }
-    let sizes: Vec<usize> = std::env::var("BENCH_MOVES")
-        .unwrap_or_else(|_| "10000,100000".into())
-        .split(',')
-        .map(|s| {
-            s.trim()
-                .parse()
-                .expect("BENCH_MOVES: sizes separated by commas")
-        })
-        .collect();
+    let sizes = common::sizes("10000,100000");
     let repeat: usize = std::env::var("BENCH_REPEAT")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -118,8 +110,8 @@ fn main() {
                         parse: b.parse.min(t.parse),
                         build: b.build.min(t.build),
                         plan: b.plan.min(t.plan),
-                        interpolate: b.interpolate.min(t.interpolate),
-                        summarize: b.summarize.min(t.summarize),
+                        run: b.run.min(t.run),
+                        peak_mb: b.peak_mb.max(t.peak_mb),
                     },
                 })
             });
@@ -138,7 +130,7 @@ fn main() {
                 print!(" ({r:.1}x for {:.0}x)", n as f64 / m as f64);
             }
         }
-        println!();
+        println!("  peak resident {:.0} MB", best.peak_mb);
         before = Some((n, best));
     }
 }

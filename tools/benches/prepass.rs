@@ -9,6 +9,8 @@
 //! Run: `cargo bench -p dnurbs-tools --bench prepass` (10^5 and 10^6 moves);
 //! `BENCH_MOVES=100000,1000000,10000000` for 10^7 (a 700 MB file, deleted afterwards).
 
+mod common;
+
 use dnurbs_tools::setup::MachineSetup;
 use nc::parse::{ReadLines, Setup};
 use std::io::{BufWriter, Write};
@@ -19,17 +21,12 @@ const MACHINE: &str = concat!(
     "/../config/machines/paper-ac-table.toml"
 );
 
-/// Writes n moves of 0.05 mm along a sine in XY, in rows of 580 mm inside the paper
-/// machine's travel, as `g01_program` would (the bench `linear`'s path up to 10^6 moves;
-/// beyond, its rows would leave the travel, so they start over).
+/// Writes the n-move wiggle ([`common::wiggle_point`]) as `g01_program` would.
 fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
     let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
     w.write_all(b"%\nG90 G21 G94\n")?;
     for k in 0..=n {
-        let d = k as f64 * 0.05;
-        let x = -290.0 + d % 580.0;
-        // Rows 2 mm apart, starting over after 120 rows (240 mm: the Y travel is +-250).
-        let y = 2.0 * ((d / 580.0).floor() % 120.0) + 0.5 * (x / 2.0).sin();
+        let (x, y) = common::wiggle_point(k);
         let g = if k < 2 { "G01 " } else { "" };
         let f = if k == 0 { " F3000" } else { "" };
         writeln!(
@@ -46,30 +43,12 @@ fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
     w.flush()
 }
 
-/// The process's peak resident memory since the last reset (VmHWM), in MB.
-fn peak_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix("VmHWM:"))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
-        .map_or(f64::NAN, |kb| kb / 1024.0)
-}
-
 fn main() {
     // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
     if !std::env::args().any(|a| a == "--bench") {
         return;
     }
-    let sizes: Vec<usize> = std::env::var("BENCH_MOVES")
-        .unwrap_or_else(|_| "100000,1000000".into())
-        .split(',')
-        .map(|s| {
-            s.trim()
-                .parse()
-                .expect("BENCH_MOVES: sizes separated by commas")
-        })
-        .collect();
+    let sizes = common::sizes("100000,1000000");
     let machine = config::load(std::path::Path::new(MACHINE)).expect("the paper machine loads");
     let setup = MachineSetup::new(&machine);
     println!("the pre-pass on {} sizes, paper-ac-table:", sizes.len());
@@ -80,7 +59,7 @@ fn main() {
         write_wiggle(&path, n).expect("the program is written");
         let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
         // Reset the peak: what follows is the pre-pass's alone.
-        let _ = std::fs::write("/proc/self/clear_refs", "5");
+        common::reset_peak();
         let clock = Instant::now();
         let file = std::fs::File::open(&path).expect("the program opens");
         let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file));
@@ -93,7 +72,7 @@ fn main() {
         )
         .expect("the wiggle passes");
         let secs = clock.elapsed().as_secs_f64();
-        let peak = peak_mb();
+        let peak = common::peak_mb();
         let _ = std::fs::remove_file(&path);
         assert_eq!(passed.blocks, n + 1, "every move is read");
         print!(

@@ -1,0 +1,40 @@
+//! What the benches `linear` and `prepass` share: the program sizes to run, the dense G01
+//! path they run, and the process's peak resident memory.
+
+/// The sizes (moves) in `BENCH_MOVES`, comma-separated, else `default`.
+pub fn sizes(default: &str) -> Vec<usize> {
+    std::env::var("BENCH_MOVES")
+        .unwrap_or_else(|_| default.into())
+        .split(',')
+        .map(|s| {
+            s.trim()
+                .parse()
+                .expect("BENCH_MOVES: sizes separated by commas")
+        })
+        .collect()
+}
+
+/// The k-th point of the wiggle: moves of 0.05 mm along a sine in XY, in rows of 580 mm
+/// 2 mm apart, starting over after 120 rows (240 mm: the paper machine's Y travel is +-250),
+/// so any number of moves stays inside the travel.
+pub fn wiggle_point(k: usize) -> (f64, f64) {
+    let d = k as f64 * 0.05;
+    let x = -290.0 + d % 580.0;
+    let y = 2.0 * ((d / 580.0).floor() % 120.0) + 0.5 * (x / 2.0).sin();
+    (x, y)
+}
+
+/// Forget the peak resident memory so far: [`peak_mb`] then measures from here.
+pub fn reset_peak() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// The process's peak resident memory since the last reset (VmHWM), in MB.
+pub fn peak_mb() -> f64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmHWM:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
+        .map_or(f64::NAN, |kb| kb / 1024.0)
+}
