@@ -288,13 +288,7 @@ impl From<nc::fit::compress::Compressed> for Compression {
     }
 }
 
-/// Write the trace CSV (header documented in the README).
-pub fn write_trace(w: &mut impl std::io::Write, sps: &[Setpoint]) -> std::io::Result<()> {
-    write_trace_header(w)?;
-    sps.iter().try_for_each(|s| write_trace_row(w, s))
-}
-
-/// The trace's CSV header.
+/// The trace's CSV header (documented in the README).
 pub fn write_trace_header(w: &mut impl std::io::Write) -> std::io::Result<()> {
     writeln!(w, "cycle,t,block,u,x,y,z,i,j,k,feed,X,Y,Z,A,C")
 }
