@@ -128,6 +128,22 @@ impl Mark {
     pub fn next_cycle(&self) -> u64 {
         self.cycle
     }
+
+    /// The segment and the profile phase the interpolator stands at.
+    pub(crate) fn segment(&self) -> usize {
+        self.seg
+    }
+
+    pub(crate) fn phase(&self) -> usize {
+        self.phase
+    }
+
+    /// The path's first `segments` and the profile's first `phases` were dropped (a
+    /// streaming planner's buffers): count from there.
+    pub(crate) fn rebase(&mut self, segments: usize, phases: usize) {
+        self.seg -= segments;
+        self.phase -= phases;
+    }
 }
 
 impl<'a> Interpolator<'a> {

@@ -33,11 +33,13 @@ use crate::kinematics::Tilt;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::program::SrcPos;
 use crate::scurve::{push_section, reachable, Motion, Phase};
-use crate::segment::{Geometry, Path, Segment, Tooling};
+use crate::segment::{Path, Segment};
 use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
-use nalgebra::Vector3;
 
+mod stations;
 mod window;
+
+pub use window::{Finished, Planner, Sink};
 
 /// Limits of one machine axis, in mm or radians and seconds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -166,251 +168,6 @@ impl Near<'_> {
         let mut i = (self.i0 + local).saturating_sub(1);
         self.profile.at(t, &mut i)
     }
-}
-
-fn joint_derivatives(q: &[Joints], h: f64, i: usize) -> ([f64; 5], [f64; 5]) {
-    let n = q.len();
-    let (a, b, c) = if i == 0 {
-        (0, 1, 2.min(n - 1))
-    } else if i + 1 == n {
-        (n.saturating_sub(3), n - 2, n - 1)
-    } else {
-        (i - 1, i, i + 1)
-    };
-    let mut d1 = [0.0; 5];
-    let mut d2 = [0.0; 5];
-    for j in 0..5 {
-        d1[j] = if i == 0 {
-            (q[b][j] - q[a][j]) / h
-        } else if i + 1 == n {
-            (q[c][j] - q[b][j]) / h
-        } else {
-            (q[c][j] - q[a][j]) / (2.0 * h)
-        };
-        d2[j] = if c > b && b > a {
-            (q[c][j] - 2.0 * q[b][j] + q[a][j]) / (h * h)
-        } else {
-            0.0
-        };
-    }
-    (d1, d2)
-}
-
-fn curvature(seg: &Segment, s: f64) -> f64 {
-    match &seg.geometry {
-        Geometry::Line { .. } => 0.0,
-        Geometry::Nurbs { curve, table } => {
-            let d = curve.cutter(table.u_of_s(curve, s), 2);
-            let sp = d.d1.norm();
-            if sp < 1e-12 {
-                0.0
-            } else {
-                d.d1.cross(&d.d2).norm() / (sp * sp * sp)
-            }
-        }
-    }
-}
-
-/// The cutter path's unit tangent at a segment's start or end, if it has one.
-fn end_tangent(seg: &Segment, at_end: bool) -> Option<Vector3<f64>> {
-    let d = match &seg.geometry {
-        Geometry::Line { from, to } => to - from,
-        Geometry::Nurbs { curve, table } => {
-            let s = if at_end { seg.length } else { 0.0 };
-            curve.cutter(table.u_of_s(curve, s), 1).d1
-        }
-    };
-    let n = d.norm();
-    (n > 1e-12 && n.is_finite()).then(|| d / n)
-}
-
-/// Highest speed at which a junction whose cutter path turns from `t0` to `t1` keeps the
-/// chord error within `tol` whatever the sampling phase: a chord of one period's travel
-/// `L = v Ts` that straddles the corner passes it at most `(L / 2) sin(phi / 2)` away
-/// (phi the turn, reached with the corner midway), so the corner's speed is at most
-/// `2 tol / (Ts sin(phi / 2))`, with [`CORNER_CHORD_SHARE`] of it taken. The setpoint check
-/// measures the chord at the plan's actual phase; a cap found from that phase alone would
-/// move with every change of the plan's timing before it, and the replanning rounds would
-/// chase it from corner to corner along a long program.
-fn corner_chord_speed(t0: &Vector3<f64>, t1: &Vector3<f64>, tol: f64, ts: f64) -> f64 {
-    let half = 0.5 * t0.dot(t1).clamp(-1.0, 1.0).acos();
-    let sin = half.sin();
-    if sin <= 1e-12 {
-        f64::INFINITY
-    } else {
-        CORNER_CHORD_SHARE * 2.0 * tol / (ts * sin)
-    }
-}
-
-/// Share of the chord tolerance a corner's speed is planned for: the chord straddling a
-/// corner is one period's travel only at a steady speed.
-const CORNER_CHORD_SHARE: f64 = 0.97;
-
-/// Whether every joint moves at a constant rate along `seg`: a line with a fixed tool axis
-/// (the rotary joints stand still, and the linear ones follow the line rotated).
-fn constant_rates(seg: &Segment) -> bool {
-    matches!(
-        (&seg.geometry, &seg.tooling),
-        (Geometry::Line { .. }, Tooling::Fixed(_))
-    )
-}
-
-/// Halvings of the station spacing over which [`end_rates`] follows a segment's ends.
-const END_HALVINGS: i32 = 10;
-
-/// A segment's joint rate dq/ds at one of its ends.
-struct EndRate {
-    /// At the end itself (the finest one-sided difference), signed.
-    at: [f64; 5],
-    /// The largest magnitude met from the station spacing down to the finest step.
-    peak: [f64; 5],
-}
-
-/// The joint rates at a segment's start and end, by one-sided differences over steps from
-/// the station spacing `h` down to `h / 2^END_HALVINGS`. A rate that peaks at an end (the
-/// tool axis leaving or reaching the vertical of an A/C table turns C fastest there) can be
-/// narrower than the stations, and a kink's velocity jump is the rate at the end itself.
-/// Along a [`constant_rates`] segment the station spacing is exact.
-fn end_rates(
-    seg: &Segment,
-    kin: &MachineKinematics,
-    cfg: &PlanConfig,
-    q: &[Joints],
-    h: f64,
-) -> (EndRate, EndRate) {
-    let n = q.len() - 1;
-    let grid = |i: usize, dir: f64| -> [f64; 5] {
-        let (a, b) = if dir > 0.0 { (i, i + 1) } else { (i - 1, i) };
-        core::array::from_fn(|j| (q[b][j] - q[a][j]) / h)
-    };
-    let exact = constant_rates(seg);
-    let one = |from: &Joints, s: f64, dir: f64, coarse: [f64; 5]| {
-        let mut r = EndRate {
-            at: coarse,
-            peak: coarse.map(f64::abs),
-        };
-        if exact {
-            return r;
-        }
-        for m in 1..=END_HALVINGS {
-            let step = h * 0.5f64.powi(m);
-            let j = seg.pose(s + dir * step).joints(kin, from, &cfg.rotary);
-            for k in 0..5 {
-                let d = dir * (j[k] - from[k]) / step;
-                r.at[k] = d;
-                r.peak[k] = r.peak[k].max(d.abs());
-            }
-        }
-        r
-    };
-    (
-        one(&q[0], 0.0, 1.0, grid(0, 1.0)),
-        one(&q[n], seg.length, -1.0, grid(n, -1.0)),
-    )
-}
-
-fn max_abs(a: [f64; 5], b: [f64; 5]) -> [f64; 5] {
-    core::array::from_fn(|j| a[j].abs().max(b[j]))
-}
-
-/// Sample every segment; returns the stations and, per segment, the index of its first
-/// station (the joint with the previous segment) and the one-sided dq/ds at both ends.
-fn stations(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> (Vec<Station>, Vec<usize>) {
-    let mut out: Vec<Station> = Vec::new();
-    let mut starts = Vec::with_capacity(path.segments.len() + 1);
-    let mut prev = path.start_joints;
-    let mut s0 = 0.0;
-    let mut prev_end: Option<([f64; 5], bool)> = None;
-    let mut prev_seg: Option<&Segment> = None;
-    for seg in &path.segments {
-        // A line with a fixed tool axis moves every joint at a constant rate, so its ceiling
-        // is the same all along: its two ends and a midpoint say all there is (a dense CAM
-        // program of such moves would otherwise carry 16 stations a move).
-        let fewest = if constant_rates(seg) { 2 } else { 16 };
-        let n = ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize)
-            .clamp(fewest, 4096);
-        let h = seg.length / n as f64;
-        let mut q = Vec::with_capacity(n + 1);
-        for i in 0..=n {
-            let j = seg.pose(h * i as f64).joints(kin, &prev, &cfg.rotary);
-            prev = j;
-            q.push(j);
-        }
-        let (start_rate, end_rate) = end_rates(seg, kin, cfg, &q, h);
-        let mut last_d1 = [0.0; 5];
-        for i in 0..=n {
-            // The last station is the joint: exactly where the next segment starts (h n
-            // can differ from the length in the last bit, and a cap at the joint would then
-            // fall on the station before it too).
-            let s_loc = if i == n { seg.length } else { h * i as f64 };
-            let (d1, d2) = joint_derivatives(&q, h, i);
-            // At the segment's ends: the rate at the end itself (what jumps at a joint) and
-            // the largest on the way there (what bounds the section's limits).
-            let (d1, peak) = match i {
-                0 => (start_rate.at, max_abs(d1, start_rate.peak)),
-                _ if i == n => (end_rate.at, max_abs(d1, end_rate.peak)),
-                _ => (d1, d1.map(f64::abs)),
-            };
-            if i == n {
-                last_d1 = d1;
-            }
-            let mut v = seg.feed.min(1e9);
-            let kappa = curvature(seg, s_loc);
-            if kappa > 1e-12 {
-                let rho = 1.0 / kappa;
-                let d = cfg.chord_tol.min(rho);
-                v = v.min(2.0 * (2.0 * rho * d - d * d).sqrt() / cfg.period);
-                v = v.min((cfg.path_acc / kappa).sqrt());
-            }
-            for (j, ax) in cfg.axes.iter().enumerate() {
-                if peak[j] > 1e-15 {
-                    v = v.min(ax.velocity / peak[j]);
-                }
-                if d2[j].abs() > 1e-15 {
-                    v = v.min((ax.acceleration / (2.0 * d2[j].abs())).sqrt());
-                }
-            }
-            let st = Station {
-                s: s0 + s_loc,
-                vlim: v.max(V_FLOOR),
-                dq: peak,
-            };
-            if i == 0 {
-                if let Some(last) = out.last_mut() {
-                    // The joint with the previous segment: one station, both sides' limits.
-                    let (pd1, prev_rotary) = prev_end.unwrap_or(([0.0; 5], seg.rotary_only));
-                    let mut vc = last.vlim.min(st.vlim);
-                    if prev_rotary != seg.rotary_only || seg.stop {
-                        // Path units change (mm <-> degrees), or the tangent kinks inside
-                        // a NURBS block: stop between.
-                        vc = 0.0;
-                    }
-                    let tangents = prev_seg
-                        .filter(|p| !p.rotary_only && !seg.rotary_only)
-                        .and_then(|p| Some((end_tangent(p, true)?, end_tangent(seg, false)?)));
-                    if let Some((t0, t1)) = tangents {
-                        vc = vc.min(corner_chord_speed(&t0, &t1, cfg.chord_tol, cfg.period));
-                    }
-                    for (j, ax) in cfg.axes.iter().enumerate() {
-                        let jump = (d1[j] - pd1[j]).abs();
-                        if jump > 1e-9 {
-                            vc = vc.min(ax.acceleration * cfg.period / jump);
-                        }
-                        last.dq[j] = last.dq[j].max(st.dq[j]);
-                    }
-                    last.vlim = vc.max(V_FLOOR);
-                    starts.push(out.len() - 1);
-                    continue;
-                }
-                starts.push(0);
-            }
-            out.push(st);
-        }
-        prev_end = Some((last_d1, seg.rotary_only));
-        prev_seg = Some(seg);
-        s0 += seg.length;
-    }
-    (out, starts)
 }
 
 /// Path acceleration and jerk allowed over stations `a..=b`.
@@ -647,13 +404,14 @@ fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64) {
 /// there drops by the factor the measurement asks for and the plan is made again; a limit
 /// that slowing cannot bring within its bound (travel, a step at rest, a violation at the
 /// slowest feed) refuses the program with the position of its block. The path is planned
-/// in windows of bounded length ([`window`]), each checked as it is planned.
+/// in windows of bounded length ([`window`]), each checked as it is planned, by the
+/// [`Planner`] a streamed program goes through, fed the whole path.
 pub fn plan(
     path: &Path,
     kin: &MachineKinematics,
     cfg: &PlanConfig,
 ) -> Result<FeedProfile, PlanError> {
-    window::plan_in_windows(path, kin, cfg, None)
+    plan_whole(path, Planner::new(start_of(path), kin, cfg))
 }
 
 /// [`plan`] with windows that look ahead just `reach` (path units) past what they commit,
@@ -665,7 +423,51 @@ pub fn plan_looking_ahead(
     cfg: &PlanConfig,
     reach: f64,
 ) -> Result<FeedProfile, PlanError> {
-    window::plan_in_windows(path, kin, cfg, Some(reach))
+    plan_whole(
+        path,
+        Planner::new(start_of(path), kin, cfg).looking_ahead(reach),
+    )
+}
+
+/// A path's start, as [`Planner::new`] takes it.
+pub fn start_of(path: &Path) -> (crate::segment::Pose, SrcPos, Joints) {
+    (path.start, path.start_src, path.start_joints)
+}
+
+/// The phases a [`Planner`] sends, collected; its segments let go.
+#[derive(Default)]
+pub struct Collect {
+    pub phases: Vec<Phase>,
+}
+
+impl Sink for Collect {
+    fn segment(&mut self, _: Segment) {}
+    fn phases(&mut self, phases: &[Phase]) {
+        self.phases.extend_from_slice(phases);
+    }
+}
+
+/// Feed `planner` every segment of `path` and collect its plan as one profile.
+pub fn plan_whole(path: &Path, mut planner: Planner) -> Result<FeedProfile, PlanError> {
+    let mut sink = Collect::default();
+    for seg in &path.segments {
+        planner.push(seg.clone(), &mut sink)?;
+    }
+    let end = planner.finish(&mut sink)?;
+    let mut seg_start = Vec::with_capacity(path.segments.len() + 1);
+    let mut total = 0.0;
+    for seg in &path.segments {
+        seg_start.push(total);
+        total += seg.length;
+    }
+    seg_start.push(total);
+    Ok(FeedProfile {
+        phases: sink.phases,
+        seg_start,
+        length: end.length,
+        duration: end.duration,
+        margins: end.margins,
+    })
 }
 
 /// The dwells (`G04`) of segments `segs` as rest phases: a segment that waits starts at rest

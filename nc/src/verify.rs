@@ -192,6 +192,29 @@ impl Trace {
         let n = self.marks.partition_point(|m| m.win[3].t < t);
         self.marks.drain(..n.saturating_sub(1));
     }
+
+    /// What a check resuming from the oldest mark reads behind it: the first segment its
+    /// samples lie on, the first phase its cursors stand at, and the time of its oldest
+    /// sample. None unless that mark's newest sample comes before time `until` (without
+    /// one, a check starts from the program's start).
+    pub fn oldest(&self, until: f64) -> Option<(usize, usize, f64)> {
+        let m = self.marks.first().filter(|m| m.win[3].t < until)?;
+        let seg = m.win.iter().map(|w| w.seg).fold(m.ip.segment(), usize::min);
+        Some((seg, m.cursor.min(m.ip.phase()), m.win[0].t))
+    }
+
+    /// The segments and phases before `segments` and `phases` are gone from the planner's
+    /// buffers: every index the marks hold counts from there now. Nothing a mark points at
+    /// may lie before them ([`Trace::oldest`]).
+    pub fn rebase(&mut self, segments: usize, phases: usize) {
+        for m in &mut self.marks {
+            m.ip.rebase(segments, phases);
+            m.cursor -= phases;
+            for w in &mut m.win {
+                w.seg -= segments;
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -551,7 +574,7 @@ pub fn smooth_junctions(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) 
     out
 }
 
-fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bool {
+pub(crate) fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bool {
     if a.rotary_only || b.rotary_only {
         return false;
     }
