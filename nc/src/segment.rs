@@ -244,6 +244,15 @@ pub struct BuildLimits {
     pub rotary: RotaryLimits,
 }
 
+impl BuildLimits {
+    /// The highest feed any segment carries: the higher of the rapid and the top feed (a
+    /// move that only turns the tool takes it in degrees a second). No plan is faster, so a
+    /// program streamed to the real-time thread is bounded by it before it is planned.
+    pub fn speed_cap(&self) -> f64 {
+        self.rapid_mm_s.max(self.max_feed_mm_s)
+    }
+}
+
 /// The start pose and the segments of a program.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Path {
@@ -309,14 +318,16 @@ pub fn follow(seg: &Segment, kin: &MachineKinematics, prev: &Joints, lim: &Rotar
 }
 
 /// A rotary-only move that turns C from `joints` to `c` at the start of `seg`, at rest,
-/// with the tool vertical: planned like any other move under the C axis limits.
-fn turn_c(seg: &Segment, joints: &Joints, c: f64) -> Segment {
+/// with the tool vertical: planned like any other move under the C axis limits (and no
+/// faster than [`BuildLimits::speed_cap`] degrees a second).
+fn turn_c(seg: &Segment, joints: &Joints, c: f64, limits: &BuildLimits) -> Segment {
     let p = seg.pose(0.0).p;
     Segment {
         block: seg.block,
         src: seg.src,
         length: (c - joints[4]).abs().to_degrees(),
-        feed: f64::INFINITY, // limited by the C axis alone
+        // Limited by the C axis, and by the top feed in degrees a second.
+        feed: limits.speed_cap(),
         rapid: false,
         rotary_only: true,
         stop: seg.stop,
@@ -540,7 +551,8 @@ fn nurbs(
                             block,
                             src: b.pos,
                             length: angle.to_degrees(),
-                            feed: f64::INFINITY, // limited by the rotary axes alone
+                            // The rotary axes' limits, and the top feed in degrees a second.
+                            feed: limits.speed_cap(),
                             rapid: false,
                             rotary_only: true,
                             stop: false,

@@ -40,17 +40,21 @@
 
 use crate::interp::Setpoint;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
-use crate::plan::{FeedProfile, V_FLOOR};
+use crate::plan::{FeedProfile, Sink, V_FLOOR};
 use crate::program::Aux;
 use crate::scurve::{Motion, Phase};
 use crate::segment::{Path, Pose, Segment};
 use crate::verify::Margins;
+pub use cutter::Cutter;
 use heapless::spsc::{Consumer, Producer, Queue};
 use heapless::Deque;
 use hold::AxisHold;
 pub use hold::{HoldConfig, HOLD_SHARE};
+pub use source::{Machine, ProgramEntries, ProgramSource, Source, StreamError};
 
+mod cutter;
 mod hold;
+mod source;
 
 /// Deepest segment queue a machine file may ask for.
 pub const MAX_DEPTH: usize = 1024;
@@ -93,6 +97,11 @@ pub struct Chunk {
     /// The plan is at rest where it arrives at the segment's end (an exact stop: at most
     /// the floor speed, [`V_FLOOR`]).
     pub rests_at_end: bool,
+    /// The program's last chunk.
+    pub last: bool,
+    /// How far into the program the chunk starts, 0..=1 (its first segment's source line
+    /// over the program's lines, where those are known; else 0).
+    pub progress: f64,
 }
 
 /// The program's start, known before any chunk.
@@ -100,10 +109,11 @@ pub struct Chunk {
 pub struct Start {
     pub pose: Pose,
     pub joints: Joints,
-    /// Number of chunks the program has.
-    pub chunks: usize,
+    /// The program has no chunk: nothing moves.
+    pub empty: bool,
     /// The plan's largest axis velocities and accelerations as fractions of their limits
-    /// (its setpoint check): what a hold may add on top of them.
+    /// (its setpoint check, or for a program streamed before it is planned,
+    /// [`Margins::ceiling`]): what a hold may add on top of them.
     pub margins: Margins,
 }
 
@@ -151,10 +161,17 @@ pub const MAX_CHUNK_SEGMENTS: usize = 4096;
 /// planner that keeps up never makes the tool hold, however short the program's moves.
 pub fn chunk_length(profile: &FeedProfile, hold: &HoldConfig, depth: usize) -> f64 {
     let vmax = profile.phases.iter().map(phase_vmax).fold(0.0, f64::max);
+    stop_length(vmax, &profile.margins, hold, depth)
+}
+
+/// [`chunk_length`] for a plan no faster than `vmax` whose margins are at most `margins`:
+/// what a program streamed before it is planned is cut by (its speed cap and
+/// [`Margins::ceiling`]).
+pub fn stop_length(vmax: f64, margins: &Margins, hold: &HoldConfig, depth: usize) -> f64 {
     if vmax <= 0.0 || !vmax.is_finite() {
         return 0.0;
     }
-    let axes = AxisHold::new(hold, &profile.margins);
+    let axes = AxisHold::new(hold, margins);
     let held = depth.clamp(MIN_DEPTH, MAX_DEPTH).min(LOOKAHEAD);
     let spare = held.saturating_sub(2).max(1) as f64;
     1.25 * hold::stop_bound(hold, &axes, vmax) / spare
@@ -177,85 +194,31 @@ pub fn chunks(
 
 /// Cut a planned path into chunks at least `min_len` long (0: one segment a chunk, as a
 /// planner that pushes each segment as soon as it is planned). [`chunks`] with the length
-/// its depth needs.
+/// its depth needs. The [`Cutter`] a streamed plan goes through, fed the whole plan; each
+/// chunk's `vmax_ahead` is the plan's own highest speed from there to its end.
 #[allow(clippy::vec_box)]
 pub fn cut(path: Path, profile: &FeedProfile, min_len: f64) -> (Start, Vec<Box<Chunk>>) {
-    // The runs of segments, [a, b).
-    let n = path.segments.len();
-    let mut runs = Vec::new();
-    let mut a = 0;
-    for (i, seg) in path.segments.iter().enumerate().skip(1) {
-        let waits = seg.wait.operator.is_some() || seg.wait.spindle;
-        let long = profile.seg_start[i] - profile.seg_start[a] >= min_len;
-        if waits || long || i - a >= MAX_CHUNK_SEGMENTS {
-            runs.push((a, i));
-            a = i;
-        }
+    let mut cutter = Cutter::new(min_len, 0.0);
+    let (start, joints) = (path.start, path.start_joints);
+    cutter.phases(&profile.phases);
+    for seg in path.segments {
+        cutter.segment(seg);
     }
-    if n > 0 {
-        runs.push((a, n));
+    cutter.finish(profile.duration);
+    let mut out: Vec<Box<Chunk>> = core::iter::from_fn(|| cutter.next_chunk()).collect();
+    let n = out.len();
+    for (i, c) in out.iter_mut().enumerate() {
+        c.progress = i as f64 / n as f64;
     }
-    let start = Start {
-        pose: path.start,
-        joints: path.start_joints,
-        chunks: runs.len(),
-        margins: profile.margins,
-    };
-    let mut out = Vec::with_capacity(runs.len());
-    let eps = 1e-9 * profile.length.max(1.0);
-    let mut first = 0;
-    let mut segments = path.segments.into_iter();
-    for (index, &(a, b)) in runs.iter().enumerate() {
-        let s0 = profile.seg_start[a];
-        let s1 = profile.seg_start[b];
-        // Phases are in time order and s never decreases: skip those that end before s0.
-        while first + 1 < profile.phases.len() && profile.phases[first].end().s < s0 - eps {
-            first += 1;
-        }
-        let mut last = first;
-        while last + 1 < profile.phases.len() && profile.phases[last + 1].s0 <= s1 + eps {
-            last += 1;
-        }
-        let phases: Vec<Phase> = profile.phases.get(first..=last).unwrap_or(&[]).to_vec();
-        let t_end = phases
-            .last()
-            .map_or(profile.duration, |p| p.t0 + p.dur)
-            .min(profile.duration);
-        let vmax = phases.iter().map(phase_vmax).fold(0.0, f64::max);
-        // The first phase that ends at or after s0: `first`, unless none does.
-        let t_start = profile
-            .phases
-            .get(first)
-            .filter(|p| p.end().s >= s0 - eps)
-            .map_or(0.0, |p| if p.s0 >= s0 - eps { p.t0 } else { p.t0 + p.dur });
-        out.push(Box::new(Chunk {
-            index,
-            segments: segments.by_ref().take(b - a).collect(),
-            starts: profile.seg_start[a..b].to_vec(),
-            s0,
-            s1,
-            phases,
-            t_end,
-            t_start,
-            vmax,
-            vmax_ahead: vmax,
-            t_arrive: t_end,
-            rests_at_end: false,
-        }));
-    }
-    for i in (1..out.len()).rev() {
+    for i in (1..n).rev() {
         out[i - 1].vmax_ahead = out[i - 1].vmax.max(out[i].vmax_ahead);
     }
-    for i in 1..out.len() {
-        let t = out[i].t_start;
-        let c = &mut out[i - 1];
-        c.t_arrive = t;
-        c.rests_at_end = c
-            .phases
-            .iter()
-            .find(|p| t <= p.t0 + p.dur)
-            .is_some_and(|p| p.at((t - p.t0).clamp(0.0, p.dur)).v <= REST_V);
-    }
+    let start = Start {
+        pose: start,
+        joints,
+        empty: out.is_empty(),
+        margins: profile.margins,
+    };
     (start, out)
 }
 
@@ -375,8 +338,8 @@ pub struct Follower<'q> {
     lim: RotaryLimits,
     hold: HoldConfig,
     axis_hold: AxisHold,
-    start: Start,
-    received: usize,
+    /// The program's last chunk has arrived.
+    complete: bool,
     cycle: u64,
     tau: f64,
     k: f64,
@@ -436,8 +399,7 @@ impl<'q> Follower<'q> {
             lim,
             hold,
             axis_hold: AxisHold::new(&hold, &start.margins),
-            start,
-            received: 0,
+            complete: start.empty,
             cycle: 0,
             tau: 0.0,
             k: 1.0,
@@ -456,7 +418,7 @@ impl<'q> Follower<'q> {
             spindle_gate_from: 0,
             awaiting_spindle: None,
             aux: Aux::default(),
-            done: start.chunks == 0,
+            done: start.empty,
             pose: start.pose,
             joints: start.joints,
             block: 1,
@@ -556,13 +518,13 @@ impl<'q> Follower<'q> {
             .map_or(0, |(seg, _)| seg.src.line)
     }
 
-    /// Fraction of the program's chunks finished, 0..=1.
+    /// How far into the program the tool is, 0..=1 ([`Chunk::progress`] of the chunk at
+    /// hand).
     pub fn progress(&self) -> f64 {
-        if self.start.chunks == 0 || self.done {
+        if self.done {
             return 1.0;
         }
-        let cur = self.local.front().map_or(0, |c| c.index);
-        cur as f64 / self.start.chunks as f64
+        self.local.front().map_or(0.0, |c| c.progress)
     }
 
     /// Take what the planner has pushed, up to the look-ahead.
@@ -570,7 +532,7 @@ impl<'q> Follower<'q> {
         while !self.local.is_full() {
             match self.inlet.ready.dequeue() {
                 Some(c) => {
-                    self.received += 1;
+                    self.complete |= c.last;
                     // The deque is not full: cannot fail.
                     if let Err(c) = self.local.push_back(c) {
                         self.give_back(c);
@@ -676,7 +638,7 @@ impl<'q> Follower<'q> {
         if self.local.is_empty() {
             self.k = 0.0;
             self.r = 0.0;
-            if self.received < self.start.chunks && !self.stop_requested {
+            if !self.complete && !self.stop_requested {
                 self.counters.hold_periods += 1;
             }
             self.pending = Pending::Fixed(cycle, 0.0);
@@ -694,7 +656,7 @@ impl<'q> Follower<'q> {
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
         let mut jmax = self.hold.jerk / vb;
-        let complete = self.received >= self.start.chunks;
+        let complete = self.complete;
         let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
         let room = avail_end - self.motion.s;
         // Held at rest for data, closer to its end than the least stop distance: creep on
@@ -798,7 +760,7 @@ impl<'q> Follower<'q> {
         // The data ends where the plan comes to rest (an exact stop at a kink): wait there,
         // at rest like the plan, for the next chunk. Nothing is cut short: no hard stop.
         let rest_end = match (self.local.len(), self.local.front()) {
-            (1, Some(c)) => c.rests_at_end && c.index + 1 < self.start.chunks && tau >= c.t_arrive,
+            (1, Some(c)) => c.rests_at_end && !c.last && tau >= c.t_arrive,
             _ => false,
         };
         let mut m = self.motion;
@@ -815,7 +777,7 @@ impl<'q> Follower<'q> {
         for _ in 0..walk {
             let Some(c) = self.local.front() else { break };
             m = Self::motion_in(c, tau, &mut self.phase);
-            if c.index + 1 == self.start.chunks {
+            if c.last {
                 if tau >= c.t_end {
                     self.done = true;
                     m = Motion {

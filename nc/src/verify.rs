@@ -120,6 +120,25 @@ pub struct Margins {
     pub cycles: u64,
 }
 
+impl Margins {
+    /// The most any plan the planner accepts can reach: the shares of the axes' velocity
+    /// and acceleration that [`reserve`] leaves, the whole jerk and chord tolerance (with
+    /// the check's rounding slack). A plan streamed to the real-time thread is bounded by
+    /// it before it is whole.
+    pub fn ceiling(cfg: &PlanConfig) -> Margins {
+        let share = |f: fn((f64, f64)) -> f64| -> [f64; 5] {
+            core::array::from_fn(|j| f(reserve(&cfg.axes[j], cfg.period)) * (1.0 + SLACK))
+        };
+        Margins {
+            velocity: share(|r| r.0),
+            acceleration: share(|r| r.1),
+            jerk: [1.0 + SLACK; 5],
+            chord: 1.0 + SLACK,
+            cycles: 0,
+        }
+    }
+}
+
 /// The result of [`check`]: the margins, and at most one violation per cycle (the worst).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Checked {

@@ -24,6 +24,8 @@ use std::fmt::Write;
 
 #[path = "adversarial/hold.rs"]
 mod hold;
+#[path = "adversarial/streamed.rs"]
+mod streamed;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 const PERIOD: f64 = 0.002;
@@ -426,6 +428,8 @@ struct Counts {
     /// Accepted programs run through the follower with a stop, a pause, an override change,
     /// a slow planner ([`hold::Event`]).
     held: [AtomicU64; 4],
+    /// Of those, the ones run on the streamed chunks.
+    on_stream: AtomicU64,
 }
 
 /// Largest chord error between two setpoints of one NURBS segment.
@@ -541,6 +545,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     );
     let travel_before =
         |line: u32| matches!(&pre, Err(Refused::Travel { pos, .. }) if pos.line <= line);
+    let stream = streamed::stream(src, &cfg, &bl, &kin);
     let program = match nc::parse::parse(src) {
         Ok(p) => p,
         Err(e) => {
@@ -549,6 +554,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
                 _ => None,
             };
             prop_assert_eq!(first, Some(e), "the pre-pass: {:?}", pre);
+            streamed::refused_too(&stream, e.pos.line, src)?;
             return refused("parse", e.pos.line, &e, src, counts);
         }
     };
@@ -562,6 +568,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
                 pre,
                 e
             );
+            streamed::refused_too(&stream, e.pos.line, src)?;
             return refused("build", e.pos.line, &e, src, counts);
         }
     };
@@ -576,6 +583,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
             if pre.is_err() {
                 counts.prepass_travel.fetch_add(1, Ordering::Relaxed);
             }
+            streamed::refused_too(&stream, e.pos.line, src)?;
             return refused("plan", e.pos.line, &e, src, counts);
         }
     };
@@ -584,6 +592,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
         "the planner accepts what the pre-pass refused: {:?}",
         pre
     );
+    streamed::same_chunks(&stream, &path, &profile, &cfg, &bl, src)?;
     if profile.duration / PERIOD > MAX_TEST_CYCLES {
         counts.long.fetch_add(1, Ordering::Relaxed);
         return Ok(());
@@ -640,7 +649,20 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     }
     // Through the real-time follower too, with a stop, pause, override or slow planner.
     counts.held[ev.kind()].fetch_add(1, Ordering::Relaxed);
-    hold::check(path, &profile, &cfg, kin, ev, src)
+    // Half of them on the chunks as `dnurbs run` streams them.
+    let on_stream = src.len() % 2 == 0;
+    if on_stream {
+        counts.on_stream.fetch_add(1, Ordering::Relaxed);
+    }
+    hold::check(
+        path,
+        &profile,
+        &cfg,
+        kin,
+        ev,
+        src,
+        stream.ok().filter(|_| on_stream),
+    )
 }
 
 /// Cases per run: `ADV_CASES` (default 300; CI sets 10 000), shared by the two halves below
@@ -709,12 +731,13 @@ fn run_half(half: u64, cases: u32) {
         counts.long.load(Ordering::Relaxed),
     );
     let pre = counts.prepass_travel.load(Ordering::Relaxed);
+    let on_stream = counts.on_stream.load(Ordering::Relaxed);
     let held: Vec<u64> = counts
         .held
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
     if let Err(e) = result {
         panic!("{e}");
     }
@@ -730,6 +753,10 @@ fn run_half(half: u64, cases: u32) {
     assert!(
         turning * 50 >= u64::from(cases),
         "only {turning} of {cases} accepted with an arc turning the tool"
+    );
+    assert!(
+        on_stream * 3 >= acc,
+        "only {on_stream} of {acc} through the follower on the streamed chunks"
     );
     assert!(
         long * 100 <= u64::from(cases),

@@ -155,7 +155,7 @@ impl<'k> Builder<'k> {
                     }
                     self.joints[4] = c;
                 } else if (c - self.joints[4]).abs() > 1e-9 {
-                    out.push(turn_c(&seg, &self.joints, c));
+                    out.push(turn_c(&seg, &self.joints, c, self.limits));
                     self.joints[4] = c;
                     // The turn waits where the segment would have: not a second time.
                     seg.wait = Wait::default();

@@ -109,6 +109,7 @@ pub fn check(
     kin: MachineKinematics,
     ev: Event,
     src: &str,
+    streamed: Option<super::streamed::Streamed>,
 ) -> Result<(), TestCaseError> {
     let end = path.segments.last().map(|s| s.pose(s.length).p);
     let depth = match ev {
@@ -117,10 +118,12 @@ pub fn check(
     };
     // Cut for the default depth (or one segment a chunk), so that a shallower queue fed
     // slowly starves the follower as a slow planner does.
-    let (start, all) = match ev {
-        Event::Underrun { single: true, .. } => cut(path, profile, 0.0),
+    let (start, all) = match (ev, streamed) {
+        (Event::Underrun { single: true, .. }, _) => cut(path, profile, 0.0),
+        (_, Some(s)) => s,
         _ => chunks(path, profile, &HoldConfig::from_plan(cfg), 64),
     };
+    let n_chunks = all.len() as u64;
     let mut source = all.into_iter();
     let mut q = Queues::new();
     let (mut feeder, inlet) = q.split(depth);
@@ -131,7 +134,7 @@ pub fn check(
     let (mut rest, mut back_at) = (0u64, None);
     // Longest the run may take: the plan, a pause or an override's extra time, and the
     // holds of a slow planner, with room to spare.
-    let limit = 4 * planned + 20_000 + 2 * 401 * start.chunks as u64;
+    let limit = 4 * planned + 20_000 + 2 * 401 * n_chunks;
     for i in 0..limit {
         let push = match ev {
             Event::Underrun { every, .. } => i % every == 0,

@@ -1,0 +1,230 @@
+//! [`Source`]: a program in, chunks out, read a line at a time. It chains the streaming
+//! stages: the parser's entries ([`crate::parse::Entries`], or a parsed program's,
+//! [`ProgramEntries`]), the segment builder, the [`Planner`] and the [`Cutter`], and holds
+//! only what each holds: a line, a block, the planner's windows, the chunks not yet taken.
+//! Its chunks are the ones [`super::cut`] cuts from [`crate::plan::plan`]'s plan of the
+//! whole program, but for what only the whole plan knows: each chunk's `vmax_ahead` is the
+//! machine's speed cap, and the start's margins are [`Margins::ceiling`].
+
+use super::{stop_length, Chunk, Cutter, HoldConfig, Start};
+use crate::kinematics::{Joints, MachineKinematics};
+use crate::parse::{Entries, Entry, LineSource, ParseError};
+use crate::plan::{PlanConfig, PlanError, Planner};
+use crate::program::{Action, Block, Program, SrcPos};
+use crate::segment::{BuildError, BuildLimits, Builder, Segment};
+use crate::verify::Margins;
+
+/// A program's entries in the order they take effect, and its tilting-axis word.
+pub trait ProgramSource: Iterator<Item = Result<Entry, ParseError>> {
+    /// The letter the program's angle words use and where it first stood, once read.
+    fn tilt_word(&self) -> Option<(char, SrcPos)>;
+}
+
+impl<S: LineSource> ProgramSource for Entries<'_, S> {
+    fn tilt_word(&self) -> Option<(char, SrcPos)> {
+        Entries::tilt_word(self)
+    }
+}
+
+/// A parsed program's entries (after on-line compression, which needs it whole), in the
+/// order [`crate::segment::build`] takes them.
+pub struct ProgramEntries {
+    blocks: std::iter::Enumerate<std::vec::IntoIter<Block>>,
+    actions: std::iter::Peekable<std::vec::IntoIter<Action>>,
+    held: Option<(usize, Block)>,
+    tilt: Option<(char, SrcPos)>,
+}
+
+impl ProgramEntries {
+    pub fn new(program: Program) -> Self {
+        ProgramEntries {
+            blocks: program.blocks.into_iter().enumerate(),
+            actions: program.actions.into_iter().peekable(),
+            held: None,
+            tilt: program.tilt_word,
+        }
+    }
+}
+
+impl Iterator for ProgramEntries {
+    type Item = Result<Entry, ParseError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let Some((i, block)) = self.held.take().or_else(|| self.blocks.next()) else {
+            return self.actions.next().map(|a| Ok(Entry::Action(a)));
+        };
+        if let Some(a) = self.actions.next_if(|a| a.before_block <= i) {
+            self.held = Some((i, block));
+            return Some(Ok(Entry::Action(a)));
+        }
+        Some(Ok(Entry::Block(i, block)))
+    }
+}
+
+impl ProgramSource for ProgramEntries {
+    fn tilt_word(&self) -> Option<(char, SrcPos)> {
+        self.tilt
+    }
+}
+
+/// Why a streamed program stops: the first error of its parse, build or plan.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum StreamError {
+    #[error(transparent)]
+    Parse(#[from] ParseError),
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+}
+
+impl StreamError {
+    /// Where in the program.
+    pub fn pos(&self) -> SrcPos {
+        match self {
+            StreamError::Parse(e) => e.pos,
+            StreamError::Build(e) => e.pos,
+            StreamError::Plan(e) => e.pos,
+        }
+    }
+}
+
+/// The machine a [`Source`] plans for.
+#[derive(Clone, Copy)]
+pub struct Machine<'a> {
+    pub kin: &'a MachineKinematics,
+    pub build: &'a BuildLimits,
+    pub plan: &'a PlanConfig,
+}
+
+/// Chunks of a program as it is read (see the module's text).
+pub struct Source<'a, E> {
+    entries: E,
+    machine: Machine<'a>,
+    builder: Builder<'a>,
+    /// Created once the start pose is final (the first segment is built).
+    planner: Option<Planner<'a>>,
+    segments: Vec<Segment>,
+    cutter: Cutter,
+    tilt_checked: bool,
+    start: Option<Start>,
+    end: Option<Joints>,
+    failed: bool,
+}
+
+impl<'a, E: ProgramSource> Source<'a, E> {
+    /// Chunks for a follower holding `depth` of them (each at least the stop distance from
+    /// the machine's speed cap over what it holds, [`super::stop_length`]).
+    pub fn new(entries: E, machine: Machine<'a>, depth: usize) -> Self {
+        let cap = machine.build.speed_cap();
+        // A plan's speed reaches the cap by the planner's rounding at most.
+        let vmax = cap * (1.0 + 1e-6);
+        let hold = HoldConfig::from_plan(machine.plan);
+        let min_len = stop_length(vmax, &Margins::ceiling(machine.plan), &hold, depth);
+        Source {
+            entries,
+            machine,
+            builder: Builder::new(machine.kin, machine.build),
+            planner: None,
+            segments: Vec::new(),
+            cutter: Cutter::new(min_len, vmax),
+            tilt_checked: false,
+            start: None,
+            end: None,
+            failed: false,
+        }
+    }
+
+    /// The program has `lines` source lines (each chunk's progress is measured by it).
+    pub fn set_lines(&mut self, lines: u32) {
+        self.cutter.set_lines(lines);
+    }
+
+    /// The program's start, once the first chunk has been cut or the program ended.
+    pub fn start(&self) -> Option<Start> {
+        self.start
+    }
+
+    /// Where the program leaves the machine's joints, once it ended.
+    pub fn end_joints(&self) -> Option<Joints> {
+        self.end
+    }
+
+    /// The next chunk; None once the program has ended. After an error, None.
+    pub fn next_chunk(&mut self) -> Result<Option<Box<Chunk>>, StreamError> {
+        loop {
+            if let Some(c) = self.cutter.next_chunk() {
+                return Ok(Some(c));
+            }
+            if self.end.is_some() || self.failed {
+                return Ok(None);
+            }
+            let read = self.read();
+            self.failed = read.is_err();
+            read?;
+        }
+    }
+
+    /// One entry of the program, through the stages.
+    fn read(&mut self) -> Result<(), StreamError> {
+        let Some(entry) = self.entries.next() else {
+            return self.finish();
+        };
+        let entry = entry?;
+        if !self.tilt_checked {
+            if let Some(word) = self.entries.tilt_word() {
+                self.tilt_checked = true;
+                self.builder.tilt_word(Some(word))?;
+            }
+        }
+        match entry {
+            Entry::Action(a) => self.builder.action(&a),
+            Entry::Block(i, block) => {
+                self.builder.block(i, &block, &mut self.segments)?;
+                for seg in self.segments.drain(..) {
+                    let planner = match &mut self.planner {
+                        Some(p) => p,
+                        None => {
+                            let start = self.builder.start()?;
+                            self.start = Some(Start {
+                                pose: start.0,
+                                joints: start.2,
+                                empty: false,
+                                margins: Margins::ceiling(self.machine.plan),
+                            });
+                            self.planner.insert(Planner::new(
+                                start,
+                                self.machine.kin,
+                                self.machine.plan,
+                            ))
+                        }
+                    };
+                    planner.push(seg, &mut self.cutter)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<(), StreamError> {
+        let m = self.machine;
+        let planner = match self.planner.take() {
+            Some(p) => p,
+            None => {
+                // Nothing moves: the start pose alone, checked by the planner (its travel).
+                let start = self.builder.start()?;
+                self.start = Some(Start {
+                    pose: start.0,
+                    joints: start.2,
+                    empty: true,
+                    margins: Margins::ceiling(m.plan),
+                });
+                Planner::new(start, m.kin, m.plan)
+            }
+        };
+        let end = planner.finish(&mut self.cutter)?;
+        self.cutter.finish(end.duration);
+        self.end = Some(self.builder.joints());
+        Ok(())
+    }
+}
