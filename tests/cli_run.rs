@@ -146,30 +146,20 @@ fn run_help_explains_the_start_pose_and_the_stop() {
     }
 }
 
-/// SIGTERM while `run` plans a long program ends it at once with exit 4, before any drive
-/// is touched: it does not finish the plan and then set up, enable and stop the drives. The
-/// machine file's `can0` does not exist here, so a run that went on would fail to open it
-/// (exit 1).
+/// SIGTERM while `run` is still reading and checking its program ends it at once with
+/// exit 4, before any drive is touched. The program comes through a FIFO whose writer sends
+/// its first lines and then never finishes: the pre-pass waits for the rest, as it would
+/// on a program too slow to read. The machine file's `can0` does not exist here, so a run
+/// that went on would fail to open it (exit 1).
 #[test]
-fn sigterm_while_planning_stops_run_before_the_bus_with_exit_4() {
-    use std::fmt::Write as _;
-    use std::io::{BufRead, BufReader};
-    let prog = temp("long-raster.nc");
-    let mut text = String::from("G90 G21 G94\nG01 X-100 Y0 Z0 F3000\n");
-    // 200 000 moves of 0.1 mm: 100 rows of 200 mm, 0.5 mm apart.
-    for row in 0..100 {
-        let y = 0.5 * f64::from(row);
-        for k in 1..=2000 {
-            let x = if row % 2 == 0 {
-                -100.0 + 0.1 * f64::from(k)
-            } else {
-                100.0 - 0.1 * f64::from(k)
-            };
-            let _ = writeln!(text, "X{x:.4} Y{y:.4}");
-        }
-    }
-    text.push_str("M30\n");
-    std::fs::write(&prog, text).unwrap();
+fn sigterm_while_the_program_is_read_stops_run_before_the_bus_with_exit_4() {
+    use std::io::{BufRead, BufReader, Write};
+    let prog = temp("program.fifo");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&prog)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success());
     let m = machine("paper-ac-table.toml");
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
         .args([
@@ -183,7 +173,15 @@ fn sigterm_while_planning_stops_run_before_the_bus_with_exit_4() {
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("dnurbs run starts");
-    // The banner comes just before the stop handler is installed and planning begins.
+    // Opening the FIFO waits for the reader; the writer stays open, the program unfinished.
+    let mut writer = std::fs::OpenOptions::new()
+        .write(true)
+        .open(&prog)
+        .expect("the FIFO opens");
+    writer
+        .write_all(b"G90 G21 G94\nG01 X-100 Y0 Z0 F3000\nX-99 Y0\n")
+        .unwrap();
+    writer.flush().unwrap();
     let mut err = BufReader::new(child.stderr.take().unwrap());
     let mut banner = String::new();
     err.read_line(&mut banner).unwrap();
@@ -195,6 +193,7 @@ fn sigterm_while_planning_stops_run_before_the_bus_with_exit_4() {
     let mut rest = String::new();
     std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
     let status = child.wait().unwrap();
+    drop(writer);
     assert_eq!(status.code(), Some(4), "{banner}{rest}");
     assert!(
         rest.contains("stop requested (SIGINT/SIGTERM) while planning the program: nothing moved"),

@@ -24,6 +24,10 @@ pub struct Passed {
     pub segments: usize,
     /// Sum of the segments' lengths (mm; degrees for moves that only turn the tool).
     pub length: f64,
+    /// The joints at the program's end, on the rotary branch the interpolator follows.
+    pub end_joints: Joints,
+    /// The first move that waits for the operator (`M00`, `M01` taken, `M06`), if any.
+    pub operator_stop: Option<SrcPos>,
 }
 
 /// Why a program fails the pre-pass.
@@ -142,6 +146,9 @@ pub fn check<S: LineSource>(
                 passed.blocks += 1;
                 passed.segments += segments.len();
                 passed.length += segments.iter().map(|s| s.length).sum::<f64>();
+                if passed.operator_stop.is_none() {
+                    passed.operator_stop = segments.iter().find_map(|s| s.wait.operator);
+                }
                 refused = outside(&builder.joints(), travel, kin, block.pos());
             }
         }
@@ -160,5 +167,6 @@ pub fn check<S: LineSource>(
         return Err(r);
     }
     passed.lines = entries.eof().line;
+    passed.end_joints = builder.joints();
     Ok(passed)
 }

@@ -51,6 +51,7 @@ use heapless::Deque;
 use hold::AxisHold;
 pub use hold::{HoldConfig, HOLD_SHARE};
 pub use source::{Machine, ProgramEntries, ProgramSource, Source, StreamError};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 mod cutter;
 mod hold;
@@ -231,6 +232,8 @@ const REST_V: f64 = V_FLOOR * (1.0 + 1e-9);
 pub struct Queues {
     ready: Queue<Box<Chunk>, QUEUE_N>,
     retired: Queue<Box<Chunk>, QUEUE_N>,
+    /// The source line the planner refused the program at (0: none), [`Feeder::refuse`].
+    refused: AtomicU32,
 }
 
 impl Default for Queues {
@@ -238,6 +241,7 @@ impl Default for Queues {
         Queues {
             ready: Queue::new(),
             retired: Queue::new(),
+            refused: AtomicU32::new(0),
         }
     }
 }
@@ -253,6 +257,7 @@ impl Queues {
     pub fn split(&mut self, depth: usize) -> (Feeder<'_>, Inlet<'_>) {
         let (rp, rc) = self.ready.split();
         let (tp, tc) = self.retired.split();
+        let refused = &self.refused;
         (
             Feeder {
                 ready: rp,
@@ -260,10 +265,12 @@ impl Queues {
                 depth: depth.clamp(MIN_DEPTH, MAX_DEPTH),
                 alive: 0,
                 pushed: 0,
+                refused,
             },
             Inlet {
                 ready: rc,
                 retired: tp,
+                refused,
             },
         )
     }
@@ -276,6 +283,7 @@ pub struct Feeder<'q> {
     depth: usize,
     alive: usize,
     pushed: usize,
+    refused: &'q AtomicU32,
 }
 
 impl Feeder<'_> {
@@ -307,12 +315,19 @@ impl Feeder<'_> {
     pub fn pushed(&self) -> usize {
         self.pushed
     }
+
+    /// The program is refused at source line `line` (an error the planner met ahead of the
+    /// tool): the follower stops along the path with what it has ([`Follower::refused`]).
+    pub fn refuse(&self, line: u32) {
+        self.refused.store(line.max(1), Ordering::Release);
+    }
 }
 
 /// The interpolator's side of the queues.
 pub struct Inlet<'q> {
     ready: Consumer<'q, Box<Chunk>>,
     retired: Producer<'q, Box<Chunk>>,
+    refused: &'q AtomicU32,
 }
 
 /// Counters of a streamed run.
@@ -429,6 +444,17 @@ impl<'q> Follower<'q> {
     /// Decelerate along the path to a stop and stay there (SIGINT, a drive fault).
     pub fn request_stop(&mut self) {
         self.stop_requested = true;
+    }
+
+    /// The source line at which the planner refused the program, once it has: the follower
+    /// is stopping along the path (allocation-free, one atomic load).
+    ///
+    /// Real-time thread.
+    pub fn refused(&self) -> Option<u32> {
+        match self.inlet.refused.load(Ordering::Acquire) {
+            0 => None,
+            line => Some(line),
+        }
     }
 
     /// The operator's feed override, a fraction of the planned feed in 0..=1 (clamped; NaN
@@ -627,6 +653,9 @@ impl<'q> Follower<'q> {
     /// Real-time thread.
     pub fn advance(&mut self) {
         self.pull();
+        if self.refused().is_some() {
+            self.stop_requested = true;
+        }
         let ts = self.hold.period;
         let cycle = self.cycle;
         self.cycle += 1;

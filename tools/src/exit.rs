@@ -26,7 +26,9 @@ pub const COMPLETED_OVERRUNS: u8 = 5;
 pub const TABLE: &str = "Exit codes (every subcommand):
   0  completed cleanly
   1  failed (cannot write a file, open a CAN interface, get real-time privileges; internal)
-  2  bad input: NC program, machine file or command-line value (nothing moved)
+  2  bad input: NC program, machine file or command-line value (nothing moved; or, for a
+     program too long to check whole before it starts, an error found ahead of the tool:
+     stopped along the path, drives disabled)
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
   4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,
@@ -40,6 +42,8 @@ pub enum Outcome {
     CompletedWithOverruns,
     StoppedByFault,
     StoppedByOperator,
+    /// An error in the program met ahead of the tool while it moved: stopped along the path.
+    StoppedByProgram,
 }
 
 impl Outcome {
@@ -49,6 +53,7 @@ impl Outcome {
             Outcome::CompletedWithOverruns => COMPLETED_OVERRUNS,
             Outcome::StoppedByFault => STOPPED_FAULT,
             Outcome::StoppedByOperator => STOPPED_OPERATOR,
+            Outcome::StoppedByProgram => BAD_INPUT,
         }
     }
 
@@ -59,6 +64,7 @@ impl Outcome {
             Outcome::CompletedWithOverruns => "completed with overruns",
             Outcome::StoppedByFault => "stopped by a fault",
             Outcome::StoppedByOperator => "stopped by the operator",
+            Outcome::StoppedByProgram => "stopped by the program",
         }
     }
 }

@@ -6,6 +6,7 @@ pub mod cli;
 pub mod commands;
 pub mod control;
 pub mod exit;
+pub mod feed;
 pub mod report;
 pub mod run;
 pub mod setup;

@@ -57,6 +57,12 @@ pub struct Report {
     /// What on-line compression did, when it was on.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compressed: Option<crate::simulate::Compression>,
+    /// Why the program was refused ahead of the tool (`file:line:col: reason`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refusal: Option<String>,
+    /// How the planner streamed the program.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stream: Option<crate::run::StreamNotes>,
 }
 
 /// Axis names in joint order.
@@ -68,6 +74,7 @@ pub fn outcome(reason: Option<&rt_loop::pipeline::StopReason>, overruns: u64) ->
         None if overruns == 0 => Outcome::Completed,
         None => Outcome::CompletedWithOverruns,
         Some(r) if r.by_operator() => Outcome::StoppedByOperator,
+        Some(rt_loop::pipeline::StopReason::ProgramRefused { .. }) => Outcome::StoppedByProgram,
         Some(_) => Outcome::StoppedByFault,
     }
 }
@@ -93,6 +100,21 @@ impl Report {
         s.push_str(&crate::words::text(&self.program_words));
         if let Some(c) = &self.compressed {
             s.push_str(&c.line());
+        }
+        if let Some(n) = &self.stream {
+            let lines = n.lines.map_or(String::new(), |l| format!(", {l} lines"));
+            let how = if n.checked_whole {
+                "checked whole before motion"
+            } else {
+                "checked beside the planner while it ran"
+            };
+            s.push_str(&format!(
+                "planner: first window planned {:.3} s after the start; program {how}{lines}\n",
+                n.first_window_s
+            ));
+        }
+        if let Some(r) = &self.refusal {
+            s.push_str(&format!("refused: {r}\n"));
         }
         let what = if self.machine.is_empty() {
             self.program.clone()

@@ -11,6 +11,7 @@
 //!   and writes the latency report.
 
 use crate::exit::StoppedBeforeMotion;
+use crate::feed::{Input, Learned, Ready};
 use crate::report::{DriveEnd, Report, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
@@ -20,9 +21,7 @@ use drives::master::{
     configure_nodes, Master, NodeSetup, SetupOptions, Supervision, VelocitySetup,
 };
 use drives::wire::NodeId;
-use nc::plan::plan;
-use nc::segment::build;
-use nc::stream::{chunks, Follower, HoldConfig, Queues, Start};
+use nc::stream::{Follower, HoldConfig, Queues};
 use rt_loop::control::{Command, Commands, Producer};
 use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
 use rt_loop::latency::{RtSettings, INTERVAL_NS};
@@ -33,6 +32,7 @@ use rt_loop::thread::RtMode;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 /// How to run.
@@ -80,6 +80,22 @@ pub struct RunResult {
     pub program_words: Vec<String>,
     /// What on-line compression did, when it was on.
     pub compressed: Option<crate::simulate::Compression>,
+    /// Why the program was refused ahead of the tool (`file:line:col: reason`), if it was.
+    pub refusal: Option<String>,
+    /// How the planner streamed the program.
+    pub stream: Option<StreamNotes>,
+}
+
+/// How the planner streamed the program, for the report.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct StreamNotes {
+    /// Seconds from the planner thread's start to its first window (the pre-pass included
+    /// when the program was checked whole before motion).
+    pub first_window_s: f64,
+    /// The whole program went through the pre-pass before anything moved.
+    pub checked_whole: bool,
+    /// The program's lines, once the pre-pass has read it to its end.
+    pub lines: Option<u32>,
 }
 
 impl RunResult {
@@ -116,110 +132,30 @@ impl RunResult {
             latency: self.stats.summary(),
             program_words: self.program_words.clone(),
             compressed: self.compressed,
+            refusal: self.refusal.clone(),
+            stream: self.stream,
         }
     }
 }
 
-/// The planner's output: the start, the chunks to stream, the end joints and what the
-/// report says about the program.
-type Planned = (
-    Start,
-    Vec<Box<nc::stream::Chunk>>,
-    nc::kinematics::Joints,
-    Notes,
-);
-
-/// What the report says about the program: its words without axes and what on-line
-/// compression did to it.
-#[derive(Clone, Debug, Default)]
-struct Notes {
-    words: Vec<String>,
-    compressed: Option<crate::simulate::Compression>,
-}
-
-/// A program that stops for the operator (`M00`, `M01` with optional stop, `M06`) needs
-/// someone to resume it: without a control socket it is refused before anything moves.
-#[allow(clippy::vec_box)]
-fn operator_reachable(planned: Planned, name: &str, control: bool) -> Result<Planned, InputError> {
-    if !control {
-        let waits = planned.1.iter().flat_map(|c| &c.segments);
-        if let Some(pos) = waits.clone().find_map(|s| s.wait.operator) {
-            return Err(InputError::Usage(format!(
-                "{}:{pos}: the program stops here for the operator (M00, M01 or M06) and \
-                 only the control socket can resume it: run with --control SOCKET (or the \
-                 machine file's [control] socket) and resume with `dnurbs ctl SOCKET resume`",
-                name
-            )));
-        }
-    }
-    Ok(planned)
-}
-
-/// Planner output before streaming.
-#[allow(clippy::vec_box)] // the boxes travel through the queue as pointers
-fn plan_program(
-    src: &[u8],
-    name: &str,
-    setup: &MachineSetup,
-    shop: &nc::parse::Setup,
-    depth: usize,
-) -> Result<Planned, InputError> {
-    let (program, compressed) = setup.prepare(crate::parse_program(src, name, shop)?);
-    let notes = Notes {
-        words: crate::words::describe(&program),
-        compressed: compressed.map(crate::simulate::Compression::from),
-    };
-    let file = std::path::Path::new(name);
-    let path =
-        build(&program, &setup.kin, &setup.build).map_err(|e| InputError::program(file, e))?;
-    let profile = plan(&path, &setup.kin, &setup.plan).map_err(|e| InputError::program(file, e))?;
-    // The program's end, for the closing check of the drive positions.
-    let end = match path.segments.last() {
-        Some(seg) => {
-            let mut prev = path.start_joints;
-            // Joint continuity: walk the last segment from its start to its end.
-            for i in 0..=64 {
-                prev = seg.pose(seg.length * f64::from(i) / 64.0).joints(
-                    &setup.kin,
-                    &prev,
-                    &setup.plan.rotary,
-                );
-            }
-            prev
-        }
-        None => path.start_joints,
-    };
-    let hold = nc::stream::HoldConfig::from_plan(&setup.plan);
-    let (start, list) = chunks(path, &profile, &hold, depth);
-    Ok((start, list, end, notes))
-}
-
-/// Plans the program in a thread of its own while this one watches for SIGINT and SIGTERM:
-/// a stop requested while it plans ends `run` at once, before any drive is touched (the
-/// planning thread is left to finish alone; the process's exit ends it).
-fn plan_in_background(
-    src: &[u8],
-    setup: &MachineSetup,
-    shop: &nc::parse::Setup,
-    opts: &RunOptions,
-    rtc: &config::Realtime,
-) -> anyhow::Result<Planned> {
+/// Starts the planner thread ([`crate::feed`]) and waits for its first window while this
+/// one watches for SIGINT and SIGTERM: a stop requested meanwhile ends `run` at once, before
+/// any drive is touched (the planner thread is left to end alone; the process's exit ends
+/// it, or the `finished` flag once it reads it).
+fn start_planner(
+    job: crate::feed::Job,
+    feeder: nc::stream::Feeder<'static>,
+    finished: Arc<AtomicBool>,
+    learned: Arc<Learned>,
+) -> anyhow::Result<Ready> {
     let (tx, rx) = std::sync::mpsc::sync_channel(1);
-    let src: std::sync::Arc<[u8]> = src.into();
-    let (name, setup, shop) = (opts.name.clone(), setup.clone(), shop.clone());
-    let (depth, control) = (rtc.queue_depth, opts.control.is_some());
     std::thread::Builder::new()
-        .name("dnurbs-plan".into())
-        .spawn(move || {
-            let planned = plan_program(&src, &name, &setup, &shop, depth)
-                .and_then(|p| operator_reachable(p, &name, control));
-            // The receiver is gone if a stop ended the run meanwhile.
-            let _ = tx.send(planned);
-        })?;
+        .name("dnurbs-planner".into())
+        .spawn(move || crate::feed::plan_and_feed(&job, feeder, &finished, tx, &learned))?;
     let stop = os::stop_requested();
     loop {
         match rx.recv_timeout(Duration::from_millis(20)) {
-            Ok(planned) => return Ok(planned?),
+            Ok(ready) => return Ok(ready?),
             Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
                 if stop.load(Ordering::Relaxed) {
                     Err(StoppedBeforeMotion {
@@ -294,6 +230,16 @@ pub fn run<L: CanLink + Send>(
     open_links: impl FnOnce() -> anyhow::Result<Vec<L>>,
     opts: &RunOptions,
 ) -> anyhow::Result<RunResult> {
+    run_input(Input::Text(src.into()), machine, open_links, opts)
+}
+
+/// [`run`] of a program from `input` (a file is read a line at a time as it runs).
+pub fn run_input<L: CanLink + Send>(
+    input: Input,
+    machine: &Machine,
+    open_links: impl FnOnce() -> anyhow::Result<Vec<L>>,
+    opts: &RunOptions,
+) -> anyhow::Result<RunResult> {
     check_drives(machine)?;
     crate::check_bus_load(machine)?;
     let started = crate::report::now_utc();
@@ -302,8 +248,10 @@ pub fn run<L: CanLink + Send>(
     let rtc = &machine.realtime;
     let period = machine.period_s;
     let period_ns = (period * 1e9).round() as u64;
-    let mut queues = Queues::new();
-    let (mut feeder, inlet) = queues.split(rtc.queue_depth);
+    // The queues live as long as the process: the planner thread may outlive a run that a
+    // stop ended while it planned.
+    let queues: &'static mut Queues = Box::leak(Queues::new());
+    let (feeder, inlet) = queues.split(rtc.queue_depth);
     let mut commands = Commands::new();
     let (command_tx, command_rx) = commands.split();
     let server = match &opts.control {
@@ -320,7 +268,7 @@ pub fn run<L: CanLink + Send>(
         }
         None => None,
     };
-    let finished = AtomicBool::new(false);
+    let finished = Arc::new(AtomicBool::new(false));
     let log = match &opts.report {
         Some(dir) => {
             std::fs::create_dir_all(dir)
@@ -335,7 +283,25 @@ pub fn run<L: CanLink + Send>(
     };
     os::install_stop_handler()?;
     let stop = os::stop_requested();
-    let (start, list, end_joints, notes) = plan_in_background(src, &setup, &shop, opts, rtc)?;
+    let learned = Arc::new(Learned::default());
+    let job = crate::feed::Job {
+        input,
+        name: opts.name.clone(),
+        setup: setup.clone(),
+        shop,
+        depth: rtc.queue_depth,
+        control: opts.control.is_some(),
+    };
+    // Whatever way the run ends, the planner thread is told.
+    struct Finish(Arc<AtomicBool>);
+    impl Drop for Finish {
+        fn drop(&mut self) {
+            self.0.store(true, Ordering::Release);
+        }
+    }
+    let _finish = Finish(Arc::clone(&finished));
+    let ready = start_planner(job, feeder, Arc::clone(&finished), Arc::clone(&learned))?;
+    let start = ready.start;
     // Checked before each bus is set up and before the real-time thread starts.
     let stop_before_motion = || -> anyhow::Result<()> {
         if stop.load(Ordering::Relaxed) {
@@ -346,19 +312,7 @@ pub fn run<L: CanLink + Send>(
         Ok(())
     };
 
-    std::thread::scope(|scope| -> anyhow::Result<RunResult> {
-        let finished = &finished;
-        // The planner thread streams the plan.
-        let mut source = list.into_iter();
-        let planner = std::thread::Builder::new()
-            .name("dnurbs-planner".into())
-            .spawn_scoped(scope, move || {
-                while !finished.load(Ordering::Acquire) {
-                    feeder.feed(&mut source);
-                    std::thread::sleep(Duration::from_millis(1));
-                }
-                feeder.feed(&mut std::iter::empty());
-            })?;
+    {
         let result = (|| -> anyhow::Result<RunResult> {
             // Drive set-up on every bus (SDO, PDO mapping, NMT start).
             let mut sopts = SetupOptions::new(period);
@@ -397,13 +351,10 @@ pub fn run<L: CanLink + Send>(
                 buses.push(bus);
             }
             stop_before_motion()?;
-            let end_counts: Vec<Option<i32>> = buses
+            let drive_axes: Vec<_> = buses
                 .iter()
                 .flat_map(|b| b.drives.iter())
-                .map(|d| {
-                    let v = end_joints[d.axis];
-                    d.counts(if d.axis >= 3 { v.to_degrees() } else { v })
-                })
+                .map(|d| (d.axis, d.clone()))
                 .collect();
             let lim = |f: fn(&config::AxisLimits) -> f64| -> [f64; 5] {
                 core::array::from_fn(|j| f(&setup.limits[j]))
@@ -434,26 +385,34 @@ pub fn run<L: CanLink + Send>(
             pipeline.set_max_consecutive_overruns(rtc.max_consecutive_overruns);
             pipeline.set_commands(command_rx);
             let control = server.as_ref().map(|s| (s, command_tx));
-            run_threads(
-                &mut pipeline,
-                period_ns,
-                stop,
-                opts,
-                log,
-                end_counts,
-                control,
-            )
-            .map(|r| RunResult {
+            let r = run_threads(&mut pipeline, period_ns, stop, opts, log, control)?;
+            // The program's end, for the closing check of the drive positions: known once
+            // the pre-pass or the planner has read the whole program.
+            let end = learned.end_joints.get().copied();
+            let end_counts = drive_axes
+                .iter()
+                .map(|(axis, d)| {
+                    let v = end?[*axis];
+                    d.counts(if *axis >= 3 { v.to_degrees() } else { v })
+                })
+                .collect();
+            Ok(RunResult {
                 started,
-                program_words: notes.words,
-                compressed: notes.compressed,
+                program_words: learned.words(),
+                compressed: ready.compressed,
+                end_counts,
+                refusal: learned.refusal().map(|r| r.1),
+                stream: Some(StreamNotes {
+                    first_window_s: ready.first_window_s,
+                    checked_whole: ready.checked_whole,
+                    lines: learned.lines.get().copied(),
+                }),
                 ..r
             })
         })();
         finished.store(true, Ordering::Release);
-        let _ = planner.join();
         result
-    })
+    }
 }
 
 fn run_threads<L: CanLink + Send>(
@@ -462,7 +421,6 @@ fn run_threads<L: CanLink + Send>(
     stop: &'static AtomicBool,
     opts: &RunOptions,
     mut log: Option<rt_loop::report::HlogFile>,
-    end_counts: Vec<Option<i32>>,
     control: Option<(&crate::control::Server, Producer<'_, Command>)>,
 ) -> anyhow::Result<RunResult> {
     let (mut iq, first) = IntervalQueues::new();
@@ -544,11 +502,13 @@ fn run_threads<L: CanLink + Send>(
             started: String::new(),
             realtime,
             drives: Vec::new(),
-            end_counts,
+            end_counts: Vec::new(),
             underruns: 0,
             hard_stops: 0,
             program_words: Vec::new(),
             compressed: None,
+            refusal: None,
+            stream: None,
         })
     })
     .map(|mut r| {

@@ -2,14 +2,17 @@
 //! lines `simulate` and `run` report. The machines dnurbs drives have no spindle or coolant
 //! drive yet, so these are reported, never silently dropped.
 
-use nc::program::{ActionKind, Coolant, Program, Spindle};
+use nc::program::{Action, ActionKind, Coolant, Program, Spindle};
 
 /// One line per action: `line:col  word  what it does`.
 pub fn describe(program: &Program) -> Vec<String> {
-    program
-        .actions
-        .iter()
-        .map(|a| {
+    program.actions.iter().map(describe_action).collect()
+}
+
+/// One action's line: `line:col  word  what it does`.
+pub fn describe_action(a: &Action) -> String {
+    {
+        {
             let what = match a.kind {
                 ActionKind::Spindle { dir, rpm } => match dir {
                     Spindle::Cw => format!("M03 spindle clockwise at S{rpm}"),
@@ -43,8 +46,8 @@ pub fn describe(program: &Program) -> Vec<String> {
                 }
             };
             format!("{}  {what}", a.pos)
-        })
-        .collect()
+        }
+    }
 }
 
 /// The report's section: a heading and the lines, or nothing.

@@ -23,6 +23,16 @@ pub trait LineSource {
     fn eof(&self) -> SrcPos;
 }
 
+impl<L: LineSource + ?Sized> LineSource for Box<L> {
+    fn next_line(&mut self) -> Option<Result<(u32, &str), ParseError>> {
+        (**self).next_line()
+    }
+
+    fn eof(&self) -> SrcPos {
+        (**self).eof()
+    }
+}
+
 /// Line numbers saturate instead of overflowing on absurdly large inputs.
 fn to_u32(n: usize) -> u32 {
     u32::try_from(n).unwrap_or(u32::MAX)

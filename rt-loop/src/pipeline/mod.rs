@@ -97,6 +97,11 @@ pub enum StopReason {
         actual_rpm: f64,
         timeout_s: f64,
     },
+    #[error(
+        "the program is refused at line {line}, ahead of the tool (the refusal says why); \
+         stopped along the path, drives disabled"
+    )]
+    ProgramRefused { line: u32 },
 }
 
 impl StopReason {
@@ -567,6 +572,11 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         self.stage_cycles += 1;
         if stop && self.reason.is_none() && self.stage != Stage::Finished {
             self.stop(StopReason::Requested);
+        }
+        if let Some(line) = self.follower.refused() {
+            if self.reason.is_none() && self.stage != Stage::Finished {
+                self.stop(StopReason::ProgramRefused { line });
+            }
         }
         self.take_commands();
         let mut compute_ns = 0;

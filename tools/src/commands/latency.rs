@@ -52,6 +52,8 @@ pub fn latency(
         machine: String::new(),
         program_words: Vec::new(),
         compressed: None,
+        refusal: None,
+        stream: None,
         outcome: outcome.name(),
         exit_code: outcome.code(),
         stop_reason: None,

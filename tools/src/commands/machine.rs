@@ -76,7 +76,9 @@ pub fn run(
     shop: &crate::shop::ShopArgs,
 ) -> anyhow::Result<Outcome> {
     let m = crate::load_machine(machine)?;
-    let src = std::fs::read(program).map_err(|error| InputError::ReadProgram {
+    // Read a line at a time as it runs (the planner thread opens it; a FIFO is read once):
+    // a program that is not there is exit 2 before anything else.
+    std::fs::metadata(program).map_err(|error| InputError::ReadProgram {
         file: program.display().to_string(),
         error,
     })?;
@@ -128,7 +130,8 @@ pub fn run(
         );
     }
     report_dir(&report)?;
-    let r = crate::run::run(&src, &m, open_links, &opts)?;
+    let input = crate::feed::Input::File(program.to_path_buf());
+    let r = crate::run::run_input(input, &m, open_links, &opts)?;
     let name = program.display().to_string();
     let title = format!("dnurbs run: {name} on {}", m.name);
     finish(

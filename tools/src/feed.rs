@@ -1,0 +1,429 @@
+//! The planner thread of `dnurbs run` and `dnurbs demo`: the program read, built, planned
+//! and cut into chunks a line at a time ([`nc::stream::Source`]), pushed into the queue as
+//! the real-time thread frees room, so memory does not grow with the program and motion
+//! starts once the first window is planned.
+//!
+//! **What is checked before motion.** A program of at most [`CHECK_WHOLE_BYTES`] is read
+//! through the pre-pass ([`nc::prepass`]: syntax, geometry, the travel at every programmed
+//! point) from its first line to its last before anything moves, as `dnurbs check` does: an
+//! error there is exit 2 with nothing touched. A longer one starts after its first window
+//! (checked at the period like every window) while the pre-pass reads the rest beside the
+//! planner. An error either of them meets ahead of the tool stops the tool along the path
+//! (`Feeder::refuse`), disables the drives and ends the run with exit 2, the file, line and
+//! reason in the report.
+
+use crate::exit::InputError;
+use crate::setup::MachineSetup;
+use nc::kinematics::Joints;
+use nc::parse::{Entries, LineSource, ReadLines};
+use nc::program::Action;
+use nc::stream::{
+    Chunk, Feeder, Machine, ProgramEntries, ProgramSource, Source, Start, StreamError,
+};
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
+
+/// Programs up to this size are checked whole before anything moves (about 130 000 lines
+/// of a CAM post, read in about 0.1 s).
+pub const CHECK_WHOLE_BYTES: u64 = 8 << 20;
+
+/// Words without axes kept for the report; more are counted.
+const MAX_WORDS: usize = 1000;
+
+/// Where the program comes from.
+#[derive(Clone, Debug)]
+pub enum Input {
+    /// Its text in memory (the demo's built-in program, the tests).
+    Text(Arc<[u8]>),
+    /// A file, read a line at a time.
+    File(PathBuf),
+}
+
+/// What the planner thread hands the run before anything moves.
+#[derive(Clone, Debug)]
+pub struct Ready {
+    pub start: Start,
+    /// How long the first window took to plan, from the thread's start (the pre-pass, when
+    /// the program is checked whole, included).
+    pub first_window_s: f64,
+    /// The program was checked whole before motion.
+    pub checked_whole: bool,
+    /// What on-line compression did, when it was on.
+    pub compressed: Option<crate::simulate::Compression>,
+}
+
+/// What the planner thread learns as it reads, for the report.
+#[derive(Debug, Default)]
+pub struct Learned {
+    /// The program's end joints, once the pre-pass has read it all.
+    pub end_joints: OnceLock<Joints>,
+    /// The program's lines, once the pre-pass has read it all.
+    pub lines: OnceLock<u32>,
+    /// Why the program was refused ahead of the tool (`file:line:col: reason`).
+    pub refusal: Mutex<Option<(u32, String)>>,
+    /// Words without axes (spindle, coolant, tools, stops, dwells) and how many more.
+    pub words: Mutex<(Vec<String>, usize)>,
+}
+
+impl Learned {
+    fn refuse(&self, line: u32, why: String) {
+        let mut r = self.refusal.lock().unwrap_or_else(|e| e.into_inner());
+        r.get_or_insert((line, why));
+    }
+
+    /// The first refusal, if any.
+    pub fn refusal(&self) -> Option<(u32, String)> {
+        self.refusal
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clone()
+    }
+
+    /// The words, with a last line for those not kept.
+    pub fn words(&self) -> Vec<String> {
+        let w = self.words.lock().unwrap_or_else(|e| e.into_inner());
+        let mut out = w.0.clone();
+        if w.1 > 0 {
+            out.push(format!("... and {} more", w.1));
+        }
+        out
+    }
+}
+
+/// A program's entries, its actions noted for the report on the way.
+struct Noting<'l, E> {
+    inner: E,
+    learned: &'l Learned,
+}
+
+impl<E: ProgramSource> Iterator for Noting<'_, E> {
+    type Item = <E as Iterator>::Item;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let e = self.inner.next();
+        if let Some(Ok(nc::parse::Entry::Action(a))) = &e {
+            note(self.learned, a);
+        }
+        e
+    }
+}
+
+impl<E: ProgramSource> ProgramSource for Noting<'_, E> {
+    fn tilt_word(&self) -> Option<(char, nc::program::SrcPos)> {
+        self.inner.tilt_word()
+    }
+}
+
+fn note(learned: &Learned, a: &Action) {
+    let mut w = learned.words.lock().unwrap_or_else(|e| e.into_inner());
+    if w.0.len() < MAX_WORDS {
+        w.0.push(crate::words::describe_action(a));
+    } else {
+        w.1 += 1;
+    }
+}
+
+/// The run's planner side: what it plans for and where its chunks go.
+#[derive(Clone)]
+pub struct Job {
+    pub input: Input,
+    /// The program's name in messages (its path).
+    pub name: String,
+    pub setup: MachineSetup,
+    pub shop: nc::parse::Setup,
+    pub depth: usize,
+    /// A control socket serves the run (an operator stop can be resumed).
+    pub control: bool,
+}
+
+impl Job {
+    fn unreadable(&self, error: std::io::Error) -> InputError {
+        InputError::ReadProgram {
+            file: self.name.clone(),
+            error,
+        }
+    }
+
+    fn stream_error(&self, e: StreamError) -> InputError {
+        let file = self.name.clone();
+        match e {
+            StreamError::Parse(p) => InputError::Parse {
+                file,
+                errors: nc::parse::ParseErrors {
+                    errors: vec![p],
+                    more: false,
+                },
+            },
+            StreamError::Build(b) => InputError::program(Path::new(&self.name), b),
+            StreamError::Plan(p) => InputError::program(Path::new(&self.name), p),
+        }
+    }
+
+    fn size(&self) -> Result<u64, InputError> {
+        match &self.input {
+            Input::Text(t) => Ok(t.len() as u64),
+            Input::File(p) => std::fs::metadata(p)
+                .map(|m| m.len())
+                .map_err(|e| self.unreadable(e)),
+        }
+    }
+
+    /// A fresh reader over the program's lines.
+    fn lines(&self) -> Result<Box<dyn LineSource + Send>, InputError> {
+        Ok(match &self.input {
+            Input::Text(t) => Box::new(ReadLines::new(std::io::Cursor::new(Arc::clone(t)))),
+            Input::File(p) => {
+                let f = std::fs::File::open(p).map_err(|e| self.unreadable(e))?;
+                Box::new(ReadLines::new(std::io::BufReader::with_capacity(
+                    1 << 16,
+                    f,
+                )))
+            }
+        })
+    }
+
+    /// The pre-pass over the whole program.
+    fn prepass(
+        &self,
+        lines: Box<dyn LineSource + Send>,
+    ) -> Result<nc::prepass::Passed, InputError> {
+        let s = &self.setup;
+        nc::prepass::check(lines, &self.shop, &s.kin, &s.build, &s.plan.travel).map_err(|e| match e
+        {
+            nc::prepass::Refused::Parse(errors) => InputError::Parse {
+                file: self.name.clone(),
+                errors,
+            },
+            other => InputError::Checked {
+                file: self.name.clone(),
+                error: other,
+            },
+        })
+    }
+
+    /// A program that stops for the operator needs someone to resume it.
+    fn operator_reachable(&self, stop: Option<nc::program::SrcPos>) -> Result<(), InputError> {
+        match stop {
+            Some(pos) if !self.control => Err(InputError::Usage(format!(
+                "{}:{pos}: the program stops here for the operator (M00, M01 or M06) and \
+                 only the control socket can resume it: run with --control SOCKET (or the \
+                 machine file's [control] socket) and resume with `dnurbs ctl SOCKET resume`",
+                self.name
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// The planner thread's body: check, plan the first window, say `ready`, then plan and push
+/// chunks into `feeder` until `finished` (the run is over) or the program's end.
+pub fn plan_and_feed(
+    job: &Job,
+    mut feeder: Feeder,
+    finished: &AtomicBool,
+    ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
+    learned: &Arc<Learned>,
+) {
+    let t0 = Instant::now();
+    let source = match prepare(job, learned) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let m = Machine {
+        kin: &job.setup.kin,
+        build: &job.setup.build,
+        plan: &job.setup.plan,
+    };
+    match source {
+        Prepared::Lines(lines, checked, compressed) => {
+            let entries = Noting {
+                inner: Entries::new(lines, &job.shop),
+                learned,
+            };
+            let source = Source::new(entries, m, job.depth);
+            let run = Feed {
+                job,
+                learned,
+                t0,
+                checked,
+                compressed,
+            };
+            run.go(source, &mut feeder, finished, ready);
+        }
+        Prepared::Program(entries, checked, compressed) => {
+            let source = Source::new(entries, m, job.depth);
+            let run = Feed {
+                job,
+                learned,
+                t0,
+                checked,
+                compressed,
+            };
+            run.go(source, &mut feeder, finished, ready);
+        }
+    }
+    // Free what the interpolator handed back.
+    feeder.feed(&mut std::iter::empty());
+}
+
+/// The program's entries, ready to stream, and whether it was checked whole.
+enum Prepared {
+    Lines(
+        Box<dyn LineSource + Send>,
+        bool,
+        Option<crate::simulate::Compression>,
+    ),
+    Program(ProgramEntries, bool, Option<crate::simulate::Compression>),
+}
+
+/// The pre-pass (whole, or started beside the planner) and the source of entries.
+fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
+    let size = job.size()?;
+    let checked = size <= CHECK_WHOLE_BYTES;
+    if checked {
+        let passed = job.prepass(job.lines()?)?;
+        job.operator_reachable(passed.operator_stop)?;
+        let _ = learned.end_joints.set(passed.end_joints);
+        let _ = learned.lines.set(passed.lines);
+    } else {
+        // Beside the planner, with a reader of its own; what it refuses stops the run.
+        let lines = job.lines()?;
+        let j = job.clone();
+        let learned = Arc::clone(learned);
+        std::thread::Builder::new()
+            .name("dnurbs-prepass".into())
+            .spawn(move || {
+                let result = j
+                    .prepass(lines)
+                    .and_then(|p| j.operator_reachable(p.operator_stop).map(|()| p));
+                match result {
+                    Ok(p) => {
+                        let _ = learned.end_joints.set(p.end_joints);
+                        let _ = learned.lines.set(p.lines);
+                    }
+                    Err(e) => learned.refuse(first_line(&e), e.to_string()),
+                }
+            })
+            .map_err(|e| job.unreadable(e))?;
+    }
+    if job.setup.compress.is_some() {
+        // Compression fits runs of moves over the whole program: parsed whole first.
+        let bytes = match &job.input {
+            Input::Text(t) => t.to_vec(),
+            Input::File(p) => std::fs::read(p).map_err(|e| job.unreadable(e))?,
+        };
+        let program = crate::parse_program(&bytes, &job.name, &job.shop)?;
+        for a in &program.actions {
+            note(learned, a);
+        }
+        let (program, c) = job.setup.prepare(program);
+        let c = c.map(crate::simulate::Compression::from);
+        return Ok(Prepared::Program(ProgramEntries::new(program), checked, c));
+    }
+    Ok(Prepared::Lines(job.lines()?, checked, None))
+}
+
+/// The line an input error names (1 if none).
+fn first_line(e: &InputError) -> u32 {
+    let text = e.to_string();
+    // `file:line:col: ...`
+    text.split(':')
+        .nth(1)
+        .and_then(|l| l.trim().parse().ok())
+        .unwrap_or(1)
+}
+
+/// The streaming stage, once the entries are ready.
+struct Feed<'j> {
+    job: &'j Job,
+    learned: &'j Arc<Learned>,
+    t0: Instant,
+    checked: bool,
+    compressed: Option<crate::simulate::Compression>,
+}
+
+impl Feed<'_> {
+    fn go<E: ProgramSource>(
+        self,
+        mut source: Source<'_, E>,
+        feeder: &mut Feeder,
+        finished: &AtomicBool,
+        ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
+    ) {
+        if let Some(&n) = self.learned.lines.get() {
+            source.set_lines(n);
+        }
+        // The first window: motion waits for it.
+        let mut held: VecDeque<Box<Chunk>> = VecDeque::new();
+        match source.next_chunk() {
+            Ok(c) => held.extend(c),
+            Err(e) => {
+                let _ = ready.send(Err(self.job.stream_error(e)));
+                return;
+            }
+        }
+        let Some(start) = source.start() else {
+            let _ = ready.send(Err(InputError::Usage(format!(
+                "{}: the program has no start pose",
+                self.job.name
+            ))));
+            return;
+        };
+        let r = Ready {
+            start,
+            first_window_s: self.t0.elapsed().as_secs_f64(),
+            checked_whole: self.checked,
+            compressed: self.compressed,
+        };
+        if ready.send(Ok(r)).is_err() {
+            return;
+        }
+        let mut stopped = false;
+        while !finished.load(Ordering::Acquire) {
+            if !stopped {
+                if let Some((line, _)) = self.learned.refusal() {
+                    feeder.refuse(line);
+                    stopped = true;
+                }
+            }
+            if let Some(j) = source.end_joints() {
+                let _ = self.learned.end_joints.set(j);
+            }
+            if let Some(&n) = self.learned.lines.get() {
+                source.set_lines(n);
+            }
+            let mut failed = None;
+            if stopped {
+                feeder.feed(&mut std::iter::empty());
+            } else {
+                let mut chunks = std::iter::from_fn(|| {
+                    if let Some(c) = held.pop_front() {
+                        return Some(c);
+                    }
+                    match source.next_chunk() {
+                        Ok(c) => c,
+                        Err(e) => {
+                            failed = Some(e);
+                            None
+                        }
+                    }
+                });
+                feeder.feed(&mut chunks);
+            }
+            if let Some(e) = failed {
+                let line = e.pos().line;
+                self.learned
+                    .refuse(line, self.job.stream_error(e).to_string());
+                feeder.refuse(line);
+                stopped = true;
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+}
