@@ -230,15 +230,8 @@ fn check_run(
     for d in &rep.drives {
         assert_eq!(Some(d.target_counts), d.program_end_counts, "{name}: {d:?}");
     }
-    let axes: Vec<Vec<i32>> = (0..records[usize::from(m.drives[0].node)].len())
-        .map(|k| {
-            m.drives
-                .iter()
-                .map(|d| records[usize::from(d.node)][k].target_counts)
-                .collect()
-        })
-        .collect();
-    within_the_limits_at_the_period(name, m, &setup, &axes);
+    let axes = common::drive_targets(m, &records);
+    common::within_the_limits_at_the_period(name, m, &setup.limits, &axes);
     the_offline_interpolation(name, m, &setup, &prog, &axes);
     let leave = spindle_at_speed_before_the_first_feed_move(name, m, &prog, &records);
     coolant_on_for_the_cut_and_off_at_the_end(name, m, &prog, &records, leave);
@@ -270,40 +263,6 @@ fn the_nx_post_runs_compressed_as_simulate_compresses_it() {
     // Off, the report has no such line.
     let plain = check_run(name, &m, Some(false));
     assert!(plain.compressed.is_none());
-}
-
-/// Velocity and acceleration of every axis by finite differences of the targets at the
-/// period, in counts, against its limits (quantization: 1 and 2 counts).
-fn within_the_limits_at_the_period(
-    name: &str,
-    m: &config::Machine,
-    setup: &MachineSetup,
-    axes: &[Vec<i32>],
-) {
-    for (j, d) in m.drives.iter().enumerate() {
-        let t: Vec<f64> = axes.iter().map(|a| f64::from(a[j])).collect();
-        let lim = &setup.limits[d.axis];
-        let vlim = lim.velocity * d.counts_per_unit * m.period_s;
-        let alim = lim.acceleration * d.counts_per_unit * m.period_s * m.period_s;
-        let v = t
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .fold(0.0, f64::max);
-        let a = t
-            .windows(3)
-            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
-            .fold(0.0, f64::max);
-        assert!(
-            v <= vlim * (1.0 + 1e-6) + 1.0,
-            "{name}: node {} stepped {v} counts in a period, limit {vlim}",
-            d.node
-        );
-        assert!(
-            a <= alim * (1.0 + 1e-6) + 2.0,
-            "{name}: node {} changed its step by {a} counts, limit {alim}",
-            d.node
-        );
-    }
 }
 
 /// The path the drives received is the path `dnurbs simulate` interpolates (whose chord

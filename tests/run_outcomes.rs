@@ -158,3 +158,113 @@ fn a_dense_g01_program_runs_in_the_planned_time_without_a_feed_hold() {
     assert_eq!(rep.stop_reason, None, "{}", rep.text());
     assert_eq!((rep.feed_holds, rep.hard_stops), (0, 0), "{}", rep.text());
 }
+
+/// `program` on the demo machine's simulated drives (in-memory link, the code path of `dnurbs
+/// run`); the report and every target the drives received, SYNC by SYNC.
+fn run_program(program: &str, name: &str) -> (dnurbs_tools::report::Report, Vec<Vec<i32>>) {
+    let mut machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
+        .expect("the demo machine");
+    machine.realtime.feedback_timeout_s = 2.0;
+    machine.realtime.heartbeat_timeout_s = 5.0;
+    machine.realtime.max_consecutive_overruns = 100_000;
+    let (links, sim) = common::sim_drives(&machine, |_| Faults::default());
+    let opts = common::run_options(name, None);
+    let r = run(program.as_bytes(), &machine, move || Ok(links), &opts).expect("the run starts");
+    let mut per_node = vec![Vec::new(); 8];
+    for rec in sim.finish() {
+        per_node[usize::from(rec.node)].push(rec);
+    }
+    let targets = common::drive_targets(&machine, &per_node);
+    let setup = dnurbs_tools::setup::MachineSetup::new(&machine);
+    common::within_the_limits_at_the_period(name, &machine, &setup.limits, &targets);
+    (r.report(name, &machine.name), targets)
+}
+
+/// A dense finishing pass from the origin, where the simulated drives start (so the
+/// approach is nothing): `moves` moves of 0.05 mm out along X to X285 and back at Y1, with a
+/// 0.02 mm ripple in Y, at `feed` mm/min, as a post writes one; a short dwell every
+/// `dwell_every` moves (0: none).
+fn dense_pass(moves: usize, feed: f64, dwell_every: usize) -> String {
+    use std::fmt::Write as _;
+    let mut s = format!("G90 G21 G94 G17\nG01 X0 Y0 Z0 I0 J0 K1 F{feed}\n");
+    for k in 1..=moves {
+        let (x, y0) = if k <= 5_700 {
+            (0.05 * k as f64, 0.0)
+        } else {
+            (285.0 - 0.05 * (k - 5_700) as f64, 1.0)
+        };
+        let y = y0 + 0.02 * (0.3 * k as f64).sin();
+        let _ = writeln!(s, "X{x:.4} Y{y:.4}");
+        if dwell_every > 0 && k % dwell_every == 0 {
+            s.push_str("G04 P0.05\n");
+        }
+    }
+    s
+}
+
+/// Issue "Dense CAM programs", streaming: an error the planner meets ahead of the tool, far
+/// into a program already moving, stops the tool along the path before it gets there (every
+/// target within the velocity and acceleration limits at the period), disables the drives
+/// and ends the run with exit 2 and the line and reason in the report. The program is small
+/// enough to be checked whole before motion, and that check passes: the arc's ends are
+/// within the travel, its top (Y260) is not, which only the planner sees.
+#[test]
+fn an_error_met_ahead_of_the_tool_stops_it_along_the_path_with_exit_2() {
+    // 570 mm of moves, with a dwell every 58 mm: each dwell is a stop, where a window ends,
+    // so the planner reads no further ahead than the queue it fills (about 200 mm here)
+    // and meets the arc while the tool is on its way.
+    let mut src = dense_pass(11_400, 3000.0, 1_160);
+    let arc_line = src.lines().count() + 2;
+    src.push_str("G01 X0 Y230\nG02 X60 Y230 I30 J0\nM30\n");
+    let (rep, targets) = run_program(&src, "arc-past-the-travel.nc");
+    let text = rep.text();
+    assert_eq!(rep.exit_code, exit::BAD_INPUT, "{text}");
+    assert_eq!(rep.outcome, "stopped by the program", "{text}");
+    let refusal = rep.refusal.clone().unwrap_or_default();
+    assert!(
+        refusal.starts_with(&format!("arc-past-the-travel.nc:{arc_line}:")),
+        "{refusal}\n{text}"
+    );
+    assert!(
+        refusal.contains("the Y axis would leave its travel"),
+        "{refusal}"
+    );
+    let stream = rep.stream.expect("the planner's notes");
+    assert!(stream.checked_whole, "{text}");
+    // It moved (from X0), and stopped before the arc.
+    let x: Vec<i32> = targets.iter().map(|t| t[0]).collect();
+    let (first, last) = (x[0], x[x.len() - 1]);
+    assert!(
+        first == 0 && last > 0,
+        "X never moved: {first} .. {last}\n{text}"
+    );
+    // Stopped on the pass, short of the move up to Y230 and the arc (10 000 counts a mm).
+    let y_last = targets[targets.len() - 1][1];
+    assert!(y_last < 2 * 10_000, "Y at {y_last} counts\n{text}");
+}
+
+/// A program too long to check whole before motion (over 8 MiB) starts after its first
+/// window while the pre-pass reads the rest; the pre-pass's refusal of a point at its end
+/// (X400, past the +-300 mm travel) stops the moving tool along the path: exit 2, the line
+/// and reason in the report, every target within the limits at the period.
+#[test]
+fn a_long_program_refused_by_the_pre_pass_while_it_runs_stops_with_exit_2() {
+    let mut src = dense_pass(11_400, 3000.0, 1_160);
+    // Over 8 MiB: comments a post writes, 80 000 lines of them.
+    for k in 0..80_000 {
+        src.push_str(&format!("(operation 1 toolpath segment {k:06} ... ... ... ... ... ... ... ... ... ... ... ... ... ... ... ... ... )\n"));
+    }
+    let bad = src.lines().count() + 1;
+    src.push_str("G01 X400\nM30\n");
+    assert!(src.len() > 8 << 20, "{} bytes", src.len());
+    let (rep, _) = run_program(&src, "long-to-x400.nc");
+    let text = rep.text();
+    assert_eq!(rep.exit_code, exit::BAD_INPUT, "{text}");
+    let refusal = rep.refusal.clone().unwrap_or_default();
+    assert!(
+        refusal.starts_with(&format!("long-to-x400.nc:{bad}:")),
+        "{refusal}\n{text}"
+    );
+    assert!(refusal.contains("X axis at 400"), "{refusal}");
+    assert!(!rep.stream.expect("notes").checked_whole, "{text}");
+}

@@ -332,3 +332,56 @@ impl BootWatch {
         panic!("no boot-up message within {timeout:?} of starting dnurbs sim-drives");
     }
 }
+
+/// The targets the drives of `m` received, SYNC by SYNC, in drive order, from the records of
+/// every node (`per_node[node]`, in order).
+pub fn drive_targets(m: &config::Machine, per_node: &[Vec<drives::sim::Record>]) -> Vec<Vec<i32>> {
+    let n = m
+        .drives
+        .iter()
+        .map(|d| per_node[usize::from(d.node)].len())
+        .min()
+        .unwrap_or(0);
+    (0..n)
+        .map(|k| {
+            m.drives
+                .iter()
+                .map(|d| per_node[usize::from(d.node)][k].target_counts)
+                .collect()
+        })
+        .collect()
+}
+
+/// Velocity and acceleration of every axis by finite differences of the targets at the
+/// period, in counts, against its limits (quantization: 1 and 2 counts).
+pub fn within_the_limits_at_the_period(
+    name: &str,
+    m: &config::Machine,
+    limits: &[config::AxisLimits; 5],
+    axes: &[Vec<i32>],
+) {
+    for (j, d) in m.drives.iter().enumerate() {
+        let t: Vec<f64> = axes.iter().map(|a| f64::from(a[j])).collect();
+        let lim = &limits[d.axis];
+        let vlim = lim.velocity * d.counts_per_unit * m.period_s;
+        let alim = lim.acceleration * d.counts_per_unit * m.period_s * m.period_s;
+        let v = t
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        let a = t
+            .windows(3)
+            .map(|w| (w[2] - 2.0 * w[1] + w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            v <= vlim * (1.0 + 1e-6) + 1.0,
+            "{name}: node {} stepped {v} counts in a period, limit {vlim}",
+            d.node
+        );
+        assert!(
+            a <= alim * (1.0 + 1e-6) + 2.0,
+            "{name}: node {} changed its step by {a} counts, limit {alim}",
+            d.node
+        );
+    }
+}

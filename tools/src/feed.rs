@@ -240,46 +240,51 @@ pub fn plan_and_feed(
         build: &job.setup.build,
         plan: &job.setup.plan,
     };
-    match source {
-        Prepared::Lines(lines, checked, compressed) => {
+    let run = Feed {
+        job,
+        learned,
+        t0,
+        checked: source.checked,
+        compressed: source.compressed,
+    };
+    match source.entries {
+        From::Lines(lines) => {
             let entries = Noting {
                 inner: Entries::new(lines, &job.shop),
                 learned,
             };
-            let source = Source::new(entries, m, job.depth);
-            let run = Feed {
-                job,
-                learned,
-                t0,
-                checked,
-                compressed,
-            };
-            run.go(source, &mut feeder, finished, ready);
+            run.go(
+                Source::new(entries, m, job.depth),
+                &mut feeder,
+                finished,
+                ready,
+            );
         }
-        Prepared::Program(entries, checked, compressed) => {
-            let source = Source::new(entries, m, job.depth);
-            let run = Feed {
-                job,
-                learned,
-                t0,
-                checked,
-                compressed,
-            };
-            run.go(source, &mut feeder, finished, ready);
+        From::Program(entries) => {
+            run.go(
+                Source::new(*entries, m, job.depth),
+                &mut feeder,
+                finished,
+                ready,
+            );
         }
     }
     // Free what the interpolator handed back.
     feeder.feed(&mut std::iter::empty());
 }
 
-/// The program's entries, ready to stream, and whether it was checked whole.
-enum Prepared {
-    Lines(
-        Box<dyn LineSource + Send>,
-        bool,
-        Option<crate::simulate::Compression>,
-    ),
-    Program(ProgramEntries, bool, Option<crate::simulate::Compression>),
+/// The program's entries, ready to stream, whether it was checked whole, and what
+/// compression did to it.
+struct Prepared {
+    entries: From,
+    checked: bool,
+    compressed: Option<crate::simulate::Compression>,
+}
+
+/// Where the entries come from: the program's lines, or the program parsed whole.
+enum From {
+    Lines(Box<dyn LineSource + Send>),
+    Program(Box<ProgramEntries>),
 }
 
 /// The pre-pass (whole, or started beside the planner) and the source of entries.
@@ -324,9 +329,17 @@ fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
         }
         let (program, c) = job.setup.prepare(program);
         let c = c.map(crate::simulate::Compression::from);
-        return Ok(Prepared::Program(ProgramEntries::new(program), checked, c));
+        return Ok(Prepared {
+            entries: From::Program(Box::new(ProgramEntries::new(program))),
+            checked,
+            compressed: c,
+        });
     }
-    Ok(Prepared::Lines(job.lines()?, checked, None))
+    Ok(Prepared {
+        entries: From::Lines(job.lines()?),
+        checked,
+        compressed: None,
+    })
 }
 
 /// The line an input error names (1 if none).
