@@ -13,35 +13,12 @@ mod common;
 
 use dnurbs_tools::setup::MachineSetup;
 use nc::parse::{ReadLines, Setup};
-use std::io::{BufWriter, Write};
 use std::time::Instant;
 
 const MACHINE: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/../config/machines/paper-ac-table.toml"
 );
-
-/// Writes the n-move wiggle ([`common::wiggle_point`]) as `g01_program` would.
-fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
-    let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
-    w.write_all(b"%\nG90 G21 G94\n")?;
-    for k in 0..=n {
-        let (x, y) = common::wiggle_point(k);
-        let g = if k < 2 { "G01 " } else { "" };
-        let f = if k == 0 { " F3000" } else { "" };
-        writeln!(
-            w,
-            "N{} {g}X{x:.4} Y{y:.4} Z{:.4} I{:.6} J{:.6} K{:.6}{f}",
-            10 * (k + 1),
-            0.0,
-            0.0,
-            0.0,
-            1.0
-        )?;
-    }
-    w.write_all(b"M30\n%\n")?;
-    w.flush()
-}
 
 fn main() {
     // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
@@ -56,7 +33,7 @@ fn main() {
     for &n in &sizes {
         let path =
             std::env::temp_dir().join(format!("dnurbs-prepass-{}-{n}.nc", std::process::id()));
-        write_wiggle(&path, n).expect("the program is written");
+        common::write_wiggle(&path, n).expect("the program is written");
         let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
         // Reset the peak: what follows is the pre-pass's alone.
         common::reset_peak();

@@ -72,6 +72,10 @@ pub enum Command {
         /// Serve the control socket here (see `dnurbs ctl`).
         #[arg(long, value_name = "SOCKET")]
         control: Option<PathBuf>,
+        /// Run this NC program instead of the paper's example, on the same machine and
+        /// simulated drives, read a line at a time as it runs (as `dnurbs run` does).
+        #[arg(long, value_name = "FILE")]
+        program: Option<PathBuf>,
     },
     /// Run a program on the machine's CiA-402 drives over SocketCAN.
     ///

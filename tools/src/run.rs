@@ -545,20 +545,24 @@ pub const DEMO_QUEUE_FRAMES: usize = 1024;
 pub fn demo(
     opts: &RunOptions,
     link: DemoLink,
+    input: Input,
 ) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
     let machine = config::from_str(
         DEMO_MACHINE,
         std::path::Path::new("config/machines/paper-ac-table.toml"),
     )?;
     match link {
-        DemoLink::Memory => demo_on(&machine, opts, || Ok(MemLink::pair(DEMO_QUEUE_FRAMES))),
-        DemoLink::Socketpair => demo_on(&machine, opts, SocketLink::pair),
+        DemoLink::Memory => demo_on(&machine, opts, input, || {
+            Ok(MemLink::pair(DEMO_QUEUE_FRAMES))
+        }),
+        DemoLink::Socketpair => demo_on(&machine, opts, input, SocketLink::pair),
     }
 }
 
 fn demo_on<L: CanLink + Send + 'static>(
     machine: &Machine,
     opts: &RunOptions,
+    input: Input,
     pair: impl Fn() -> std::io::Result<(L, L)>,
 ) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
     let mut links = Vec::new();
@@ -582,7 +586,7 @@ fn demo_on<L: CanLink + Send + 'static>(
         )?);
         links.push(master_end);
     }
-    let result = run(DEMO_PROGRAM.as_bytes(), machine, move || Ok(links), opts);
+    let result = run_input(input, machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))
 }

@@ -1,5 +1,9 @@
-//! What the benches `linear` and `prepass` share: the program sizes to run, the dense G01
-//! path they run, and the process's peak resident memory.
+//! What the benches `linear`, `prepass` and `stream` share: the program sizes to run, the
+//! dense G01 path they run (in memory, or written to a file), and the process's peak
+//! resident memory.
+#![allow(dead_code)] // each bench uses part of it
+
+use std::io::{BufWriter, Write};
 
 /// The sizes (moves) in `BENCH_MOVES`, comma-separated, else `default`.
 pub fn sizes(default: &str) -> Vec<usize> {
@@ -37,4 +41,26 @@ pub fn peak_mb() -> f64 {
         .find_map(|l| l.strip_prefix("VmHWM:"))
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<f64>().ok())
         .map_or(f64::NAN, |kb| kb / 1024.0)
+}
+
+/// Writes the n-move wiggle ([`wiggle_point`]) as `g01_program` would.
+pub fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
+    let mut w = BufWriter::with_capacity(1 << 20, std::fs::File::create(path)?);
+    w.write_all(b"%\nG90 G21 G94\n")?;
+    for k in 0..=n {
+        let (x, y) = wiggle_point(k);
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 { " F3000" } else { "" };
+        writeln!(
+            w,
+            "N{} {g}X{x:.4} Y{y:.4} Z{:.4} I{:.6} J{:.6} K{:.6}{f}",
+            10 * (k + 1),
+            0.0,
+            0.0,
+            0.0,
+            1.0
+        )?;
+    }
+    w.write_all(b"M30\n%\n")?;
+    w.flush()
 }

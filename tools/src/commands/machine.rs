@@ -30,11 +30,21 @@ pub fn demo(
     rt: rt_loop::latency::RtSettings,
     lead_ns: u64,
     control: Option<PathBuf>,
+    program: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
     keep_off_rt_cpu(rt)?;
     report_dir(&report)?;
+    let name = program
+        .as_ref()
+        .map_or("paper-example.nc".into(), |p| p.display().to_string());
+    if let Some(p) = &program {
+        std::fs::metadata(p).map_err(|error| InputError::ReadProgram {
+            file: name.clone(),
+            error,
+        })?;
+    }
     let opts = RunOptions {
-        name: "paper-example.nc".into(),
+        name: name.clone(),
         approach: true,
         rt,
         lead_ns,
@@ -48,22 +58,28 @@ pub fn demo(
         DemoLink::Memory => "an in-memory CAN link",
         DemoLink::Socketpair => "a socketpair CAN link",
     };
+    let what = match &program {
+        Some(_) => name.clone(),
+        None => "the paper's example".into(),
+    };
     eprintln!(
-        "dnurbs demo: the paper's example on the paper's A/C table machine, 5 simulated \
+        "dnurbs demo: {what} on the paper's A/C table machine, 5 simulated \
          CiA-402 drives on {bus}, 2 ms period{}{}",
         lead_text(lead_ns),
         cpu_text(rt)
     );
-    let (r, records) = crate::run::demo(&opts, link)?;
+    let input = match program {
+        Some(p) => crate::feed::Input::File(p),
+        None => crate::feed::Input::Text(crate::run::DEMO_PROGRAM.as_bytes().into()),
+    };
+    let (r, records) = crate::run::demo(&opts, link, input)?;
     println!("simulated drives received {} targets", records.len());
-    finish(
-        &r,
-        report,
-        "paper-example.nc",
-        "paper-ac-table",
-        "dnurbs demo: paper example, 2 ms",
-        2_000_000,
-    )
+    let title = if name == "paper-example.nc" {
+        "dnurbs demo: paper example, 2 ms".to_string()
+    } else {
+        format!("dnurbs demo: {name}, 2 ms")
+    };
+    finish(&r, report, &name, "paper-ac-table", &title, 2_000_000)
 }
 
 pub fn run(

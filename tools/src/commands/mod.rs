@@ -29,12 +29,14 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             cpu,
             lead,
             control,
+            program,
         } => machine::demo(
             report,
             link,
             cpu.settings((!no_rt).then_some(80)),
             lead,
             control,
+            program,
         ),
         Command::Run {
             program,
