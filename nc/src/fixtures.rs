@@ -8,6 +8,30 @@ use crate::plan::{AxisLimit, FeedProfile, PlanConfig};
 use crate::segment::{BuildLimits, Path};
 use nalgebra::Vector3;
 
+/// The programs of `tests/data` the planner's tests plan on the small mill: the test
+/// programs and the classics it accepts.
+pub const TEST_PROGRAMS: [&str; 13] = [
+    "g01-5axis.nc",
+    "g062-example.nc",
+    "helix-ramp.nc",
+    "paper-example.nc",
+    "tight-curvature.nc",
+    "two-blocks-g2.nc",
+    "vertical-turns.nc",
+    "classics/butterfly.nc",
+    "classics/dual-spline.nc",
+    "classics/fan-5axis.nc",
+    "classics/figure-eight-circles.nc",
+    "classics/figure-eight-weights.nc",
+    "classics/star.nc",
+];
+
+/// The text of `tests/data/<rel>` (for the tests; panics with the path if unreadable).
+pub fn test_program(rel: &str) -> String {
+    let p = format!("{}/../tests/data/{rel}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e}"))
+}
+
 /// Degree of the paper's block (`G06.5 P3`).
 pub const PAPER_DEGREE: usize = 3;
 /// Cutter-centre control points X Y Z of the paper's block.

@@ -14,11 +14,6 @@ use nc::verify::Margins;
 const PERIOD: f64 = 0.002;
 const DEPTH: usize = 64;
 
-fn data(rel: &str) -> String {
-    let p = format!("{}/../tests/data/{rel}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e}"))
-}
-
 fn streamed(
     text: &str,
     kin: &MachineKinematics,
@@ -112,20 +107,8 @@ fn a_streamed_program_gives_the_chunks_of_its_whole_plan() {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let mut chunks = 0;
-    for rel in [
-        "g01-5axis.nc",
-        "g062-example.nc",
-        "helix-ramp.nc",
-        "paper-example.nc",
-        "tight-curvature.nc",
-        "two-blocks-g2.nc",
-        "vertical-turns.nc",
-        "classics/butterfly.nc",
-        "classics/dual-spline.nc",
-        "classics/fan-5axis.nc",
-        "classics/star.nc",
-    ] {
-        chunks += same_chunks(rel, &data(rel), &kin, &cfg, &bl);
+    for rel in nc::fixtures::TEST_PROGRAMS {
+        chunks += same_chunks(rel, &nc::fixtures::test_program(rel), &kin, &cfg, &bl);
     }
     assert!(chunks > 20, "{chunks} chunks");
 }
@@ -134,7 +117,7 @@ fn a_streamed_program_gives_the_chunks_of_its_whole_plan() {
 fn a_streamed_program_is_refused_where_the_whole_one_is() {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::adversarial_mill(PERIOD);
-    let text = data("paper-example.nc");
+    let text = nc::fixtures::test_program("paper-example.nc");
     let end = text
         .lines()
         .position(|l| l.starts_with("M30") || l.starts_with("M02"))

@@ -13,11 +13,6 @@ use nc::segment::{build, Path};
 
 const PERIOD: f64 = 0.002;
 
-fn data(rel: &str) -> String {
-    let p = format!("{}/../tests/data/{rel}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e}"))
-}
-
 fn planner<'a>(
     path: &Path,
     kin: &'a MachineKinematics,
@@ -65,29 +60,17 @@ fn dropping_what_the_check_has_read_changes_no_plan() {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let mut accepted = 0;
-    let mut programs: Vec<(String, String)> = [
-        "g01-5axis.nc",
-        "g062-example.nc",
-        "helix-ramp.nc",
-        "paper-example.nc",
-        "tight-curvature.nc",
-        "two-blocks-g2.nc",
-        "vertical-turns.nc",
-        "classics/butterfly.nc",
-        "classics/dual-spline.nc",
-        "classics/fan-5axis.nc",
-        "classics/star.nc",
-    ]
-    .iter()
-    .map(|rel| (rel.to_string(), data(rel)))
-    .collect();
+    let mut programs: Vec<(String, String)> = nc::fixtures::TEST_PROGRAMS
+        .iter()
+        .map(|rel| (rel.to_string(), nc::fixtures::test_program(rel)))
+        .collect();
     programs.push(("raster".into(), raster(12, 20.0, 0.1)));
     for (name, text) in &programs {
         let program = nc::parse::parse(text).expect("parses");
         let path = build(&program, &kin, &bl).expect("builds");
         accepted += same_either_way(name, &path, &kin, &cfg);
     }
-    assert!(accepted >= 30, "{accepted} plans accepted");
+    assert!(accepted >= 36, "{accepted} plans accepted");
 }
 
 #[test]

@@ -60,32 +60,13 @@ fn every_reach_holds(
         .collect()
 }
 
-fn data(rel: &str) -> String {
-    let p = format!("{}/../tests/data/{rel}", env!("CARGO_MANIFEST_DIR"));
-    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{p}: {e}"))
-}
-
 #[test]
 fn the_test_programs_hold_every_limit_at_any_look_ahead() {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
     let mut accepted = 0;
-    for rel in [
-        "g01-5axis.nc",
-        "g062-example.nc",
-        "helix-ramp.nc",
-        "paper-example.nc",
-        "tight-curvature.nc",
-        "two-blocks-g2.nc",
-        "vertical-turns.nc",
-        "classics/butterfly.nc",
-        "classics/dual-spline.nc",
-        "classics/fan-5axis.nc",
-        "classics/figure-eight-circles.nc",
-        "classics/figure-eight-weights.nc",
-        "classics/star.nc",
-    ] {
-        let program = nc::parse::parse(&data(rel)).expect("parses");
+    for rel in nc::fixtures::TEST_PROGRAMS {
+        let program = nc::parse::parse(&nc::fixtures::test_program(rel)).expect("parses");
         let path = build(&program, &kin, &bl).expect("builds");
         let times = every_reach_holds(rel, &path, &kin, &cfg);
         assert!(times[0].is_some(), "{rel} is refused");

@@ -16,11 +16,6 @@ use nalgebra::Vector3;
 use nc::interp::Method;
 use std::time::{Duration, Instant};
 
-const MACHINE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../config/machines/paper-ac-table.toml"
-);
-
 /// The n-move wiggle ([`common::wiggle_point`]) as a G01 program.
 fn wiggle(n: usize) -> String {
     let points: Vec<_> = (0..=n)
@@ -83,8 +78,7 @@ fn once(src: &str, setup: &MachineSetup) -> Times {
 }
 
 fn main() {
-    // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
-    if !std::env::args().any(|a| a == "--bench") {
+    if !common::benching() {
         return;
     }
     let sizes = common::sizes("10000,100000");
@@ -92,8 +86,7 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(3);
-    let machine = config::load(std::path::Path::new(MACHINE)).expect("the paper machine loads");
-    let setup = MachineSetup::new(&machine);
+    let (_, setup) = common::paper_machine();
     println!(
         "simulate's stages on {n} sizes (best of {repeat}), paper-ac-table:",
         n = sizes.len()

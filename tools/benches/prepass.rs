@@ -11,23 +11,15 @@
 
 mod common;
 
-use dnurbs_tools::setup::MachineSetup;
 use nc::parse::{ReadLines, Setup};
 use std::time::Instant;
 
-const MACHINE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../config/machines/paper-ac-table.toml"
-);
-
 fn main() {
-    // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
-    if !std::env::args().any(|a| a == "--bench") {
+    if !common::benching() {
         return;
     }
     let sizes = common::sizes("100000,1000000");
-    let machine = config::load(std::path::Path::new(MACHINE)).expect("the paper machine loads");
-    let setup = MachineSetup::new(&machine);
+    let (_, setup) = common::paper_machine();
     println!("the pre-pass on {} sizes, paper-ac-table:", sizes.len());
     let mut before: Option<(usize, f64)> = None;
     for &n in &sizes {

@@ -13,24 +13,16 @@
 
 mod common;
 
-use dnurbs_tools::setup::MachineSetup;
 use nc::parse::{Entries, ReadLines, Setup};
 use nc::stream::{Machine, Source};
 use std::time::Instant;
 
-const MACHINE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../config/machines/paper-ac-table.toml"
-);
-
 fn main() {
-    // `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
-    if !std::env::args().any(|a| a == "--bench") {
+    if !common::benching() {
         return;
     }
     let sizes = common::sizes("100000,1000000");
-    let machine = config::load(std::path::Path::new(MACHINE)).expect("the paper machine loads");
-    let setup = MachineSetup::new(&machine);
+    let (machine, setup) = common::paper_machine();
     let shop = Setup::default();
     let depth = machine.realtime.queue_depth;
     println!(

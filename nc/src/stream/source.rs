@@ -184,20 +184,12 @@ impl<'a, E: ProgramSource> Source<'a, E> {
                 for seg in self.segments.drain(..) {
                     let planner = match &mut self.planner {
                         Some(p) => p,
-                        None => {
-                            let start = self.builder.start()?;
-                            self.start = Some(Start {
-                                pose: start.0,
-                                joints: start.2,
-                                empty: false,
-                                margins: Margins::ceiling(self.machine.plan),
-                            });
-                            self.planner.insert(Planner::new(
-                                start,
-                                self.machine.kin,
-                                self.machine.plan,
-                            ))
-                        }
+                        None => self.planner.insert(Self::planner_for(
+                            &self.builder,
+                            self.machine,
+                            &mut self.start,
+                            false,
+                        )?),
                     };
                     planner.push(seg, &mut self.cutter)?;
                 }
@@ -206,21 +198,29 @@ impl<'a, E: ProgramSource> Source<'a, E> {
         Ok(())
     }
 
+    /// The planner, once the builder's start pose is final (a segment is built, or the
+    /// program ended: `empty`), and the program's start.
+    fn planner_for(
+        builder: &Builder,
+        m: Machine<'a>,
+        start: &mut Option<Start>,
+        empty: bool,
+    ) -> Result<Planner<'a>, StreamError> {
+        let pose = builder.start()?;
+        *start = Some(Start {
+            pose: pose.0,
+            joints: pose.2,
+            empty,
+            margins: Margins::ceiling(m.plan),
+        });
+        Ok(Planner::new(pose, m.kin, m.plan))
+    }
+
     fn finish(&mut self) -> Result<(), StreamError> {
-        let m = self.machine;
         let planner = match self.planner.take() {
             Some(p) => p,
-            None => {
-                // Nothing moves: the start pose alone, checked by the planner (its travel).
-                let start = self.builder.start()?;
-                self.start = Some(Start {
-                    pose: start.0,
-                    joints: start.2,
-                    empty: true,
-                    margins: Margins::ceiling(m.plan),
-                });
-                Planner::new(start, m.kin, m.plan)
-            }
+            // Nothing moves: the start pose alone, checked by the planner (its travel).
+            None => Self::planner_for(&self.builder, self.machine, &mut self.start, true)?,
         };
         let end = planner.finish(&mut self.cutter)?;
         self.cutter.finish(end.duration);

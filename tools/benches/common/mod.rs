@@ -5,6 +5,22 @@
 
 use std::io::{BufWriter, Write};
 
+/// The paper machine (`config/machines/paper-ac-table.toml`) and its nc types.
+pub fn paper_machine() -> (config::Machine, dnurbs_tools::setup::MachineSetup) {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../config/machines/paper-ac-table.toml"
+    );
+    let machine = config::load(std::path::Path::new(file)).expect("the paper machine loads");
+    let setup = dnurbs_tools::setup::MachineSetup::new(&machine);
+    (machine, setup)
+}
+
+/// `cargo bench` passes `--bench`; `cargo test --benches` does not, and only builds it.
+pub fn benching() -> bool {
+    std::env::args().any(|a| a == "--bench")
+}
+
 /// The sizes (moves) in `BENCH_MOVES`, comma-separated, else `default`.
 pub fn sizes(default: &str) -> Vec<usize> {
     std::env::var("BENCH_MOVES")
