@@ -73,6 +73,36 @@ fn dropping_what_the_check_has_read_changes_no_plan() {
     assert!(accepted >= 36, "{accepted} plans accepted");
 }
 
+/// 0.04 mm chords at F6000 (5 a period at 2 ms) along a line that turns by 0.3 degrees,
+/// one way then back, every `every` chords: each turn a kink (not G2-smooth) too slight to
+/// slow the feed, the joints between them smooth. A kink's one-sided stencils read the path
+/// three periods back, many chords behind the check's resumption mark.
+fn kinked_line(n: usize, every: usize) -> String {
+    let mut points = vec![(Vector3::zeros(), Vector3::z())];
+    let (mut p, mut heading) = (Vector3::<f64>::zeros(), 0.0f64);
+    for k in 1..=n {
+        if k % every == 0 {
+            heading = if heading == 0.0 {
+                0.3f64.to_radians()
+            } else {
+                0.0
+            };
+        }
+        p += 0.04 * Vector3::new(heading.cos(), heading.sin(), 0.0);
+        points.push((p - Vector3::new(200.0, 0.0, 0.0), Vector3::z()));
+    }
+    nc::fixtures::g01_program(&points, 6000.0)
+}
+
+#[test]
+fn short_chords_between_kinks_plan_the_same_when_the_front_is_dropped() {
+    let kin = MachineKinematics::Paper;
+    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
+    let program = nc::parse::parse(&kinked_line(10_000, 16)).expect("parses");
+    let path = build(&program, &kin, &bl).expect("builds");
+    assert_eq!(same_either_way("kinked line", &path, &kin, &cfg), 3);
+}
+
 #[test]
 fn a_refusal_is_the_same_when_the_front_is_dropped() {
     // X travel is +-300 on the adversarial mill: the move to X400 at the end of a long

@@ -26,9 +26,10 @@ pub const COMPLETED_OVERRUNS: u8 = 5;
 pub const TABLE: &str = "Exit codes (every subcommand):
   0  completed cleanly
   1  failed (cannot write a file, open a CAN interface, get real-time privileges; internal)
-  2  bad input: NC program, machine file or command-line value (nothing moved; or, for a
-     program too long to check whole before it starts, an error found ahead of the tool:
-     stopped along the path, drives disabled)
+  2  bad input: NC program, machine file or command-line value (nothing moved; or an
+     error in the program met ahead of the moving tool, by the planner or, for a program
+     too long to check whole before it starts, the pre-pass: stopped along the path,
+     drives disabled)
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
   4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,

@@ -22,7 +22,7 @@ use nc::stream::{
 };
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
@@ -66,6 +66,8 @@ pub struct Learned {
     pub refusal: Mutex<Option<(u32, String)>>,
     /// Words without axes (spindle, coolant, tools, stops, dwells) and how many more.
     pub words: Mutex<(Vec<String>, usize)>,
+    /// The line of the last block the planner read (what an internal error names).
+    pub planning_line: AtomicU32,
 }
 
 impl Learned {
@@ -104,8 +106,14 @@ impl<E: ProgramSource> Iterator for Noting<'_, E> {
 
     fn next(&mut self) -> Option<Self::Item> {
         let e = self.inner.next();
-        if let Some(Ok(nc::parse::Entry::Action(a))) = &e {
-            note(self.learned, a);
+        match &e {
+            Some(Ok(nc::parse::Entry::Action(a))) => note(self.learned, a),
+            Some(Ok(nc::parse::Entry::Block(_, b))) => {
+                self.learned
+                    .planning_line
+                    .store(b.pos().line, Ordering::Relaxed);
+            }
+            _ => {}
         }
         e
     }
@@ -191,8 +199,13 @@ impl Job {
         lines: Box<dyn LineSource + Send>,
     ) -> Result<nc::prepass::Passed, InputError> {
         let s = &self.setup;
-        nc::prepass::check(lines, &self.shop, &s.kin, &s.build, &s.plan.travel).map_err(|e| match e
-        {
+        nc::prepass::check(lines, &self.shop, &s.kin, &s.build, &s.plan.travel)
+            .map_err(|e| self.refused(e))
+    }
+
+    /// The pre-pass's refusal as an input error naming the file.
+    fn refused(&self, e: nc::prepass::Refused) -> InputError {
+        match e {
             nc::prepass::Refused::Parse(errors) => InputError::Parse {
                 file: self.name.clone(),
                 errors,
@@ -201,7 +214,7 @@ impl Job {
                 file: self.name.clone(),
                 error: other,
             },
-        })
+        }
     }
 
     /// A program that stops for the operator needs someone to resume it.
@@ -227,7 +240,60 @@ pub fn plan_and_feed(
     ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
     learned: &Arc<Learned>,
 ) {
+    // A panic here must not leave the tool holding for data that never comes: the run is
+    // refused at the line being planned, and stops along the path. (Before the first
+    // window the dropped sender ends the run: "the planner thread ended without a result".)
+    let body =
+        std::panic::AssertUnwindSafe(|| feed_program(job, &mut feeder, finished, ready, learned));
+    if let Err(panic) = std::panic::catch_unwind(body) {
+        let what = panic
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| panic.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        let line = learned.planning_line.load(Ordering::Relaxed);
+        learned.refuse(
+            line,
+            format!("{}:{line}: internal error in the planner: {what}", job.name),
+        );
+        feeder.refuse(line);
+        while !finished.load(Ordering::Acquire) {
+            feeder.feed(&mut std::iter::empty());
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    }
+    // Free what the interpolator handed back.
+    feeder.feed(&mut std::iter::empty());
+}
+
+fn feed_program(
+    job: &Job,
+    feeder: &mut Feeder,
+    finished: &AtomicBool,
+    ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
+    learned: &Arc<Learned>,
+) {
     let t0 = Instant::now();
+    // A pipe or FIFO can be read once: read it whole, then as a program in memory.
+    let piped;
+    let job = match &job.input {
+        Input::File(p) if !std::fs::metadata(p).is_ok_and(|m| m.is_file()) => {
+            match std::fs::read(p) {
+                Ok(bytes) => {
+                    piped = Job {
+                        input: Input::Text(bytes.into()),
+                        ..job.clone()
+                    };
+                    &piped
+                }
+                Err(e) => {
+                    let _ = ready.send(Err(job.unreadable(e)));
+                    return;
+                }
+            }
+        }
+        _ => job,
+    };
     let source = match prepare(job, learned) {
         Ok(s) => s,
         Err(e) => {
@@ -253,24 +319,12 @@ pub fn plan_and_feed(
                 inner: Entries::new(lines, &job.shop),
                 learned,
             };
-            run.go(
-                Source::new(entries, m, job.depth),
-                &mut feeder,
-                finished,
-                ready,
-            );
+            run.go(Source::new(entries, m, job.depth), feeder, finished, ready);
         }
         From::Program(entries) => {
-            run.go(
-                Source::new(*entries, m, job.depth),
-                &mut feeder,
-                finished,
-                ready,
-            );
+            run.go(Source::new(*entries, m, job.depth), feeder, finished, ready);
         }
     }
-    // Free what the interpolator handed back.
-    feeder.feed(&mut std::iter::empty());
 }
 
 /// The program's entries, ready to stream, whether it was checked whole, and what
@@ -304,15 +358,18 @@ fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
         std::thread::Builder::new()
             .name("dnurbs-prepass".into())
             .spawn(move || {
-                let result = j
-                    .prepass(lines)
-                    .and_then(|p| j.operator_reachable(p.operator_stop).map(|()| p));
-                match result {
-                    Ok(p) => {
-                        let _ = learned.end_joints.set(p.end_joints);
-                        let _ = learned.lines.set(p.lines);
-                    }
-                    Err(e) => learned.refuse(first_line(&e), e.to_string()),
+                let s = &j.setup;
+                match nc::prepass::check(lines, &j.shop, &s.kin, &s.build, &s.plan.travel) {
+                    Ok(p) => match j.operator_reachable(p.operator_stop) {
+                        Ok(()) => {
+                            let _ = learned.end_joints.set(p.end_joints);
+                            let _ = learned.lines.set(p.lines);
+                        }
+                        Err(e) => {
+                            learned.refuse(p.operator_stop.map_or(1, |pos| pos.line), e.to_string())
+                        }
+                    },
+                    Err(r) => learned.refuse(r.pos().line, j.refused(r).to_string()),
                 }
             })
             .map_err(|e| job.unreadable(e))?;
@@ -340,16 +397,6 @@ fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
         checked,
         compressed: None,
     })
-}
-
-/// The line an input error names (1 if none).
-fn first_line(e: &InputError) -> u32 {
-    let text = e.to_string();
-    // `file:line:col: ...`
-    text.split(':')
-        .nth(1)
-        .and_then(|l| l.trim().parse().ok())
-        .unwrap_or(1)
 }
 
 /// The streaming stage, once the entries are ready.
@@ -388,6 +435,12 @@ impl Feed<'_> {
             ))));
             return;
         };
+        // The pre-pass beside the planner may have refused the program already: then
+        // nothing moves.
+        if let Some((_, why)) = self.learned.refusal() {
+            let _ = ready.send(Err(InputError::Usage(why)));
+            return;
+        }
         let r = Ready {
             start,
             first_window_s: self.t0.elapsed().as_secs_f64(),

@@ -19,7 +19,8 @@
 //! plan is the same however the program is fed. What the plan has committed goes to a
 //! [`Sink`] (the phases at once; each segment once nothing reads it any more), and the
 //! buffers keep only what the next window's check reads: from the oldest mark of the last
-//! check on (it resumes there), a few periods and one segment more for a corner's stencil.
+//! check on (it resumes there), and the path of a few periods before it, for a corner's
+//! stencil.
 //! Every index into them is counted from the buffers' front, and moved when it drops. So
 //! the memory is that of a window or two, whatever the program's length, and the time is
 //! linear in the program.
@@ -445,7 +446,6 @@ impl<'a> Planner<'a> {
         let Some((seg_mark, phase_mark, t_mark)) = before.trace.oldest(usable_until) else {
             return;
         };
-        let segs = seg_mark.saturating_sub(1);
         let t_keep = t_mark - KEEP_PERIODS * self.cfg.period;
         let phases = self
             .profile
@@ -454,6 +454,16 @@ impl<'a> Planner<'a> {
             .saturating_sub(1)
             .min(phase_mark)
             .min(self.sent);
+        // The segments from where the plan is at that time (no later than the first kept
+        // phase's start): a corner's stencil reads the path there, and with segments
+        // shorter than a period's travel that is several segments behind the mark's.
+        let s_keep = self.profile.phases.get(phases).map_or(0.0, |p| p.s0);
+        let at_keep = self
+            .profile
+            .seg_start
+            .partition_point(|&x| x <= s_keep)
+            .saturating_sub(1);
+        let segs = seg_mark.min(at_keep).saturating_sub(1);
         let stations = self.starts[segs].min(self.from.station);
         if segs == 0 && phases == 0 && stations == 0 {
             return;
