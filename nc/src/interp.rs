@@ -29,6 +29,9 @@ use crate::scurve::Motion;
 use crate::segment::{Geometry, Path, Pose};
 use nalgebra::Vector3;
 
+mod rolling;
+pub use rolling::{interpolate, Rolling, Stepping, Unrolled, Window};
+
 /// Parameter update method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Method {

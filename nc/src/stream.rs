@@ -50,7 +50,7 @@ use heapless::spsc::{Consumer, Producer, Queue};
 use heapless::Deque;
 use hold::AxisHold;
 pub use hold::{HoldConfig, HOLD_SHARE};
-pub use source::{Machine, ProgramEntries, ProgramSource, Source, StreamError};
+pub use source::{Machine, ProgramEntries, ProgramSource, Source, Stages, StreamError};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 mod cutter;

@@ -9,7 +9,7 @@
 use super::{stop_length, Chunk, Cutter, HoldConfig, Start};
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::parse::{Entries, Entry, LineSource, ParseError};
-use crate::plan::{PlanConfig, PlanError, Planner};
+use crate::plan::{Finished, PlanConfig, PlanError, Planner, Sink};
 use crate::program::{Action, Block, Program, SrcPos};
 use crate::segment::{BuildError, BuildLimits, Builder, Segment};
 use crate::verify::Margins;
@@ -97,78 +97,75 @@ pub struct Machine<'a> {
     pub plan: &'a PlanConfig,
 }
 
-/// Chunks of a program as it is read (see the module's text).
-pub struct Source<'a, E> {
+/// A program read an entry at a time through the parser, the segment builder and the
+/// [`Planner`], whose final plan goes to a [`Sink`] the caller hands in: the [`Cutter`] for
+/// a [`Source`]'s chunks, a rolling window for `simulate` ([`crate::interp::Rolling`]).
+pub struct Stages<'a, E> {
     entries: E,
     machine: Machine<'a>,
     builder: Builder<'a>,
     /// Created once the start pose is final (the first segment is built).
     planner: Option<Planner<'a>>,
     segments: Vec<Segment>,
-    cutter: Cutter,
     tilt_checked: bool,
     start: Option<Start>,
-    end: Option<Joints>,
+    end: Option<(Joints, Finished)>,
+    blocks: usize,
     failed: bool,
 }
 
-impl<'a, E: ProgramSource> Source<'a, E> {
-    /// Chunks for a follower holding `depth` of them (each at least the stop distance from
-    /// the machine's speed cap over what it holds, [`super::stop_length`]).
-    pub fn new(entries: E, machine: Machine<'a>, depth: usize) -> Self {
-        let cap = machine.build.speed_cap();
-        // A plan's speed reaches the cap by the planner's rounding at most.
-        let vmax = cap * (1.0 + 1e-6);
-        let hold = HoldConfig::from_plan(machine.plan);
-        let min_len = stop_length(vmax, &Margins::ceiling(machine.plan), &hold, depth);
-        Source {
+impl<'a, E: ProgramSource> Stages<'a, E> {
+    pub fn new(entries: E, machine: Machine<'a>) -> Self {
+        Stages {
             entries,
             machine,
             builder: Builder::new(machine.kin, machine.build),
             planner: None,
             segments: Vec::new(),
-            cutter: Cutter::new(min_len, vmax),
             tilt_checked: false,
             start: None,
             end: None,
+            blocks: 0,
             failed: false,
         }
     }
 
-    /// The program has `lines` source lines (each chunk's progress is measured by it).
-    pub fn set_lines(&mut self, lines: u32) {
-        self.cutter.set_lines(lines);
-    }
-
-    /// The program's start, once the first chunk has been cut or the program ended.
+    /// The program's start, once its first segment is built or the program ended.
     pub fn start(&self) -> Option<Start> {
         self.start
     }
 
-    /// Where the program leaves the machine's joints, once it ended.
-    pub fn end_joints(&self) -> Option<Joints> {
+    /// Where the program leaves the machine's joints and what its plan came to, once it
+    /// ended.
+    pub fn end(&self) -> Option<(Joints, Finished)> {
         self.end
     }
 
-    /// The next chunk; None once the program has ended. After an error, None.
-    pub fn next_chunk(&mut self) -> Result<Option<Box<Chunk>>, StreamError> {
-        loop {
-            if let Some(c) = self.cutter.next_chunk() {
-                return Ok(Some(c));
-            }
-            if self.end.is_some() || self.failed {
-                return Ok(None);
-            }
-            let read = self.read();
-            self.failed = read.is_err();
-            read?;
-        }
+    /// The motion blocks read so far.
+    pub fn blocks(&self) -> usize {
+        self.blocks
     }
 
-    /// One entry of the program, through the stages.
-    fn read(&mut self) -> Result<(), StreamError> {
+    /// The entries the stages read (what they have noted on the way).
+    pub fn entries(&self) -> &E {
+        &self.entries
+    }
+
+    /// Read the next entry through the stages, the plan it makes final into `sink`; at the
+    /// program's end, plan the rest into it. False once the program has ended or failed.
+    pub fn read(&mut self, sink: &mut impl Sink) -> Result<bool, StreamError> {
+        if self.end.is_some() || self.failed {
+            return Ok(false);
+        }
+        let read = self.entry(sink);
+        self.failed = read.is_err();
+        read?;
+        Ok(self.end.is_none())
+    }
+
+    fn entry(&mut self, sink: &mut impl Sink) -> Result<(), StreamError> {
         let Some(entry) = self.entries.next() else {
-            return self.finish();
+            return self.finish(sink);
         };
         let entry = entry?;
         if !self.tilt_checked {
@@ -180,6 +177,7 @@ impl<'a, E: ProgramSource> Source<'a, E> {
         match entry {
             Entry::Action(a) => self.builder.action(&a),
             Entry::Block(i, block) => {
+                self.blocks += 1;
                 self.builder.block(i, &block, &mut self.segments)?;
                 for seg in self.segments.drain(..) {
                     let planner = match &mut self.planner {
@@ -191,7 +189,7 @@ impl<'a, E: ProgramSource> Source<'a, E> {
                             false,
                         )?),
                     };
-                    planner.push(seg, &mut self.cutter)?;
+                    planner.push(seg, sink)?;
                 }
             }
         }
@@ -216,15 +214,72 @@ impl<'a, E: ProgramSource> Source<'a, E> {
         Ok(Planner::new(pose, m.kin, m.plan))
     }
 
-    fn finish(&mut self) -> Result<(), StreamError> {
+    fn finish(&mut self, sink: &mut impl Sink) -> Result<(), StreamError> {
         let planner = match self.planner.take() {
             Some(p) => p,
             // Nothing moves: the start pose alone, checked by the planner (its travel).
             None => Self::planner_for(&self.builder, self.machine, &mut self.start, true)?,
         };
-        let end = planner.finish(&mut self.cutter)?;
-        self.cutter.finish(end.duration);
-        self.end = Some(self.builder.joints());
+        let end = planner.finish(sink)?;
+        self.end = Some((self.builder.joints(), end));
         Ok(())
+    }
+}
+
+/// Chunks of a program as it is read (see the module's text).
+pub struct Source<'a, E> {
+    stages: Stages<'a, E>,
+    cutter: Cutter,
+    /// The stages have ended (or failed): the cutter has all it will get.
+    cut_last: bool,
+}
+
+impl<'a, E: ProgramSource> Source<'a, E> {
+    /// Chunks for a follower holding `depth` of them (each at least the stop distance from
+    /// the machine's speed cap over what it holds, [`super::stop_length`]).
+    pub fn new(entries: E, machine: Machine<'a>, depth: usize) -> Self {
+        let cap = machine.build.speed_cap();
+        // A plan's speed reaches the cap by the planner's rounding at most.
+        let vmax = cap * (1.0 + 1e-6);
+        let hold = HoldConfig::from_plan(machine.plan);
+        let min_len = stop_length(vmax, &Margins::ceiling(machine.plan), &hold, depth);
+        Source {
+            stages: Stages::new(entries, machine),
+            cutter: Cutter::new(min_len, vmax),
+            cut_last: false,
+        }
+    }
+
+    /// The program has `lines` source lines (each chunk's progress is measured by it).
+    pub fn set_lines(&mut self, lines: u32) {
+        self.cutter.set_lines(lines);
+    }
+
+    /// The program's start, once the first chunk has been cut or the program ended.
+    pub fn start(&self) -> Option<Start> {
+        self.stages.start()
+    }
+
+    /// Where the program leaves the machine's joints, once it ended.
+    pub fn end_joints(&self) -> Option<Joints> {
+        self.stages.end().map(|e| e.0)
+    }
+
+    /// The next chunk; None once the program has ended. After an error, None.
+    pub fn next_chunk(&mut self) -> Result<Option<Box<Chunk>>, StreamError> {
+        loop {
+            if let Some(c) = self.cutter.next_chunk() {
+                return Ok(Some(c));
+            }
+            if self.cut_last {
+                return Ok(None);
+            }
+            if !self.stages.read(&mut self.cutter)? {
+                self.cut_last = true;
+                if let Some((_, end)) = self.stages.end() {
+                    self.cutter.finish(end.duration);
+                }
+            }
+        }
     }
 }

@@ -1,0 +1,137 @@
+//! The interpolator over a streamed plan (`nc::interp::interpolate`: the program read a line
+//! at a time through parser, builder and planner into a `Rolling` window that lets go of
+//! what lies behind it) gives the setpoints the interpolator gives over the whole path and
+//! plan, to the bit, with every parameter update method; and it holds a window, not the
+//! program.
+
+use nalgebra::Vector3;
+use nc::interp::{interpolate, Interpolator, Method, Setpoint, Stepping};
+use nc::kinematics::MachineKinematics;
+use nc::parse::{Entries, Setup, StrLines};
+use nc::plan::{plan, PlanConfig};
+use nc::segment::{build, BuildLimits};
+use nc::stream::{Machine, Stages};
+
+const PERIOD: f64 = 0.002;
+
+fn stepping(kin: MachineKinematics, cfg: &PlanConfig, bl: &BuildLimits, m: Method) -> Stepping {
+    Stepping {
+        kin,
+        lim: cfg.rotary,
+        method: m,
+        period: PERIOD,
+        creep: cfg.path_acc * PERIOD,
+        speed_cap: bl.speed_cap(),
+    }
+}
+
+/// Every setpoint over the whole path and plan, as `simulate` made them before it streamed.
+fn whole(text: &str, st: &Stepping, cfg: &PlanConfig, bl: &BuildLimits) -> Option<Vec<Setpoint>> {
+    let program = nc::parse::parse(text).ok()?;
+    let path = build(&program, &st.kin, bl).ok()?;
+    let profile = plan(&path, &st.kin, cfg).ok()?;
+    let mut ip = Interpolator::new(
+        &path, &profile, st.kin, st.lim, st.method, st.period, st.creep,
+    );
+    let mut out = Vec::new();
+    loop {
+        let sp = ip.step();
+        out.push(sp);
+        if sp.done || path.segments.is_empty() {
+            return Some(out);
+        }
+        assert!(sp.cycle < 10_000_000, "runs away");
+    }
+}
+
+/// The same through the stream; also the most segments the window held, and whether each
+/// setpoint's segment was in the window it was handed with.
+fn rolled(
+    text: &str,
+    st: &Stepping,
+    cfg: &PlanConfig,
+    bl: &BuildLimits,
+) -> Option<(Vec<Setpoint>, usize)> {
+    let setup = Setup::default();
+    let machine = Machine {
+        kin: &st.kin,
+        build: bl,
+        plan: cfg,
+    };
+    let mut stages = Stages::new(Entries::new(StrLines::new(text), &setup), machine);
+    let mut out = Vec::new();
+    let rolling = interpolate(&mut stages, *st, |sp, w| {
+        assert!(
+            w.segments.iter().any(|s| s.block == sp.block) || sp.cycle == 0,
+            "setpoint {} of block {} handed without its block's segments",
+            sp.cycle,
+            sp.block
+        );
+        out.push(*sp);
+    })
+    .ok()?;
+    Some((out, rolling.most_held()))
+}
+
+/// A wiggle of `n` G01 moves of 0.05 mm (the dense CAM program of issue 12).
+fn wiggle(n: usize) -> String {
+    let points: Vec<_> = (0..=n)
+        .map(|k| {
+            let x = 0.05 * k as f64;
+            (Vector3::new(x, 2.0 * (x * 0.3).sin(), 0.0), Vector3::z())
+        })
+        .collect();
+    nc::fixtures::g01_program(&points, 3000.0)
+}
+
+#[test]
+fn the_rolling_interpolator_gives_the_whole_paths_setpoints() {
+    let kin = MachineKinematics::Paper;
+    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
+    let mut programs: Vec<(String, String)> = nc::fixtures::TEST_PROGRAMS
+        .iter()
+        .map(|rel| (rel.to_string(), nc::fixtures::test_program(rel)))
+        .collect();
+    programs.push(("wiggle".into(), wiggle(6_000)));
+    let mut compared = 0;
+    for (name, text) in &programs {
+        for method in [Method::ArcLength, Method::Taylor1, Method::Taylor2] {
+            let st = stepping(kin, &cfg, &bl, method);
+            let want = whole(text, &st, &cfg, &bl);
+            let got = rolled(text, &st, &cfg, &bl);
+            match (want, got) {
+                (Some(w), Some((g, _))) => {
+                    assert_eq!(w.len(), g.len(), "{name} {method:?}: setpoints");
+                    if let Some(i) = (0..w.len()).find(|&i| w[i] != g[i]) {
+                        panic!("{name} {method:?}: setpoint {i}: {:?} != {:?}", w[i], g[i]);
+                    }
+                    compared += 1;
+                }
+                (None, None) => {}
+                (w, g) => panic!(
+                    "{name} {method:?}: whole {} but rolled {}",
+                    w.is_some(),
+                    g.is_some()
+                ),
+            }
+        }
+    }
+    assert!(compared >= 36, "{compared} runs compared");
+}
+
+#[test]
+fn the_rolling_window_does_not_grow_with_the_program() {
+    let kin = MachineKinematics::Paper;
+    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
+    let st = stepping(kin, &cfg, &bl, Method::ArcLength);
+    // The planner commits about a metre of these moves at a time (three stops from
+    // 50 mm/s at its look-ahead): the window is that, whatever comes after (13 598 and
+    // 17 958 segments when this was written: 4x the program, 1.3x the window).
+    let (short, held_short) = rolled(&wiggle(40_000), &st, &cfg, &bl).expect("plans");
+    let (long, held_long) = rolled(&wiggle(160_000), &st, &cfg, &bl).expect("plans");
+    assert!(long.len() > 3 * short.len());
+    assert!(
+        2 * held_long <= 3 * held_short && held_long < 40_000,
+        "the window held {held_short} segments of 40 000 and {held_long} of 160 000"
+    );
+}
