@@ -270,3 +270,78 @@ fn simulate_reports_the_spindle_waits_beside_the_machining_time() {
     let json: serde_json::Value = serde_json::from_str(&run(args(&paper, true))).unwrap();
     assert!(json.get("spindle_waits").is_none(), "{json}");
 }
+
+/// A wiggle of `n` G01 moves of 0.05 mm at F3000 with coolant words, as a post writes it.
+fn long_program(n: usize, break_at: Option<usize>) -> String {
+    let mut s = String::from("%\nG90 G21 G94\nM08\n");
+    for k in 0..=n {
+        let d = k as f64 * 0.05;
+        let x = -200.0 + d % 400.0;
+        let y = 2.0 * (d / 400.0).floor() + 0.5 * (x / 2.0).sin();
+        let x = if Some(k) == break_at { 400.0 } else { x };
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 { " F3000" } else { "" };
+        s += &format!(
+            "N{} {g}X{x:.4} Y{y:.4} Z0.0000 I0.0 J0.0 K1.0{f}\n",
+            10 * (k + 1)
+        );
+    }
+    s + "M09\nM30\n%\n"
+}
+
+/// A program longer than `simulate` parses whole (8 MiB, where every syntax error is listed)
+/// is read, built, planned and interpolated a line at a time, holding a window of it: the
+/// summary is the one the whole path gives (the library's `simulate::run` and `summarize`,
+/// which keep everything), every word listed; an error deep in it is refused at its line.
+#[test]
+fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
+    let n = 180_000;
+    let text = long_program(n, None);
+    assert!(text.len() as u64 > dnurbs_tools::feed::CHECK_WHOLE_BYTES);
+    let file = temp("long.nc");
+    std::fs::write(&file, &text).unwrap();
+    let mach = machine("paper-ac-table.toml");
+    let args = [
+        "simulate",
+        file.to_str().unwrap(),
+        "--machine",
+        mach.to_str().unwrap(),
+        "--json",
+    ];
+    let out = dnurbs(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON summary");
+
+    let m = dnurbs_tools::load_machine(&mach).unwrap();
+    let shop = dnurbs_tools::shop::ShopArgs::default().load().unwrap();
+    let prog = nc::parse::parse_with(&text, &dnurbs_tools::shop::parse_setup(&m, &shop)).unwrap();
+    let setup = dnurbs_tools::setup::MachineSetup::new(&m);
+    let whole = dnurbs_tools::simulate::run(&prog, &setup, setup.method).unwrap();
+    let mut want = dnurbs_tools::simulate::summarize(&whole, &setup, prog.blocks.len());
+    want.program_words = dnurbs_tools::words::describe(&prog);
+    // Through the same text and parser (serde_json's float parser may be 1 ulp off).
+    let want: serde_json::Value =
+        serde_json::from_str(&serde_json::to_string_pretty(&want).unwrap()).unwrap();
+    assert_eq!(got, want);
+    assert_eq!(got["blocks"], n + 1);
+    assert_eq!(
+        got["program_words"].as_array().map(Vec::len),
+        Some(2),
+        "{got}"
+    );
+
+    // X400 at move 170 000, past the 290 mm travel: refused at its line.
+    std::fs::write(&file, long_program(n, Some(170_000))).unwrap();
+    let out = dnurbs(&args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(&format!("{}:170004:", file.display())),
+        "{err}"
+    );
+    let _ = std::fs::remove_file(&file);
+}

@@ -70,7 +70,7 @@ fn rolled(
         out.push(*sp);
     })
     .ok()?;
-    Some((out, rolling.most_held()))
+    Some((out, rolling.0.most_held()))
 }
 
 /// A wiggle of `n` G01 moves of 0.05 mm (the dense CAM program of issue 12).

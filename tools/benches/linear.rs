@@ -13,7 +13,8 @@ mod common;
 
 use dnurbs_tools::simulate::{each_setpoint, Summarizer};
 use nalgebra::Vector3;
-use nc::interp::Method;
+use nc::interp::{Method, Window};
+use nc::plan::Finished;
 use std::time::{Duration, Instant};
 
 /// The n-move wiggle ([`common::wiggle_point`]) as a G01 program.
@@ -62,12 +63,26 @@ fn once(src: &str, setup: &MachineSetup) -> Times {
     t.plan = clock.elapsed();
     // As `dnurbs simulate` does it: each setpoint into the summary as it is made.
     let clock = Instant::now();
-    let mut summary = Summarizer::new(&path, setup);
+    let mut summary = Summarizer::new(setup);
+    let whole = Window {
+        segments: &path.segments,
+        first: 0,
+    };
     each_setpoint(&path, &profile, setup, Method::ArcLength, |sp| {
-        summary.push(sp)
+        summary.push(sp, whole)
     })
     .expect("it ends");
-    let summary = summary.finish(&profile, Method::ArcLength, program.blocks.len());
+    let plan = Finished {
+        length: profile.length,
+        duration: profile.duration,
+        margins: profile.margins,
+    };
+    let summary = summary.finish(
+        &plan,
+        path.segments.last(),
+        Method::ArcLength,
+        program.blocks.len(),
+    );
     t.run = clock.elapsed();
     t.peak_mb = common::peak_mb();
     assert!(

@@ -149,6 +149,22 @@ impl InputError {
             error: source.into(),
         }
     }
+
+    /// A streamed program's refusal: where it was read, built or planned.
+    pub fn stream(file: &str, e: nc::stream::StreamError) -> Self {
+        use nc::stream::StreamError;
+        match e {
+            StreamError::Parse(p) => InputError::Parse {
+                file: file.to_owned(),
+                errors: nc::parse::ParseErrors {
+                    errors: vec![p],
+                    more: false,
+                },
+            },
+            StreamError::Build(b) => InputError::program(Path::new(file), b),
+            StreamError::Plan(p) => InputError::program(Path::new(file), p),
+        }
+    }
 }
 
 /// The exit code for an error: 2 for the user's input, 4 for a stop before motion, 1 for

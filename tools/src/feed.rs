@@ -21,7 +21,7 @@ use nc::stream::{
     Chunk, Feeder, Machine, ProgramEntries, ProgramSource, Source, Start, StreamError,
 };
 use std::collections::VecDeque;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
@@ -156,18 +156,7 @@ impl Job {
     }
 
     fn stream_error(&self, e: StreamError) -> InputError {
-        let file = self.name.clone();
-        match e {
-            StreamError::Parse(p) => InputError::Parse {
-                file,
-                errors: nc::parse::ParseErrors {
-                    errors: vec![p],
-                    more: false,
-                },
-            },
-            StreamError::Build(b) => InputError::program(Path::new(&self.name), b),
-            StreamError::Plan(p) => InputError::program(Path::new(&self.name), p),
-        }
+        InputError::stream(&self.name, e)
     }
 
     fn size(&self) -> Result<u64, InputError> {

@@ -8,9 +8,9 @@
 
 use crate::setup::MachineSetup;
 use nc::arclen::GL8;
-use nc::interp::{Interpolator, Method, Setpoint};
+use nc::interp::{Interpolator, Method, Setpoint, Window};
 use nc::nurbs::DoubleNurbs;
-use nc::plan::{plan, FeedProfile, ProgramError};
+use nc::plan::{plan, FeedProfile, Finished, ProgramError};
 use nc::program::Program;
 use nc::segment::{build, Path};
 pub use nc::verify::MAX_CYCLES;
@@ -136,21 +136,6 @@ pub struct SpindleWaits {
     pub ramp_s: f64,
 }
 
-impl SpindleWaits {
-    /// The waits of a path on a machine whose spindle ramps at `acc_rpm_s`.
-    pub fn of(path: &nc::segment::Path, acc_rpm_s: f64) -> SpindleWaits {
-        let (mut count, mut ramp_s, mut rpm) = (0, 0.0, 0.0);
-        for seg in &path.segments {
-            if seg.wait.spindle {
-                count += 1;
-                ramp_s += (seg.aux.spindle_rpm - rpm).abs() / acc_rpm_s;
-            }
-            rpm = seg.aux.spindle_rpm;
-        }
-        SpindleWaits { count, ramp_s }
-    }
-}
-
 /// Arc length of the cutter curve between two parameters, integrated directly.
 pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
     // Split at the knots so each piece is smooth, then 8-point Gauss-Legendre per piece.
@@ -173,11 +158,20 @@ pub fn arc_between(curve: &DoubleNurbs, a: f64, b: f64) -> f64 {
 /// The measurements of a finished run (see [`Summarizer`], which takes them as the
 /// setpoints come, without keeping them).
 pub fn summarize(run: &Run, setup: &MachineSetup, blocks: usize) -> Summary {
-    let mut s = Summarizer::new(&run.path, setup);
+    let mut s = Summarizer::new(setup);
+    let whole = Window {
+        segments: &run.path.segments,
+        first: 0,
+    };
     for sp in &run.setpoints {
-        s.push(sp);
+        s.push(sp, whole);
     }
-    s.finish(&run.profile, run.method, blocks)
+    let plan = Finished {
+        length: run.profile.length,
+        duration: run.profile.duration,
+        margins: run.profile.margins,
+    };
+    s.finish(&plan, run.path.segments.last(), run.method, blocks)
 }
 
 impl Summary {

@@ -67,3 +67,37 @@ pub fn text(words: &[String]) -> String {
     }
     s
 }
+
+/// A program's entries, each action's line ([`describe_action`]) kept on the way: the
+/// words of a program that is read as it is planned.
+pub struct Noted<E> {
+    inner: E,
+    pub words: Vec<String>,
+}
+
+impl<E> Noted<E> {
+    pub fn new(inner: E) -> Self {
+        Noted {
+            inner,
+            words: Vec::new(),
+        }
+    }
+}
+
+impl<E: nc::stream::ProgramSource> Iterator for Noted<E> {
+    type Item = <E as Iterator>::Item;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let e = self.inner.next();
+        if let Some(Ok(nc::parse::Entry::Action(a))) = &e {
+            self.words.push(describe_action(a));
+        }
+        e
+    }
+}
+
+impl<E: nc::stream::ProgramSource> nc::stream::ProgramSource for Noted<E> {
+    fn tilt_word(&self) -> Option<(char, nc::program::SrcPos)> {
+        self.inner.tilt_word()
+    }
+}

@@ -237,12 +237,12 @@ impl From<ProgramError> for Unrolled {
 
 /// Read `stages` to the program's end, stepping a [`Rolling`] interpolator after every
 /// entry as far as the plan reaches, each setpoint to `take`. Returns the interpolator, its
-/// last setpoint given (the program's last segment and plan held for the summary).
+/// last setpoint given (it holds the program's last segment), and what the plan came to.
 pub fn interpolate<E: ProgramSource>(
     stages: &mut Stages<'_, E>,
     step: Stepping,
     mut take: impl FnMut(&Setpoint, Window),
-) -> Result<Rolling, Unrolled> {
+) -> Result<(Rolling, Finished), Unrolled> {
     let mut rolling = Rolling::new(step);
     let mut started = false;
     loop {
@@ -251,14 +251,15 @@ pub fn interpolate<E: ProgramSource>(
             rolling.start_at(start.pose, start.joints);
             started = true;
         }
-        if let (false, Some((_, end))) = (more, stages.end()) {
-            rolling.finish(&end);
+        let end = stages.end().filter(|_| !more).map(|e| e.1);
+        if let Some(end) = &end {
+            rolling.finish(end);
         }
         if started {
             rolling.run(&mut take)?;
         }
-        if !more {
-            return Ok(rolling);
+        if let Some(end) = end {
+            return Ok((rolling, end));
         }
     }
 }

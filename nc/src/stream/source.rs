@@ -151,6 +151,10 @@ impl<'a, E: ProgramSource> Stages<'a, E> {
         &self.entries
     }
 
+    pub fn entries_mut(&mut self) -> &mut E {
+        &mut self.entries
+    }
+
     /// Read the next entry through the stages, the plan it makes final into `sink`; at the
     /// program's end, plan the rest into it. False once the program has ended or failed.
     pub fn read(&mut self, sink: &mut impl Sink) -> Result<bool, StreamError> {

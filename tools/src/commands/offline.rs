@@ -3,14 +3,14 @@
 use crate::exit::{InputError, Outcome};
 use crate::setup::MachineSetup;
 use crate::shop::{parse_setup, ShopArgs};
-use crate::simulate::{
-    each_setpoint, run, summarize, write_trace_header, write_trace_row, Summarizer,
-};
+use crate::simulate::{run, summarize, write_trace_header, write_trace_row, Summarizer};
+use crate::words::Noted;
 use crate::{load_machine, load_program};
 use anyhow::Context;
-use nc::interp::Method;
-use nc::plan::{plan, ProgramError};
-use nc::segment::build;
+use nc::interp::{interpolate, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
+use nc::parse::{Entries, ReadLines};
+use nc::plan::{Finished, ProgramError};
+use nc::stream::{Machine, ProgramEntries, Stages};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -27,13 +27,10 @@ pub fn simulate(
         eprintln!("dnurbs simulate: warning (simulate uses no bus; run would refuse): {e}");
     }
     let shop = shop.load()?;
-    let prog = load_program(program, &parse_setup(&machine, &shop))?;
+    let parse = parse_setup(&machine, &shop);
     let setup = MachineSetup::new(&machine).with_compress(shop.compress);
-    let (prog, compressed) = setup.prepare(prog);
     let method = method.unwrap_or(setup.method);
-    let refused = |e: ProgramError| InputError::program(program, e);
-    let path = build(&prog, &setup.kin, &setup.build).map_err(|e| refused(e.into()))?;
-    let profile = plan(&path, &setup.kin, &setup.plan).map_err(|e| refused(e.into()))?;
+    let name = program.display().to_string();
     // The setpoints go to the summary (and the trace) as they are made: none is kept.
     let mut trace = match &trace {
         Some(file) => {
@@ -46,32 +43,88 @@ pub fn simulate(
         }
         None => None,
     };
-    let mut summarizer = Summarizer::new(&path, &setup);
-    each_setpoint(&path, &profile, &setup, method, |sp| {
-        summarizer.push(sp);
+    let mut summarizer = Summarizer::new(&setup);
+    let take = |sp: &Setpoint, w: Window| {
+        summarizer.push(sp, w);
         if let Some((_, w, result @ Ok(()))) = &mut trace {
             *result = write_trace_row(w, sp);
         }
-    })
-    .map_err(refused)?;
+    };
+    let step = Stepping {
+        kin: setup.kin,
+        lim: setup.plan.rotary,
+        method,
+        period: setup.period,
+        creep: setup.plan.path_acc * setup.period,
+        speed_cap: setup.build.speed_cap(),
+    };
+    let refused = |e: Unrolled| match e {
+        Unrolled::Stream(e) => InputError::stream(&name, e),
+        Unrolled::Unfinished(n) => InputError::program(program, ProgramError::Unfinished(n)),
+    };
+    // A program of at most CHECK_WHOLE_BYTES (or one to compress, which needs it whole) is
+    // parsed whole first, so that every syntax error in it is listed; a longer one is read
+    // a line at a time. Either way it is built, planned and interpolated as it is read.
+    let size = std::fs::metadata(program).map_or(0, |m| m.len());
+    let whole = setup.compress.is_some() || size <= crate::feed::CHECK_WHOLE_BYTES;
+    let (rolled, blocks, words, compressed) = if whole {
+        let (prog, compressed) = setup.prepare(load_program(program, &parse)?);
+        let words = crate::words::describe(&prog);
+        let blocks = prog.blocks.len();
+        let entries = ProgramEntries::new(prog);
+        let rolled = roll(entries, &setup, step, take).map_err(refused)?;
+        (rolled, blocks, words, compressed)
+    } else {
+        let f = std::fs::File::open(program).map_err(|error| InputError::ReadProgram {
+            file: name.clone(),
+            error,
+        })?;
+        let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, f));
+        let entries = Noted::new(Entries::new(lines, &parse));
+        let mut stages = Stages::new(entries, machine_of(&setup));
+        let rolled = interpolate(&mut stages, step, take).map_err(refused)?;
+        let words = std::mem::take(&mut stages.entries_mut().words);
+        (rolled, stages.blocks(), words, None)
+    };
     if let Some((file, mut w, result)) = trace {
         result
             .and_then(|_| w.flush())
             .with_context(|| format!("{}: cannot write the trace", file.display()))?;
     }
-    let mut summary = summarizer.finish(&profile, method, prog.blocks.len());
-    summary.program_words = crate::words::describe(&prog);
-    summary.compressed = compressed.map(crate::simulate::Compression::from);
-    summary.spindle_waits = machine
+    let (rolling, plan) = rolled;
+    let spindle_waits = machine
         .spindle
         .as_ref()
-        .map(|s| crate::simulate::SpindleWaits::of(&path, s.acceleration_rpm_s));
+        .map(|s| summarizer.spindle_waits(s.acceleration_rpm_s));
+    let mut summary = summarizer.finish(&plan, rolling.last_segment(), method, blocks);
+    summary.program_words = words;
+    summary.compressed = compressed.map(crate::simulate::Compression::from);
+    summary.spindle_waits = spindle_waits;
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {
         print!("{}", summary.text());
     }
     Ok(Outcome::Completed)
+}
+
+fn machine_of(setup: &MachineSetup) -> Machine<'_> {
+    Machine {
+        kin: &setup.kin,
+        build: &setup.build,
+        plan: &setup.plan,
+    }
+}
+
+/// A parsed program's entries through the stages and the rolling interpolator.
+fn roll(
+    entries: ProgramEntries,
+    setup: &MachineSetup,
+    step: Stepping,
+    take: impl FnMut(&Setpoint, Window),
+) -> Result<(Rolling, Finished), Unrolled> {
+    let mut stages = Stages::new(entries, machine_of(setup));
+    interpolate(&mut stages, step, take)
 }
 
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {

@@ -3,74 +3,108 @@
 //! setpoints however long the program (at 10^6 G01 moves they were 2.4 M, the run's largest
 //! allocation).
 
-use super::{arc_between, axis_map, Summary};
+use super::{arc_between, axis_map, SpindleWaits, Summary};
 use crate::setup::MachineSetup;
-use nc::interp::{Method, Setpoint};
+use nc::interp::{Method, Setpoint, Window};
 use nc::kinematics::Kinematics;
 use nc::nurbs::DoubleNurbs;
-use nc::plan::FeedProfile;
-use nc::segment::{Path, Tooling};
+use nc::plan::Finished;
+use nc::segment::{Segment, Tooling};
 use nc::verify::dist_to_chord;
 
 /// What the summary needs to know about the block the setpoints are in, loaded when they
 /// enter it: the setpoints walk the blocks in order, so a cursor over the segments finds
-/// each block's once, and nothing is kept per block of the program.
+/// each block's once. The block's curve pieces are copied out of the path (the window of it
+/// that a streamed run holds may let go of them before the block ends), and nothing is kept
+/// per block of the program.
 #[derive(Default)]
-struct BlockSegs<'a> {
+struct BlockSegs {
     /// Block number (0 before the first is loaded).
     number: u32,
+    /// Every segment of the block has been seen (a later block's came after them).
+    complete: bool,
     /// The block has a straight move (a setpoint without u belongs to it).
     line: bool,
     /// The block has a turn at rest (the cutter stands while the tool turns).
     turns: bool,
     /// The block's curve pieces in parameter order (`nc::split`).
-    pieces: Vec<&'a DoubleNurbs>,
+    pieces: Vec<DoubleNurbs>,
     /// The distinct knots of each piece whose tool axis is its orientation curve, with
-    /// the piece and whether the tool axis has been measured there, sorted by knot.
-    knots: Vec<(f64, &'a DoubleNurbs, bool)>,
+    /// the piece's index and whether the tool axis has been measured there, sorted by knot.
+    knots: Vec<(f64, usize, bool)>,
 }
 
-impl<'a> BlockSegs<'a> {
-    /// Make this block `number`'s, from the segments at `*cursor` on; the cursor is left
-    /// at the first segment of a later block. A block before the cursor's (never, for the
-    /// interpolator's setpoints) is searched for from the start.
-    fn load(&mut self, path: &'a Path, cursor: &mut usize, number: u32) {
-        let segs = &path.segments;
-        if number < self.number {
-            *cursor = 0;
+/// Spindle waits counted over the segments as they pass ([`SpindleWaits`]).
+#[derive(Clone, Copy, Default)]
+struct SpindleTally {
+    count: u32,
+    /// Sum of the speed changes at the waits, rpm.
+    steps_rpm: f64,
+    rpm: f64,
+}
+
+impl SpindleTally {
+    fn add(&mut self, seg: &Segment) {
+        if seg.wait.spindle {
+            self.count += 1;
+            self.steps_rpm += (seg.aux.spindle_rpm - self.rpm).abs();
         }
-        while segs.get(*cursor).is_some_and(|s| s.block < number) {
+        self.rpm = seg.aux.spindle_rpm;
+    }
+}
+
+impl BlockSegs {
+    /// Make this block `number`'s (or go on loading it), from the segments at `*cursor` on
+    /// (an index into the whole path; `window` holds its segments from `window.first`); the
+    /// cursor is left at the first segment not yet seen. Every segment passed is tallied.
+    fn load(&mut self, window: Window, cursor: &mut usize, number: u32, tally: &mut SpindleTally) {
+        let seg_at = |i: usize| {
+            i.checked_sub(window.first)
+                .and_then(|k| window.segments.get(k))
+        };
+        // Segments behind the window are those of blocks already left.
+        *cursor = (*cursor).max(window.first);
+        while let Some(s) = seg_at(*cursor).filter(|s| s.block < number) {
+            tally.add(s);
             *cursor += 1;
         }
-        self.number = number;
-        self.line = false;
-        self.turns = false;
-        self.pieces.clear();
-        self.knots.clear();
-        while let Some(s) = segs.get(*cursor).filter(|s| s.block == number) {
+        if number != self.number {
+            self.number = number;
+            self.complete = false;
+            self.line = false;
+            self.turns = false;
+            self.pieces.clear();
+            self.knots.clear();
+        }
+        let seen = *cursor;
+        while let Some(s) = seg_at(*cursor).filter(|s| s.block == number) {
+            tally.add(s);
             *cursor += 1;
             match s.nurbs() {
                 Some((c, _)) => {
-                    self.pieces.push(c);
                     if matches!(s.tooling, Tooling::Curve) {
                         let mut knots = c.knots().to_vec();
                         knots.dedup();
-                        self.knots.extend(knots.into_iter().map(|k| (k, c, false)));
+                        let piece = self.pieces.len();
+                        self.knots
+                            .extend(knots.into_iter().map(|k| (k, piece, false)));
                     }
+                    self.pieces.push(c.clone());
                 }
                 None if s.rotary_only => self.turns = true,
                 None => self.line = true,
             }
         }
-        self.knots.sort_by(|x, y| x.0.total_cmp(&y.0));
+        self.complete = seg_at(*cursor).is_some();
+        if *cursor > seen {
+            self.knots.sort_by(|x, y| x.0.total_cmp(&y.0));
+        }
     }
 
     /// The piece that holds parameter `u`: the first whose range reaches it, else the last.
-    fn piece_at(&self, u: f64) -> Option<&'a DoubleNurbs> {
+    fn piece_at(&self, u: f64) -> Option<&DoubleNurbs> {
         let i = self.pieces.partition_point(|c| c.range().1 < u);
-        self.pieces
-            .get(i.min(self.pieces.len().saturating_sub(1)))
-            .copied()
+        self.pieces.get(i.min(self.pieces.len().saturating_sub(1)))
     }
 
     /// Arc length of the block's curve between two parameters, over the pieces they span.
@@ -89,11 +123,11 @@ impl<'a> BlockSegs<'a> {
 
 /// The measurements of one run, fed its setpoints in order.
 pub struct Summarizer<'a> {
-    path: &'a Path,
     setup: &'a MachineSetup,
-    /// The block of the newest setpoint, and the first segment after it.
-    block: BlockSegs<'a>,
+    /// The block of the newest setpoint, and the first segment not yet seen.
+    block: BlockSegs,
     cursor: usize,
+    spindle: SpindleTally,
     /// The last two setpoints, newest last.
     last: [Option<Setpoint>; 2],
     /// The newest setpoint with a curve parameter, and its block.
@@ -110,12 +144,12 @@ pub struct Summarizer<'a> {
 }
 
 impl<'a> Summarizer<'a> {
-    pub fn new(path: &'a Path, setup: &'a MachineSetup) -> Summarizer<'a> {
+    pub fn new(setup: &'a MachineSetup) -> Summarizer<'a> {
         Summarizer {
-            path,
             setup,
             block: BlockSegs::default(),
             cursor: 0,
+            spindle: SpindleTally::default(),
             last: [None, None],
             last_u: None,
             cycles: 0,
@@ -130,10 +164,12 @@ impl<'a> Summarizer<'a> {
         }
     }
 
-    /// Take the next setpoint.
-    pub fn push(&mut self, sp: &Setpoint) {
-        if sp.block != self.block.number {
-            self.block.load(self.path, &mut self.cursor, sp.block);
+    /// Take the next setpoint; `window` holds the path's segments from the setpoint's (or
+    /// an earlier one) on ([`nc::interp::Rolling`], or the whole path).
+    pub fn push(&mut self, sp: &Setpoint, window: Window) {
+        if sp.block != self.block.number || !self.block.complete {
+            self.block
+                .load(window, &mut self.cursor, sp.block, &mut self.spindle);
         }
         if let Some(a) = self.last[1] {
             self.feed_and_chord(&a, sp);
@@ -211,12 +247,12 @@ impl<'a> Summarizer<'a> {
             return;
         };
         let ua = a.u.unwrap_or(0.0);
-        let knots = &mut self.block.knots;
+        let (knots, pieces) = (&mut self.block.knots, &self.block.pieces);
         if ua > ub || knots.is_empty() {
             return; // a falling pair brackets nothing
         }
         let from = knots.partition_point(|&(k, _, _)| k < ua);
-        for (k, curve, done) in knots[from..].iter_mut() {
+        for (k, piece, done) in knots[from..].iter_mut() {
             if *k > ub {
                 break;
             }
@@ -229,17 +265,32 @@ impl<'a> Summarizer<'a> {
             let j: [f64; 5] =
                 core::array::from_fn(|i| a.joints[i] + (sp.joints[i] - a.joints[i]) * f);
             let got = self.setup.kin.tool_axis(j[3], j[4]);
-            let (_, d) = curve.cutter_and_tool(k, 0);
+            let (_, d) = pieces[*piece].cutter_and_tool(k, 0);
             let want = d.p.normalize();
             let dev = got.cross(&want).norm().atan2(got.dot(&want)).to_degrees();
             self.tool_dev = self.tool_dev.max(dev);
         }
     }
 
-    /// The summary of the setpoints pushed.
-    pub fn finish(self, profile: &FeedProfile, method: Method, blocks: usize) -> Summary {
+    /// The spindle waits of the segments the setpoints passed, its ramps at `acc_rpm_s`.
+    pub fn spindle_waits(&self, acc_rpm_s: f64) -> SpindleWaits {
+        SpindleWaits {
+            count: self.spindle.count,
+            ramp_s: self.spindle.steps_rpm / acc_rpm_s,
+        }
+    }
+
+    /// The summary of the setpoints pushed, over a plan that came to `plan` on a path whose
+    /// last segment is `last_seg`.
+    pub fn finish(
+        self,
+        plan: &Finished,
+        last_seg: Option<&Segment>,
+        method: Method,
+        blocks: usize,
+    ) -> Summary {
         let last = self.last[1];
-        let end_err = match (last, self.path.segments.last()) {
+        let end_err = match (last, last_seg) {
             (Some(sp), Some(seg)) => (sp.p - seg.pose(seg.length).p).norm(),
             _ => 0.0,
         };
@@ -251,7 +302,7 @@ impl<'a> Summarizer<'a> {
             cycles: self.cycles,
             period_s: self.setup.period,
             machining_time_s: last.map_or(0.0, |s| s.t),
-            path_length: profile.length,
+            path_length: plan.length,
             feed_fluctuation_max: self.fmax,
             feed_fluctuation_rms: if self.fn_ > 0 {
                 (self.fsq / self.fn_ as f64).sqrt()
@@ -263,7 +314,7 @@ impl<'a> Summarizer<'a> {
             chord_tolerance_mm: self.setup.plan.chord_tol,
             axis_velocity_fraction: axis_map(&names, self.vfrac),
             axis_acceleration_fraction: axis_map(&names, self.afrac),
-            axis_jerk_fraction: axis_map(&names, profile.margins.jerk),
+            axis_jerk_fraction: axis_map(&names, plan.margins.jerk),
             axis_travel_ok: self.travel_ok,
             tool_axis_deviation_max_deg: self.tool_dev,
             end_position_error_mm: end_err,
