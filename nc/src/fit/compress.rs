@@ -7,7 +7,8 @@
 
 use super::find::{find_runs, moves_in};
 use super::runs::{Options, TOOL_MM};
-use crate::program::{Block, NurbsBlock, NurbsKind, Program};
+use super::Fitted;
+use crate::program::{Block, LinearMove, NurbsBlock, NurbsKind, Program};
 
 /// What the compressor did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -64,26 +65,7 @@ pub fn compress(
         for slot in &mut index[b..=e] {
             *slot = blocks.len();
         }
-        let tool_ctrl = f
-            .ctrl
-            .iter()
-            .zip(&f.tool)
-            .map(|(c, t)| core::array::from_fn(|i| c[i] + TOOL_MM * t[i]))
-            .collect();
-        blocks.push(Block::Nurbs(NurbsBlock {
-            pos: first.pos,
-            n: first.n,
-            kind: NurbsKind::G065,
-            degree: f.degree as u8,
-            ctrl: f.ctrl.clone(),
-            tool_ctrl,
-            ctrl_pos: vec![first.pos; f.ctrl.len()],
-            weights: vec![1.0; f.ctrl.len()],
-            knots: f.knots.clone(),
-            feed_mm_min: first.feed_mm_min,
-            tooling: first.tooling,
-            turn_to: None,
-        }));
+        blocks.push(Block::Nurbs(fitted_block(first, f)));
         next = e + 1;
         out.fitted_blocks += 1;
         out.moves_fitted += e + 1 - b;
@@ -106,6 +88,31 @@ pub fn compress(
         },
         out,
     )
+}
+
+/// The G06.5 block of a run fitted as `f`, whose first move is `first` (its position, `N`,
+/// feed and tooling).
+pub fn fitted_block(first: &LinearMove, f: &Fitted) -> NurbsBlock {
+    let tool_ctrl = f
+        .ctrl
+        .iter()
+        .zip(&f.tool)
+        .map(|(c, t)| core::array::from_fn(|i| c[i] + TOOL_MM * t[i]))
+        .collect();
+    NurbsBlock {
+        pos: first.pos,
+        n: first.n,
+        kind: NurbsKind::G065,
+        degree: f.degree as u8,
+        ctrl: f.ctrl.clone(),
+        tool_ctrl,
+        ctrl_pos: vec![first.pos; f.ctrl.len()],
+        weights: vec![1.0; f.ctrl.len()],
+        knots: f.knots.clone(),
+        feed_mm_min: first.feed_mm_min,
+        tooling: first.tooling,
+        turn_to: None,
+    }
 }
 
 /// Blocks `from..` (given as `old`) copied as they are, their new indices noted.

@@ -11,7 +11,7 @@
 use super::runs::Options;
 use super::{fit, Fitted, Point};
 use crate::kinematics::{Kinematics, MachineKinematics};
-use crate::program::{Block, LinearMove, Orientation, Program};
+use crate::program::{Block, LengthMode, LinearMove, Orientation, Program};
 use nalgebra::Vector3;
 
 /// Largest tool turn (degrees) of one move in a run: the fit follows the tool axis at the
@@ -63,6 +63,31 @@ pub fn moves_in(program: &Program) -> usize {
         .count()
 }
 
+/// Move `m` may follow `prev` in a run: a feed move that moves the cutter and turns the
+/// tool by at most [`MAX_TURN_DEG`].
+pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) -> bool {
+    let (pa, pb) = (point(prev, kin), point(m, kin));
+    let rot = match (angles(prev), angles(m)) {
+        (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
+        _ => pa.axis.angle(&pb.axis).to_degrees(),
+    };
+    !m.rapid && (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
+}
+
+/// What every move of a run shares: its feed and tool length and mode.
+pub fn run_key(m: &LinearMove) -> (f64, f64, LengthMode) {
+    (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode)
+}
+
+/// The path turns at the end of `m` (from `a`'s end, to `c`'s) by more than `corner_deg`.
+pub fn is_corner(a: &LinearMove, m: &LinearMove, c: &LinearMove, corner_deg: f64) -> bool {
+    let (d1, d2) = (
+        Vector3::from(m.end) - Vector3::from(a.end),
+        Vector3::from(c.end) - Vector3::from(m.end),
+    );
+    d1.angle(&d2).to_degrees() > corner_deg
+}
+
 /// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
 /// run; `may_join(k)`: block k may follow block k - 1 in one.
 pub fn find_runs(
@@ -76,31 +101,19 @@ pub fn find_runs(
         Some(Block::Linear(m)) => Some(m),
         _ => None,
     };
-    let turn_ok = |a: &LinearMove, b: &LinearMove| {
-        let (pa, pb) = (point(a, kin), point(b, kin));
-        let rot = match (angles(a), angles(b)) {
-            (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
-            _ => pa.axis.angle(&pb.axis).to_degrees(),
-        };
-        (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
-    };
     let eligible = |b: usize| -> bool {
         let (Some(m), Some(prev)) = (linear(b), b.checked_sub(1).and_then(linear)) else {
             return false;
         };
-        !m.rapid && turn_ok(prev, m)
+        may_follow(prev, m, kin)
     };
     let corner = |b: usize| -> bool {
         let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
             return true;
         };
-        let (d1, d2) = (
-            Vector3::from(m.end) - Vector3::from(a.end),
-            Vector3::from(c.end) - Vector3::from(m.end),
-        );
-        d1.angle(&d2).to_degrees() > opts.corner_deg
+        is_corner(a, m, c, opts.corner_deg)
     };
-    let key = |m: &LinearMove| (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode);
+    let key = run_key;
     let mut runs = Vec::new();
     let mut b = 1;
     while b < program.blocks.len() {

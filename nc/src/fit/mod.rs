@@ -19,6 +19,7 @@
 pub mod compress;
 pub mod deviation;
 pub mod find;
+pub mod online;
 pub mod runs;
 mod spline;
 
