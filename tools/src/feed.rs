@@ -14,12 +14,11 @@
 
 use crate::exit::InputError;
 use crate::setup::MachineSetup;
+use nc::fit::online::Compressing;
 use nc::kinematics::Joints;
 use nc::parse::{Entries, LineSource, ReadLines};
 use nc::program::Action;
-use nc::stream::{
-    Chunk, Feeder, Machine, ProgramEntries, ProgramSource, Source, Start, StreamError,
-};
+use nc::stream::{Chunk, Feeder, Machine, ProgramSource, Source, Start, StreamError};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -51,8 +50,6 @@ pub struct Ready {
     pub first_window_s: f64,
     /// The program was checked whole before motion.
     pub checked_whole: bool,
-    /// What on-line compression did, when it was on.
-    pub compressed: Option<crate::simulate::Compression>,
 }
 
 /// What the planner thread learns as it reads, for the report.
@@ -68,6 +65,9 @@ pub struct Learned {
     pub words: Mutex<(Vec<String>, usize)>,
     /// The line of the last block the planner read (what an internal error names).
     pub planning_line: AtomicU32,
+    /// What on-line compression has done so far, when it is on (all of it once the planner
+    /// has read the program to its end).
+    pub compressed: Mutex<Option<crate::simulate::Compression>>,
 }
 
 impl Learned {
@@ -82,6 +82,11 @@ impl Learned {
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .clone()
+    }
+
+    /// What on-line compression has done so far, when it is on.
+    pub fn compressed(&self) -> Option<crate::simulate::Compression> {
+        *self.compressed.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// The words, with a last line for those not kept.
@@ -300,34 +305,20 @@ fn feed_program(
         learned,
         t0,
         checked: source.checked,
-        compressed: source.compressed,
     };
-    match source.entries {
-        From::Lines(lines) => {
-            let entries = Noting {
-                inner: Entries::new(lines, &job.shop),
-                learned,
-            };
-            run.go(Source::new(entries, m, job.depth), feeder, finished, ready);
-        }
-        From::Program(entries) => {
-            run.go(Source::new(*entries, m, job.depth), feeder, finished, ready);
-        }
-    }
+    // Runs of moves are compressed (when that is on) as the lines are read.
+    let entries = Noting {
+        inner: Entries::new(source.lines, &job.shop),
+        learned,
+    };
+    let entries = Compressing::new(entries, &job.setup.kin, job.setup.compress);
+    run.go(Source::new(entries, m, job.depth), feeder, finished, ready);
 }
 
-/// The program's entries, ready to stream, whether it was checked whole, and what
-/// compression did to it.
+/// The program's lines, ready to stream, and whether it was checked whole.
 struct Prepared {
-    entries: From,
+    lines: Box<dyn LineSource + Send>,
     checked: bool,
-    compressed: Option<crate::simulate::Compression>,
-}
-
-/// Where the entries come from: the program's lines, or the program parsed whole.
-enum From {
-    Lines(Box<dyn LineSource + Send>),
-    Program(Box<ProgramEntries>),
 }
 
 /// The pre-pass (whole, or started beside the planner) and the source of entries.
@@ -363,28 +354,9 @@ fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
             })
             .map_err(|e| job.unreadable(e))?;
     }
-    if job.setup.compress.is_some() {
-        // Compression fits runs of moves over the whole program: parsed whole first.
-        let bytes = match &job.input {
-            Input::Text(t) => t.to_vec(),
-            Input::File(p) => std::fs::read(p).map_err(|e| job.unreadable(e))?,
-        };
-        let program = crate::parse_program(&bytes, &job.name, &job.shop)?;
-        for a in &program.actions {
-            note(learned, a);
-        }
-        let (program, c) = job.setup.prepare(program);
-        let c = c.map(crate::simulate::Compression::from);
-        return Ok(Prepared {
-            entries: From::Program(Box::new(ProgramEntries::new(program))),
-            checked,
-            compressed: c,
-        });
-    }
     Ok(Prepared {
-        entries: From::Lines(job.lines()?),
+        lines: job.lines()?,
         checked,
-        compressed: None,
     })
 }
 
@@ -394,13 +366,12 @@ struct Feed<'j> {
     learned: &'j Arc<Learned>,
     t0: Instant,
     checked: bool,
-    compressed: Option<crate::simulate::Compression>,
 }
 
 impl Feed<'_> {
     fn go<E: ProgramSource>(
         self,
-        mut source: Source<'_, E>,
+        mut source: Source<'_, Compressing<'_, E>>,
         feeder: &mut Feeder,
         finished: &AtomicBool,
         ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
@@ -434,7 +405,6 @@ impl Feed<'_> {
             start,
             first_window_s: self.t0.elapsed().as_secs_f64(),
             checked_whole: self.checked,
-            compressed: self.compressed,
         };
         if ready.send(Ok(r)).is_err() {
             return;
@@ -477,6 +447,14 @@ impl Feed<'_> {
                     .refuse(line, self.job.stream_error(e).to_string());
                 feeder.refuse(line);
                 stopped = true;
+            }
+            // After the feed: the last chunk is not pushed before the program has ended.
+            if let Some(c) = source.entries().compressed() {
+                *self
+                    .learned
+                    .compressed
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner()) = Some(c.into());
             }
             std::thread::sleep(Duration::from_millis(1));
         }

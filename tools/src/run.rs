@@ -399,7 +399,7 @@ pub fn run_input<L: CanLink + Send>(
             Ok(RunResult {
                 started,
                 program_words: learned.words(),
-                compressed: ready.compressed,
+                compressed: learned.compressed(),
                 end_counts,
                 refusal: learned.refusal().map(|r| r.1),
                 stream: Some(StreamNotes {

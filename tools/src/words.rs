@@ -68,23 +68,20 @@ pub fn text(words: &[String]) -> String {
     s
 }
 
-/// A program's entries, each action's line ([`describe_action`]) kept on the way: the
-/// words of a program that is read as it is planned.
-pub struct Noted<E> {
+/// A program's entries, each action's line ([`describe_action`]) added to `words` on the
+/// way: the words of a program that is read as it is planned.
+pub struct Noted<'w, E> {
     inner: E,
-    pub words: Vec<String>,
+    words: &'w mut Vec<String>,
 }
 
-impl<E> Noted<E> {
-    pub fn new(inner: E) -> Self {
-        Noted {
-            inner,
-            words: Vec::new(),
-        }
+impl<'w, E> Noted<'w, E> {
+    pub fn new(inner: E, words: &'w mut Vec<String>) -> Self {
+        Noted { inner, words }
     }
 }
 
-impl<E: nc::stream::ProgramSource> Iterator for Noted<E> {
+impl<E: nc::stream::ProgramSource> Iterator for Noted<'_, E> {
     type Item = <E as Iterator>::Item;
 
     fn next(&mut self) -> Option<Self::Item> {
@@ -96,7 +93,7 @@ impl<E: nc::stream::ProgramSource> Iterator for Noted<E> {
     }
 }
 
-impl<E: nc::stream::ProgramSource> nc::stream::ProgramSource for Noted<E> {
+impl<E: nc::stream::ProgramSource> nc::stream::ProgramSource for Noted<'_, E> {
     fn tilt_word(&self) -> Option<(char, nc::program::SrcPos)> {
         self.inner.tilt_word()
     }

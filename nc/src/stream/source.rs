@@ -269,6 +269,11 @@ impl<'a, E: ProgramSource> Source<'a, E> {
         self.stages.end().map(|e| e.0)
     }
 
+    /// The entries it reads (what they have noted on the way).
+    pub fn entries(&self) -> &E {
+        self.stages.entries()
+    }
+
     /// The next chunk; None once the program has ended. After an error, None.
     pub fn next_chunk(&mut self) -> Result<Option<Box<Chunk>>, StreamError> {
         loop {

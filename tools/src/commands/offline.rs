@@ -7,10 +7,11 @@ use crate::simulate::{run, summarize, write_trace_header, write_trace_row, Summa
 use crate::words::Noted;
 use crate::{load_machine, load_program};
 use anyhow::Context;
+use nc::fit::online::Compressing;
 use nc::interp::{interpolate, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
 use nc::parse::{Entries, ReadLines};
 use nc::plan::{Finished, ProgramError};
-use nc::stream::{Machine, ProgramEntries, Stages};
+use nc::stream::{Machine, ProgramEntries, ProgramSource, Stages};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -62,36 +63,37 @@ pub fn simulate(
         Unrolled::Stream(e) => InputError::stream(&name, e),
         Unrolled::Unfinished(n) => InputError::program(program, ProgramError::Unfinished(n)),
     };
-    // A program of at most CHECK_WHOLE_BYTES (or one to compress, which needs it whole) is
-    // parsed whole first, so that every syntax error in it is listed; a longer one is read
-    // a line at a time. Either way it is built, planned and interpolated as it is read.
+    // A program of at most CHECK_WHOLE_BYTES is parsed whole first, so that every syntax
+    // error in it is listed; a longer one is read a line at a time. Either way it is
+    // compressed (when that is on), built, planned and interpolated as it is read.
     let size = std::fs::metadata(program).map_or(0, |m| m.len());
-    let whole = setup.compress.is_some() || size <= crate::feed::CHECK_WHOLE_BYTES;
-    let (rolled, blocks, words, compressed) = if whole {
-        let (prog, compressed) = setup.prepare(load_program(program, &parse)?);
+    let (rolled, words) = if size <= crate::feed::CHECK_WHOLE_BYTES {
+        let prog = load_program(program, &parse)?;
         let words = crate::words::describe(&prog);
-        let blocks = prog.blocks.len();
-        let entries = ProgramEntries::new(prog);
-        let rolled = roll(entries, &setup, step, take).map_err(refused)?;
-        (rolled, blocks, words, compressed)
+        let rolled = roll(ProgramEntries::new(prog), &setup, step, take).map_err(refused)?;
+        (rolled, words)
     } else {
         let f = std::fs::File::open(program).map_err(|error| InputError::ReadProgram {
             file: name.clone(),
             error,
         })?;
         let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, f));
-        let entries = Noted::new(Entries::new(lines, &parse));
-        let mut stages = Stages::new(entries, machine_of(&setup));
-        let rolled = interpolate(&mut stages, step, take).map_err(refused)?;
-        let words = std::mem::take(&mut stages.entries_mut().words);
-        (rolled, stages.blocks(), words, None)
+        let mut words = Vec::new();
+        let entries = Noted::new(Entries::new(lines, &parse), &mut words);
+        let rolled = roll(entries, &setup, step, take).map_err(refused)?;
+        (rolled, words)
     };
     if let Some((file, mut w, result)) = trace {
         result
             .and_then(|_| w.flush())
             .with_context(|| format!("{}: cannot write the trace", file.display()))?;
     }
-    let (rolling, plan) = rolled;
+    let Rolled {
+        rolling,
+        plan,
+        blocks,
+        compressed,
+    } = rolled;
     let spindle_waits = machine
         .spindle
         .as_ref()
@@ -116,15 +118,32 @@ fn machine_of(setup: &MachineSetup) -> Machine<'_> {
     }
 }
 
-/// A parsed program's entries through the stages and the rolling interpolator.
-fn roll(
-    entries: ProgramEntries,
+/// A streamed simulation's end.
+struct Rolled {
+    rolling: Rolling,
+    plan: Finished,
+    /// Motion blocks planned (after compression).
+    blocks: usize,
+    compressed: Option<nc::fit::compress::Compressed>,
+}
+
+/// A program's entries through the compressor (when it is on), the stages and the rolling
+/// interpolator.
+fn roll<E: ProgramSource>(
+    entries: E,
     setup: &MachineSetup,
     step: Stepping,
     take: impl FnMut(&Setpoint, Window),
-) -> Result<(Rolling, Finished), Unrolled> {
+) -> Result<Rolled, Unrolled> {
+    let entries = Compressing::new(entries, &setup.kin, setup.compress);
     let mut stages = Stages::new(entries, machine_of(setup));
-    interpolate(&mut stages, step, take)
+    let (rolling, plan) = interpolate(&mut stages, step, take)?;
+    Ok(Rolled {
+        rolling,
+        plan,
+        blocks: stages.blocks(),
+        compressed: stages.entries().compressed(),
+    })
 }
 
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
