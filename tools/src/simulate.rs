@@ -8,7 +8,9 @@
 
 use crate::setup::MachineSetup;
 use nc::arclen::GL8;
-use nc::interp::{Interpolator, Method, Setpoint, Window};
+use nc::fit::online::Compressing;
+use nc::interp::{Interpolator, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
+use nc::stream::{Machine, ProgramSource, Stages};
 use nc::nurbs::DoubleNurbs;
 use nc::plan::{plan, FeedProfile, Finished, ProgramError};
 use nc::program::Program;
@@ -81,6 +83,54 @@ pub fn each_setpoint(
             return Err(ProgramError::Unfinished(MAX_CYCLES));
         }
     }
+}
+
+fn machine_of(setup: &MachineSetup) -> Machine<'_> {
+    Machine {
+        kin: &setup.kin,
+        build: &setup.build,
+        plan: &setup.plan,
+    }
+}
+
+/// The rolling interpolator's stepping on `setup`'s machine with `method`.
+pub fn stepping(setup: &MachineSetup, method: Method) -> Stepping {
+    Stepping {
+        kin: setup.kin,
+        lim: setup.plan.rotary,
+        method,
+        period: setup.period,
+        creep: setup.plan.path_acc * setup.period,
+        speed_cap: setup.build.speed_cap(),
+    }
+}
+
+/// A streamed simulation's end.
+pub struct Rolled {
+    pub rolling: Rolling,
+    pub plan: Finished,
+    /// Motion blocks planned (after compression).
+    pub blocks: usize,
+    pub compressed: Option<nc::fit::compress::Compressed>,
+}
+
+/// A program's entries through the compressor (when it is on), the stages and the rolling
+/// interpolator.
+pub fn roll<E: ProgramSource>(
+    entries: E,
+    setup: &MachineSetup,
+    step: Stepping,
+    take: impl FnMut(&Setpoint, Window),
+) -> Result<Rolled, Unrolled> {
+    let entries = Compressing::new(entries, &setup.kin, setup.compress);
+    let mut stages = Stages::new(entries, machine_of(setup));
+    let (rolling, plan) = nc::interp::interpolate(&mut stages, step, take)?;
+    Ok(Rolled {
+        rolling,
+        plan,
+        blocks: stages.blocks(),
+        compressed: stages.entries().compressed(),
+    })
 }
 
 /// Per-axis values in machine order (X Y Z, tilt, C).

@@ -3,15 +3,16 @@
 use crate::exit::{InputError, Outcome};
 use crate::setup::MachineSetup;
 use crate::shop::{parse_setup, ShopArgs};
-use crate::simulate::{run, summarize, write_trace_header, write_trace_row, Summarizer};
+use crate::simulate::{
+    roll, run, summarize, write_trace_header, write_trace_row, Rolled, Summarizer,
+};
 use crate::words::Noted;
 use crate::{load_machine, load_program};
 use anyhow::Context;
-use nc::fit::online::Compressing;
-use nc::interp::{interpolate, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
+use nc::interp::{Method, Setpoint, Unrolled, Window};
 use nc::parse::{Entries, ReadLines};
-use nc::plan::{Finished, ProgramError};
-use nc::stream::{Machine, ProgramEntries, ProgramSource, Stages};
+use nc::plan::ProgramError;
+use nc::stream::ProgramEntries;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -51,14 +52,7 @@ pub fn simulate(
             *result = write_trace_row(w, sp);
         }
     };
-    let step = Stepping {
-        kin: setup.kin,
-        lim: setup.plan.rotary,
-        method,
-        period: setup.period,
-        creep: setup.plan.path_acc * setup.period,
-        speed_cap: setup.build.speed_cap(),
-    };
+    let step = crate::simulate::stepping(&setup, method);
     let refused = |e: Unrolled| match e {
         Unrolled::Stream(e) => InputError::stream(&name, e),
         Unrolled::Unfinished(n) => InputError::program(program, ProgramError::Unfinished(n)),
@@ -108,42 +102,6 @@ pub fn simulate(
         print!("{}", summary.text());
     }
     Ok(Outcome::Completed)
-}
-
-fn machine_of(setup: &MachineSetup) -> Machine<'_> {
-    Machine {
-        kin: &setup.kin,
-        build: &setup.build,
-        plan: &setup.plan,
-    }
-}
-
-/// A streamed simulation's end.
-struct Rolled {
-    rolling: Rolling,
-    plan: Finished,
-    /// Motion blocks planned (after compression).
-    blocks: usize,
-    compressed: Option<nc::fit::compress::Compressed>,
-}
-
-/// A program's entries through the compressor (when it is on), the stages and the rolling
-/// interpolator.
-fn roll<E: ProgramSource>(
-    entries: E,
-    setup: &MachineSetup,
-    step: Stepping,
-    take: impl FnMut(&Setpoint, Window),
-) -> Result<Rolled, Unrolled> {
-    let entries = Compressing::new(entries, &setup.kin, setup.compress);
-    let mut stages = Stages::new(entries, machine_of(setup));
-    let (rolling, plan) = interpolate(&mut stages, step, take)?;
-    Ok(Rolled {
-        rolling,
-        plan,
-        blocks: stages.blocks(),
-        compressed: stages.entries().compressed(),
-    })
 }
 
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
