@@ -10,11 +10,11 @@ use crate::setup::MachineSetup;
 use nc::arclen::GL8;
 use nc::fit::online::Compressing;
 use nc::interp::{Interpolator, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
-use nc::stream::{Machine, ProgramSource, Stages};
 use nc::nurbs::DoubleNurbs;
 use nc::plan::{plan, FeedProfile, Finished, ProgramError};
 use nc::program::Program;
 use nc::segment::{build, Path};
+use nc::stream::{Machine, ProgramSource, Stages};
 pub use nc::verify::MAX_CYCLES;
 use serde::Serialize;
 
