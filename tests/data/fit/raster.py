@@ -2,6 +2,11 @@
 # surface, 1 mm step-overs (also 0.1 mm moves) between them, F3000.
 #   python3 raster.py 3axis   > raster-3axis.nc   (tool vertical)
 #   python3 raster.py 5axis   > raster-5axis.nc   (tool along the surface normal, I J K)
+#   python3 raster.py tilted-ac [--linuxcnc] > raster-tilted-ac.nc
+#       the tool inclined 15 degrees toward -Y (as a ball-end mill is, to keep the cutting
+#       off its tip) and following a third of the surface's slope: A and C turn a little on
+#       every move (A about 12 to 19 degrees, C within about 35 degrees), never through the
+#       vertical; machine angles as for 5axis-ac.
 #   python3 raster.py 5axis-ac [--linuxcnc] > raster-5axis-ac.nc
 #       the same tool axes as machine angles A C (degrees) for an xyzac-trt machine (A tilts
 #       about X, C turns the table; X Y Z stay the tool tip in the workpiece frame, RTCP).
@@ -35,6 +40,12 @@ def normal(x, y):
     dzdy = -2.0 / 10.0 * math.sin(x / 8.0) * math.sin(y / 10.0)
     n = (-dzdx, -dzdy, 1.0); l = math.sqrt(sum(c * c for c in n))
     return tuple(c / l for c in n)
+def tilted(x, y):
+    n = normal(x, y)
+    lean = math.radians(15.0)
+    t = (n[0] / 3.0, n[1] / 3.0 - math.sin(lean), math.cos(lean))
+    l = math.sqrt(sum(c * c for c in t))
+    return tuple(c / l for c in t)
 pts = []
 for r in range(rows):
     y = r * over
@@ -53,8 +64,8 @@ for k, (x, y) in enumerate(pts):
     if mode == "5axis":
         n = normal(x, y)
         print("%sX%.4f Y%.4f Z%.4f I%.6f J%.6f K%.6f%s" % (w, x, y, z(x, y), n[0], n[1], n[2], f))
-    elif mode == "5axis-ac":
-        prev = ac_angles(normal(x, y), prev)
+    elif mode in ("5axis-ac", "tilted-ac"):
+        prev = ac_angles(normal(x, y) if mode == "5axis-ac" else tilted(x, y), prev)
         print("%sX%.4f Y%.4f Z%.4f A%.6f C%.6f%s" % (w, x, y, z(x, y), prev[0], c_sign * prev[1], f))
     else:
         print("%sX%.4f Y%.4f Z%.4f%s" % (w, x, y, z(x, y), f))
