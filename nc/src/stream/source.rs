@@ -1,7 +1,9 @@
 //! [`Source`]: a program in, chunks out, read a line at a time. It chains the streaming
 //! stages: the parser's entries ([`crate::parse::Entries`], or a parsed program's,
-//! [`ProgramEntries`]), the segment builder, the [`Planner`] and the [`Cutter`], and holds
-//! only what each holds: a line, a block, the planner's windows, the chunks not yet taken.
+//! [`ProgramEntries`]; on-line compression wraps either, `crate::fit::online`), the segment
+//! builder and the [`Planner`] ([`Stages`], whose final plan can go to any [`Sink`]), and
+//! the [`Cutter`], and holds only what each holds: a line, a block (or the run of moves
+//! being compressed), the planner's windows, the chunks not yet taken.
 //! Its chunks are the ones [`super::cut`] cuts from [`crate::plan::plan`]'s plan of the
 //! whole program, but for what only the whole plan knows: each chunk's `vmax_ahead` is the
 //! machine's speed cap, and the start's margins are [`Margins::ceiling`].
