@@ -70,14 +70,6 @@ fn main() {
             lines as f64 / secs,
             rolled.rolling.most_held(),
         );
-        if let Some((m, t)) = before {
-            print!(
-                " ({:.1}x the time for {:.0}x)",
-                secs / t,
-                n as f64 / m as f64
-            );
-        }
-        println!();
-        before = Some((n, secs));
+        common::end_line(&mut before, n, secs);
     }
 }

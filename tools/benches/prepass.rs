@@ -50,14 +50,6 @@ fn main() {
             passed.lines,
             f64::from(passed.lines) / secs / 1e6
         );
-        if let Some((m, t)) = before {
-            print!(
-                " ({:.1}x the time for {:.0}x)",
-                secs / t,
-                n as f64 / m as f64
-            );
-        }
-        println!();
-        before = Some((n, secs));
+        common::end_line(&mut before, n, secs);
     }
 }

@@ -80,3 +80,17 @@ pub fn write_wiggle(path: &std::path::Path, n: usize) -> std::io::Result<()> {
     w.write_all(b"M30\n%\n")?;
     w.flush()
 }
+
+/// End a size's line with the ratio of its time to the size before's (10x the moves should
+/// cost at most 11x the time), and remember this one.
+pub fn end_line(before: &mut Option<(usize, f64)>, n: usize, secs: f64) {
+    if let Some((m, t)) = *before {
+        print!(
+            " ({:.1}x the time for {:.0}x)",
+            secs / t,
+            n as f64 / m as f64
+        );
+    }
+    println!();
+    *before = Some((n, secs));
+}
