@@ -334,14 +334,19 @@ fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
         "{got}"
     );
 
-    // X400 at move 170 000, past the 290 mm travel: refused at its line.
+    // X400 at move 170 000, past the 290 mm travel: refused at its line, and the trace of
+    // what came before it is not left as if it were the program's.
     std::fs::write(&file, long_program(n, Some(170_000))).unwrap();
-    let out = dnurbs(&args);
+    let trace = temp("refused-trace.csv");
+    let mut with_trace = args.to_vec();
+    with_trace.extend(["--trace", trace.to_str().unwrap()]);
+    let out = dnurbs(&with_trace);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
         err.contains(&format!("{}:170004:", file.display())),
         "{err}"
     );
+    assert!(!trace.exists(), "a refused program's trace is removed");
     let _ = std::fs::remove_file(&file);
 }

@@ -120,6 +120,20 @@ fn sigterm_stops_the_demo_along_the_path_with_exit_4() {
 #[test]
 #[ignore = "a real-time measurement of about 25 s; see its doc"]
 fn a_dense_g01_program_runs_in_the_planned_time_without_a_feed_hold() {
+    dense_run(false);
+}
+
+/// The same program compressed on line (`[interpolation] compress`): the planner thread
+/// fits each run of up to `MAX_RUN` moves at once, in tens of milliseconds, while the tool
+/// moves on what was queued before; the run must not hold for it.
+/// `cargo test --release -p dnurbs-tools --test run_outcomes -- --ignored --nocapture dense`.
+#[test]
+#[ignore = "a real-time measurement of about 25 s; see its doc"]
+fn a_dense_g01_program_compressed_on_line_runs_without_a_feed_hold() {
+    dense_run(true);
+}
+
+fn dense_run(compress: bool) {
     // A circle of radius 160 mm about the origin with a 2 mm ripple, 12 waves a turn.
     let wave = |t: f64| {
         let r = 160.0 + 2.0 * (12.0 * t).sin();
@@ -135,8 +149,10 @@ fn a_dense_g01_program_runs_in_the_planned_time_without_a_feed_hold() {
     machine.realtime.feedback_timeout_s = 2.0;
     machine.realtime.heartbeat_timeout_s = 5.0;
     machine.realtime.max_consecutive_overruns = 100_000;
+    machine.interpolation.compress = compress;
     let setup = dnurbs_tools::setup::MachineSetup::new(&machine);
     let program = nc::parse::parse(&src).expect("parses");
+    let (program, _) = setup.prepare(program);
     let path = nc::segment::build(&program, &setup.kin, &setup.build).expect("builds");
     let planned = nc::plan::plan(&path, &setup.kin, &setup.plan)
         .expect("plans")
@@ -150,10 +166,16 @@ fn a_dense_g01_program_runs_in_the_planned_time_without_a_feed_hold() {
     let rep = r.report("dense.nc", &machine.name);
     let ran = r.stats.cycles as f64 * machine.period_s;
     println!(
-        "20 000 moves of 0.05 mm, F3000, {}: planned {planned:.3} s; run {ran:.3} s of \
+        "20 000 moves of 0.05 mm, F3000, {}{}: planned {planned:.3} s; run {ran:.3} s of \
          periods ({} cycles, with enable and disable), {wall:.1} s wall; feed holds {}, \
-         hard stops {}, overruns {}",
-        machine.name, r.stats.cycles, rep.feed_holds, rep.hard_stops, rep.overruns
+         hard stops {}, overruns {}; compressed {:?}",
+        machine.name,
+        if compress { " compressed" } else { "" },
+        r.stats.cycles,
+        rep.feed_holds,
+        rep.hard_stops,
+        rep.overruns,
+        rep.compressed
     );
     assert_eq!(rep.stop_reason, None, "{}", rep.text());
     assert_eq!((rep.feed_holds, rep.hard_stops), (0, 0), "{}", rep.text());

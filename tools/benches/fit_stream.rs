@@ -2,7 +2,7 @@
 //! climbing arc of 30 mm radius in moves of 0.1 mm, the tool leaning 5 to 25 degrees toward
 //! the axis and swinging with it) is generated a line at a time, parsed and fitted into
 //! G06.5 blocks as it is read (`nc::fit::online::Compressing`, the compressor `simulate
-//! --compress` and `run` use: runs of at most 20 000 moves). Per size: moves fitted, blocks,
+//! --compress` and `run` use: runs of at most 5 000 moves). Per size: moves fitted, blocks,
 //! the time, moves a second and the peak resident memory (reset before each size), and
 //! the ratio to the size before (10x the moves should cost at most 11x the time).
 //!

@@ -306,12 +306,17 @@ fn feed_program(
         t0,
         checked: source.checked,
     };
-    // Runs of moves are compressed (when that is on) as the lines are read.
+    // Runs of moves are compressed (when that is on) as the lines are read; what reaches
+    // the builder is noted (its line is what an internal error names).
+    let entries = Compressing::new(
+        Entries::new(source.lines, &job.shop),
+        &job.setup.kin,
+        job.setup.compress,
+    );
     let entries = Noting {
-        inner: Entries::new(source.lines, &job.shop),
+        inner: entries,
         learned,
     };
-    let entries = Compressing::new(entries, &job.setup.kin, job.setup.compress);
     run.go(Source::new(entries, m, job.depth), feeder, finished, ready);
 }
 
@@ -371,7 +376,7 @@ struct Feed<'j> {
 impl Feed<'_> {
     fn go<E: ProgramSource>(
         self,
-        mut source: Source<'_, Compressing<'_, E>>,
+        mut source: Source<'_, Noting<'_, Compressing<'_, E>>>,
         feeder: &mut Feeder,
         finished: &AtomicBool,
         ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
@@ -449,7 +454,7 @@ impl Feed<'_> {
                 stopped = true;
             }
             // After the feed: the last chunk is not pushed before the program has ended.
-            if let Some(c) = source.entries().compressed() {
+            if let Some(c) = source.entries().inner.compressed() {
                 *self
                     .learned
                     .compressed

@@ -6,10 +6,12 @@
 //! (the same code, resumed at its own [`Mark`] over a window whose indices moved with the
 //! dropped front), so `simulate` needs no memory for the program however long it is.
 //!
-//! How far the data reach: a step needs the phase that holds its time, and the path a
-//! period's travel past the end of the segment the interpolator stands on (a Taylor method
-//! drifts from the plan's s(t), so its own segment is the measure, not the plan's). Until
-//! the plan is finished, the interpolator stops short of either end and waits for more.
+//! How far the data reach: a step needs the phase that holds its time (and the next one's
+//! start), and the path a period's travel past the end of the segment the interpolator
+//! stands on (a Taylor method drifts from the plan's s(t), so its own segment is the
+//! measure, not the plan's). Until the plan is finished, the interpolator stops short of
+//! either end and waits for more; a step that runs off the path held all the same (a
+//! Taylor step on a curve whose parameter speed jumps) is taken back, never given.
 
 use super::{Interpolator, Mark, Method, Setpoint};
 use crate::kinematics::{MachineKinematics, RotaryLimits};
@@ -147,8 +149,16 @@ impl Rolling {
         };
         let mut stepped = self.mark.is_some();
         while self.finished || ready(&self.profile, &self.path, &ip.mark(), &s) {
-            stepped = true;
+            let before = ip.mark();
             let sp = ip.step();
+            if sp.done && !self.finished {
+                // A Taylor step carried past the last segment held (on a curve a step's
+                // overshoot scales with the parameter speed): that is not the program's
+                // end. Take the step back and wait for more of the path.
+                ip.resume(&before);
+                break;
+            }
+            stepped = true;
             take(&sp, window);
             if sp.done || self.path.segments.is_empty() {
                 self.done = true;
@@ -187,11 +197,12 @@ impl Rolling {
 }
 
 /// Whether the next step's data have all arrived: the phase that holds its time, and the
-/// path a period's travel (twice over) past the end of the segment the interpolator stands
-/// on.
+/// one after it (the whole plan's walk moves on to a phase once its start is reached), and
+/// the path a period's travel (twice over) past the end of the segment the interpolator
+/// stands on. A step that still runs off the path held is taken back ([`Rolling::run`]).
 fn ready(profile: &FeedProfile, path: &Path, mark: &Mark, s: &Stepping) -> bool {
     let t = mark.next_cycle() as f64 * s.period;
-    let in_time = profile.phases.last().is_some_and(|p| t <= p.t0 + p.dur);
+    let in_time = profile.phases.last().is_some_and(|p| t < p.t0);
     let seg = mark.segment();
     let (Some(&end), Some(&seg_end)) = (profile.seg_start.last(), profile.seg_start.get(seg + 1))
     else {

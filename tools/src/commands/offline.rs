@@ -34,6 +34,7 @@ pub fn simulate(
     let method = method.unwrap_or(setup.method);
     let name = program.display().to_string();
     // The setpoints go to the summary (and the trace) as they are made: none is kept.
+    let trace_file = trace.clone();
     let mut trace = match &trace {
         Some(file) => {
             let f = std::fs::File::create(file)
@@ -53,23 +54,36 @@ pub fn simulate(
         }
     };
     let step = crate::simulate::stepping(&setup, method);
-    let refused = |e: Unrolled| match e {
-        Unrolled::Stream(e) => InputError::stream(&name, e),
-        Unrolled::Unfinished(n) => InputError::program(program, ProgramError::Unfinished(n)),
+    // A refused program leaves no trace: what was simulated before the error is not the
+    // program's (nothing is silently cut short).
+    let discard = || {
+        if let Some(file) = &trace_file {
+            let _ = std::fs::remove_file(file);
+        }
+    };
+    let refused = |e: Unrolled| {
+        discard();
+        match e {
+            Unrolled::Stream(e) => InputError::stream(&name, e),
+            Unrolled::Unfinished(n) => InputError::program(program, ProgramError::Unfinished(n)),
+        }
     };
     // A program of at most CHECK_WHOLE_BYTES is parsed whole first, so that every syntax
     // error in it is listed; a longer one is read a line at a time. Either way it is
     // compressed (when that is on), built, planned and interpolated as it is read.
     let size = std::fs::metadata(program).map_or(0, |m| m.len());
     let (rolled, words) = if size <= crate::feed::CHECK_WHOLE_BYTES {
-        let prog = load_program(program, &parse)?;
+        let prog = load_program(program, &parse).inspect_err(|_| discard())?;
         let words = crate::words::describe(&prog);
         let rolled = roll(ProgramEntries::new(prog), &setup, step, take).map_err(refused)?;
         (rolled, words)
     } else {
-        let f = std::fs::File::open(program).map_err(|error| InputError::ReadProgram {
-            file: name.clone(),
-            error,
+        let f = std::fs::File::open(program).map_err(|error| {
+            discard();
+            InputError::ReadProgram {
+                file: name.clone(),
+                error,
+            }
         })?;
         let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, f));
         let mut words = Vec::new();
