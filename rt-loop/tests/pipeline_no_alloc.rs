@@ -117,18 +117,24 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
                 (e, f)
             })
             .unwrap();
-        // The planner: stream the rest, free what comes back; the operator: the script.
-        let mut ms = 0;
+        // The planner: stream the rest, free what comes back; the operator: the script. Its
+        // clock runs while the program runs, and holds at the resume until the pause has
+        // shown: on a loaded machine the drives' set-up can outlast the whole script, and
+        // the pause and the resume would then land in one period, the pause never shown.
+        let (mut ms, mut next) = (0, 0);
         while !finished.load(Ordering::SeqCst) {
             feeder.feed(&mut source);
-            for (at, c) in script {
-                if ms == at {
-                    command_tx.enqueue(c).unwrap();
-                }
+            while let Some(&(_, c)) = script.get(next).filter(|s| ms >= s.0) {
+                command_tx.enqueue(c).unwrap();
+                next += 1;
             }
-            paused_seen |= progress.snapshot().paused;
+            let snap = progress.snapshot();
+            paused_seen |= snap.paused;
             std::thread::sleep(Duration::from_millis(1));
-            ms += 1;
+            let resuming = script.get(next).is_some_and(|s| s.1 == Command::Resume);
+            if snap.stage == "running" && (paused_seen || !resuming) {
+                ms += 1;
+            }
         }
         rt.join().unwrap()
     });
