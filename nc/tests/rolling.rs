@@ -135,3 +135,73 @@ fn the_rolling_window_does_not_grow_with_the_program() {
         "the window held {held_short} segments of 40 000 and {held_long} of 160 000"
     );
 }
+
+/// The window fed far more finely than the planner feeds it: a segment at a time, with the
+/// phases that start on it, the interpolator run after each. It stops at every boundary the
+/// data leave it (and a Taylor step that runs off the segments held is taken back), and
+/// the setpoints are still those over the whole path, with every method.
+#[test]
+fn fed_a_segment_at_a_time_the_rolling_interpolator_still_gives_the_whole_paths_setpoints() {
+    use nc::interp::Rolling;
+    use nc::plan::{Finished, Sink};
+    let kin = MachineKinematics::Paper;
+    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
+    let mut compared = 0;
+    for rel in nc::fixtures::TEST_PROGRAMS {
+        let text = nc::fixtures::test_program(rel);
+        let Ok(program) = nc::parse::parse(&text) else {
+            continue;
+        };
+        let Ok(path) = build(&program, &kin, &bl) else {
+            continue;
+        };
+        let Ok(profile) = plan(&path, &kin, &cfg) else {
+            continue;
+        };
+        // The Taylor methods also with no margin past the segment they stand on (a speed
+        // cap of 0): then every step that runs off the segments held must be taken back.
+        let runs = [
+            (Method::ArcLength, false),
+            (Method::Taylor1, false),
+            (Method::Taylor2, false),
+            (Method::Taylor1, true),
+            (Method::Taylor2, true),
+        ];
+        for (method, no_margin) in runs {
+            let mut st = stepping(kin, &cfg, &bl, method);
+            let want = whole(&text, &st, &cfg, &bl).expect("runs whole");
+            if no_margin {
+                st.speed_cap = 0.0;
+            }
+            let mut r = Rolling::new(st);
+            r.start_at(path.start, path.start_joints);
+            let mut got = Vec::new();
+            let (mut end, mut next_phase) = (0.0, 0);
+            for seg in &path.segments {
+                end += seg.length;
+                let upto = profile.phases.partition_point(|p| p.s0 <= end);
+                r.phases(&profile.phases[next_phase..upto.max(next_phase)]);
+                next_phase = next_phase.max(upto);
+                r.segment(seg.clone());
+                r.run(|sp, _| got.push(*sp)).expect("runs");
+            }
+            r.phases(&profile.phases[next_phase..]);
+            r.finish(&Finished {
+                length: profile.length,
+                duration: profile.duration,
+                margins: profile.margins,
+            });
+            r.run(|sp, _| got.push(*sp)).expect("runs");
+            let name = format!(
+                "{rel} {method:?}{}",
+                if no_margin { ", no margin" } else { "" }
+            );
+            assert_eq!(want.len(), got.len(), "{name}: setpoints");
+            if let Some(i) = (0..want.len()).find(|&i| want[i] != got[i]) {
+                panic!("{name}: setpoint {i}: {:?} != {:?}", want[i], got[i]);
+            }
+            compared += 1;
+        }
+    }
+    assert!(compared >= 60, "{compared} runs compared");
+}
