@@ -15,7 +15,7 @@ mod common;
 
 use dnurbs_tools::simulate::{roll, stepping, Summarizer};
 use nc::interp::Method;
-use nc::parse::{Entries, ReadLines, Setup};
+use nc::parse::{Entries, Setup};
 use std::time::Instant;
 
 fn main() {
@@ -23,7 +23,7 @@ fn main() {
         return;
     }
     let sizes = common::sizes("100000,1000000");
-    let compress = std::env::var("BENCH_COMPRESS").is_ok_and(|v| v == "1");
+    let compress = common::compressing();
     let (_, setup) = common::paper_machine();
     let setup = setup.with_compress(Some(compress));
     let shop = Setup::default();
@@ -34,13 +34,10 @@ fn main() {
     );
     let mut before: Option<(usize, f64)> = None;
     for &n in &sizes {
-        let path =
-            std::env::temp_dir().join(format!("dnurbs-linear-{}-{n}.nc", std::process::id()));
-        common::write_wiggle(&path, n).expect("the program is written");
+        let (path, _) = common::wiggle_file("linear", n);
         common::reset_peak();
         let clock = Instant::now();
-        let file = std::fs::File::open(&path).expect("the program opens");
-        let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file));
+        let lines = common::read_lines(&path);
         let mut summary = Summarizer::new(&setup);
         let mut first = None;
         let step = stepping(&setup, Method::ArcLength);

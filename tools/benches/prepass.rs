@@ -11,7 +11,7 @@
 
 mod common;
 
-use nc::parse::{ReadLines, Setup};
+use nc::parse::Setup;
 use std::time::Instant;
 
 fn main() {
@@ -23,15 +23,11 @@ fn main() {
     println!("the pre-pass on {} sizes, paper-ac-table:", sizes.len());
     let mut before: Option<(usize, f64)> = None;
     for &n in &sizes {
-        let path =
-            std::env::temp_dir().join(format!("dnurbs-prepass-{}-{n}.nc", std::process::id()));
-        common::write_wiggle(&path, n).expect("the program is written");
-        let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+        let (path, bytes) = common::wiggle_file("prepass", n);
         // Reset the peak: what follows is the pre-pass's alone.
         common::reset_peak();
         let clock = Instant::now();
-        let file = std::fs::File::open(&path).expect("the program opens");
-        let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file));
+        let lines = common::read_lines(&path);
         let passed = nc::prepass::check(
             lines,
             &Setup::default(),

@@ -15,8 +15,8 @@
 mod common;
 
 use nc::fit::online::Compressing;
-use nc::parse::{Entries, ReadLines, Setup};
-use nc::stream::{Machine, Source};
+use nc::parse::{Entries, Setup};
+use nc::stream::Source;
 use std::time::Instant;
 
 fn main() {
@@ -25,7 +25,7 @@ fn main() {
     }
     let sizes = common::sizes("100000,1000000");
     let (machine, setup) = common::paper_machine();
-    let compress = std::env::var("BENCH_COMPRESS").is_ok_and(|v| v == "1");
+    let compress = common::compressing();
     let setup = setup.with_compress(Some(compress));
     let shop = Setup::default();
     let depth = machine.realtime.queue_depth;
@@ -36,19 +36,11 @@ fn main() {
     );
     let mut before: Option<(usize, f64)> = None;
     for &n in &sizes {
-        let path =
-            std::env::temp_dir().join(format!("dnurbs-stream-{}-{n}.nc", std::process::id()));
-        common::write_wiggle(&path, n).expect("the program is written");
-        let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+        let (path, bytes) = common::wiggle_file("stream", n);
         common::reset_peak();
         let clock = Instant::now();
-        let file = std::fs::File::open(&path).expect("the program opens");
-        let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file));
-        let m = Machine {
-            kin: &setup.kin,
-            build: &setup.build,
-            plan: &setup.plan,
-        };
+        let lines = common::read_lines(&path);
+        let m = setup.machine();
         let entries = Compressing::new(Entries::new(lines, &shop), &setup.kin, setup.compress);
         let mut source = Source::new(entries, m, depth);
         let mut first = None;

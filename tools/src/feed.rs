@@ -18,7 +18,7 @@ use nc::fit::online::Compressing;
 use nc::kinematics::Joints;
 use nc::parse::{Entries, LineSource, ReadLines};
 use nc::program::Action;
-use nc::stream::{Chunk, Feeder, Machine, ProgramSource, Source, Start, StreamError};
+use nc::stream::{Chunk, Feeder, ProgramSource, Source, Start, StreamError};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -295,11 +295,7 @@ fn feed_program(
             return;
         }
     };
-    let m = Machine {
-        kin: &job.setup.kin,
-        build: &job.setup.build,
-        plan: &job.setup.plan,
-    };
+    let m = job.setup.machine();
     let run = Feed {
         job,
         learned,

@@ -116,6 +116,15 @@ impl MachineSetup {
         }
     }
 
+    /// The machine a streamed program is planned for (`nc::stream::Stages`, `Source`).
+    pub fn machine(&self) -> nc::stream::Machine<'_> {
+        nc::stream::Machine {
+            kin: &self.kin,
+            build: &self.build,
+            plan: &self.plan,
+        }
+    }
+
     /// `--compress` (`Some(true)`) or `--no-compress` (`Some(false)`) over the machine file.
     pub fn with_compress(mut self, over: Option<bool>) -> MachineSetup {
         if let Some(on) = over {

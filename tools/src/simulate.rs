@@ -14,7 +14,7 @@ use nc::nurbs::DoubleNurbs;
 use nc::plan::{plan, FeedProfile, Finished, ProgramError};
 use nc::program::Program;
 use nc::segment::{build, Path};
-use nc::stream::{Machine, ProgramSource, Stages};
+use nc::stream::{ProgramSource, Stages};
 pub use nc::verify::MAX_CYCLES;
 use serde::Serialize;
 
@@ -43,7 +43,8 @@ pub fn run(program: &Program, setup: &MachineSetup, method: Method) -> Result<Ru
 }
 
 /// Every setpoint of a planned path, period by period, to the last (`done`); a run longer
-/// than [`MAX_CYCLES`] is an error, not a truncated result.
+/// than [`MAX_CYCLES`] is an error, not a truncated result. (`simulate` streams instead,
+/// [`roll`]; this keeps the whole run, for `compare` and the tests.)
 pub fn interpolate(
     path: &Path,
     profile: &FeedProfile,
@@ -51,45 +52,25 @@ pub fn interpolate(
     method: Method,
 ) -> Result<Vec<Setpoint>, ProgramError> {
     let mut setpoints = Vec::with_capacity((profile.duration / setup.period) as usize + 2);
-    each_setpoint(path, profile, setup, method, |sp| setpoints.push(*sp))?;
-    Ok(setpoints)
-}
-
-/// [`interpolate`] without keeping the setpoints: each is handed to `take` as it is made.
-pub fn each_setpoint(
-    path: &Path,
-    profile: &FeedProfile,
-    setup: &MachineSetup,
-    method: Method,
-    mut take: impl FnMut(&Setpoint),
-) -> Result<(), ProgramError> {
-    let creep = setup.plan.path_acc * setup.period;
+    let step = stepping(setup, method);
     let mut ip = Interpolator::new(
         path,
         profile,
-        setup.kin,
-        setup.plan.rotary,
+        step.kin,
+        step.lim,
         method,
-        setup.period,
-        creep,
+        step.period,
+        step.creep,
     );
     loop {
         let sp = ip.step();
-        take(&sp);
+        setpoints.push(sp);
         if sp.done || path.segments.is_empty() {
-            return Ok(());
+            return Ok(setpoints);
         }
         if sp.cycle >= MAX_CYCLES {
             return Err(ProgramError::Unfinished(MAX_CYCLES));
         }
-    }
-}
-
-fn machine_of(setup: &MachineSetup) -> Machine<'_> {
-    Machine {
-        kin: &setup.kin,
-        build: &setup.build,
-        plan: &setup.plan,
     }
 }
 
@@ -123,7 +104,7 @@ pub fn roll<E: ProgramSource>(
     take: impl FnMut(&Setpoint, Window),
 ) -> Result<Rolled, Unrolled> {
     let entries = Compressing::new(entries, &setup.kin, setup.compress);
-    let mut stages = Stages::new(entries, machine_of(setup));
+    let mut stages = Stages::new(entries, setup.machine());
     let (rolling, plan) = nc::interp::interpolate(&mut stages, step, take)?;
     Ok(Rolled {
         rolling,

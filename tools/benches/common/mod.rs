@@ -94,3 +94,25 @@ pub fn end_line(before: &mut Option<(usize, f64)>, n: usize, secs: f64) {
     println!();
     *before = Some((n, secs));
 }
+
+/// `BENCH_COMPRESS=1`: compress the runs of moves on the way (`--compress`).
+pub fn compressing() -> bool {
+    std::env::var("BENCH_COMPRESS").is_ok_and(|v| v == "1")
+}
+
+/// The n-move wiggle written to a file of the temporary directory named for `bench`, and
+/// its size in bytes (the caller removes it).
+pub fn wiggle_file(bench: &str, n: usize) -> (std::path::PathBuf, u64) {
+    let path = std::env::temp_dir().join(format!("dnurbs-{bench}-{}-{n}.nc", std::process::id()));
+    write_wiggle(&path, n).expect("the program is written");
+    let bytes = std::fs::metadata(&path).map_or(0, |m| m.len());
+    (path, bytes)
+}
+
+/// The lines of a program file, read as `dnurbs run` and `simulate` read them.
+pub fn read_lines(
+    path: &std::path::Path,
+) -> nc::parse::ReadLines<std::io::BufReader<std::fs::File>> {
+    let file = std::fs::File::open(path).expect("the program opens");
+    nc::parse::ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file))
+}
