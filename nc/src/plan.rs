@@ -4,12 +4,13 @@
 //! 1. **Stations.** Each segment is sampled at stations about one period of travel apart
 //!    (16..=4096 per segment; 2 or more along a line with a fixed tool axis, whose joints
 //!    move at constant rates). At each station the machine joints q(s) are computed through
-//!    the kinematics (with rotary continuity), and dq/ds, d2q/ds2 by finite differences.
+//!    the kinematics (with rotary continuity), and dq/ds, d2q/ds2, d3q/ds3 by finite
+//!    differences (at a joint of two segments, each side's).
 //! 2. **Velocity ceiling** at each station, the least of: the programmed feed; the chord-error
 //!    limit `2 sqrt(2 rho delta - delta^2) / Ts` (rho = 1/curvature, delta = tolerance); the
 //!    centripetal limit `sqrt(A / curvature)`; for every axis j `vmax_j / |dq_j/ds|` and
-//!    `sqrt(amax_j / (2 |d2q_j/ds2|))` (half the axis acceleration is left for the path
-//!    acceleration, see 4). Near the vertical tool dC/ds grows like 1/sin(A), so this is what
+//!    `sqrt(amax_j / (2 |d2q_j/ds2|))` (at least half the axis acceleration is left for the
+//!    path acceleration, see 4). Near the vertical tool dC/ds grows like 1/sin(A), so this is what
 //!    slows the path and keeps the C axis within its limits.
 //! 3. **Corners.** Where segments meet with a kink in some axis (dq/ds jumps by d_j), the
 //!    joint is passed at `min_j amax_j Ts / d_j`: each axis's velocity then changes by at
@@ -21,10 +22,16 @@
 //! 4. **S-curves between critical points.** Critical points are the start, the end, the
 //!    joints and the local minima of the ceiling. Backward and forward passes make each
 //!    point's speed reachable from its neighbours; then each section gets a jerk-limited
-//!    accelerate / cruise / decelerate profile with the highest cruise speed that fits. Each
-//!    section's path acceleration and jerk are capped so that `|dq_j/ds| * A <= amax_j / 2`
-//!    (and likewise for jerk) over the section. Wherever a section's speed exceeds the
-//!    ceiling at a station, that station becomes a critical point and the plan is redone.
+//!    accelerate / cruise / decelerate profile with the highest cruise speed that fits. Its
+//!    two ramps' path acceleration and jerk are what each axis's share (90 %) leaves after
+//!    the curvature terms, over the stretch each ramp can cover and at the speeds it can
+//!    have there, and never less than half the axis's ([`limits`]). Wherever a section's
+//!    speed exceeds the ceiling at a station, that station becomes a critical point and the
+//!    plan is redone.
+//! 5. **The setpoint check** measures every axis's velocity, acceleration and jerk by finite
+//!    differences at the period ([`crate::verify`]); where one is over its limit the
+//!    ceilings there are lowered (and for jerk the path's share, to half) and the window is
+//!    planned again.
 //!
 //! The result is a [`FeedProfile`]: constant-jerk phases over the whole path, evaluated per
 //! period without allocation.
@@ -32,12 +39,16 @@
 use crate::kinematics::Tilt;
 use crate::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use crate::program::SrcPos;
-use crate::scurve::{push_section, reachable, Motion, Phase};
+use crate::scurve::{push_section, reachable, Motion, Phase, Ramps};
 use crate::segment::{Path, Segment};
 use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
 
+mod limits;
 mod stations;
 mod window;
+
+use limits::{section_ramps, AXIS_SHARE, AXIS_SHARE_LEAST};
+use stations::Station;
 
 pub use window::{Finished, Planner, Sink};
 
@@ -75,15 +86,6 @@ const A_FLOOR: f64 = 1e-3;
 /// Replanning rounds before every violating station is made critical at once.
 const ROUNDS_WORST_ONLY: usize = 60;
 const ROUNDS_MAX: usize = 400;
-
-/// A sample of the path used by the planner.
-#[derive(Clone, Copy, Debug)]
-struct Station {
-    s: f64,
-    vlim: f64,
-    /// |dq_j/ds|.
-    dq: [f64; 5],
-}
 
 /// The planned feed along the whole path.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,21 +170,6 @@ impl Near<'_> {
         let mut i = (self.i0 + local).saturating_sub(1);
         self.profile.at(t, &mut i)
     }
-}
-
-/// Path acceleration and jerk allowed over stations `a..=b`.
-fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64, f64) {
-    let mut acc = cfg.path_acc;
-    let mut jerk = cfg.path_jerk;
-    for s in &st[a..=b] {
-        for (j, ax) in cfg.axes.iter().enumerate() {
-            if s.dq[j] > 1e-15 {
-                acc = acc.min(ax.acceleration / (2.0 * s.dq[j]));
-                jerk = jerk.min(ax.jerk / (2.0 * s.dq[j]));
-            }
-        }
-    }
-    (acc.max(A_FLOOR), jerk.max(A_FLOOR))
 }
 
 /// Speed of a section's phases at path position `s` (bisection in time inside the phase).
@@ -386,7 +373,7 @@ pub enum ProgramError {
 }
 
 /// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.
-fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64) {
+fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64, share: Option<f64>) {
     let a = st.partition_point(|x| x.s < s0);
     let b = st.partition_point(|x| x.s <= s1);
     let (a, b) = if a < b {
@@ -396,6 +383,9 @@ fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64) {
     };
     for x in &mut st[a..b] {
         x.vlim = x.vlim.min(cap).max(V_FLOOR);
+        if let Some(share) = share {
+            x.share = x.share.min(share as f32);
+        }
     }
 }
 
@@ -544,14 +534,26 @@ fn schedule(
 
     let mut phases = Vec::new();
     for round in 0..ROUNDS_MAX {
-        let limits: Vec<(f64, f64)> = crit
+        let vmax: Vec<f64> = crit
             .windows(2)
-            .map(|w| section_limits(st, w[0].0, w[1].0, cfg))
+            .map(|w| {
+                st[w[0].0..=w[1].0]
+                    .iter()
+                    .map(|x| x.vlim)
+                    .fold(0.0, f64::max)
+            })
             .collect();
-        // Backward then forward: every point's speed reachable within its sections.
+        let limits: Vec<Ramps> = crit
+            .windows(2)
+            .zip(&vmax)
+            .map(|(w, &v)| section_ramps(st, w[0], w[1], v, cfg))
+            .collect();
+        // Backward then forward: every point's speed reachable within its sections (a
+        // slow-down by the ramp into the section's end, a speed-up by the one from its
+        // start).
         for k in (0..crit.len() - 1).rev() {
             let len = st[crit[k + 1].0].s - st[crit[k].0].s;
-            let (a, j) = limits[k];
+            let (a, j) = limits[k].end;
             crit[k].1 = crit[k].1.min(reachable(crit[k + 1].1, len, a, j));
         }
         // The start's speed is the committed plan's: it cannot drop. (A rounding's worth
@@ -562,7 +564,7 @@ fn schedule(
         crit[0].1 = v0;
         for k in 1..crit.len() {
             let len = st[crit[k].0].s - st[crit[k - 1].0].s;
-            let (a, j) = limits[k - 1];
+            let (a, j) = limits[k - 1].start;
             crit[k].1 = crit[k].1.min(reachable(crit[k - 1].1, len, a, j));
         }
         phases.clear();
@@ -570,7 +572,6 @@ fn schedule(
         let mut inserts = Vec::new();
         for (k, w) in crit.windows(2).enumerate() {
             let ((ia, va), (ib, vb)) = (w[0], w[1]);
-            let vmax = st[ia..=ib].iter().map(|x| x.vlim).fold(0.0, f64::max);
             let first = phases.len();
             t = push_section(
                 &mut phases,
@@ -578,7 +579,7 @@ fn schedule(
                 st[ia].s,
                 (va, vb),
                 st[ib].s - st[ia].s,
-                vmax,
+                vmax[k],
                 limits[k],
             );
             let sec = &phases[first..];

@@ -163,9 +163,28 @@ pub fn push_change(
     (t, m)
 }
 
+/// The acceleration and jerk limits of a section's two speed changes: the one from its
+/// start and the one into its end (each ramp may be allowed more than the section as a
+/// whole where the path it covers allows more, see the planner's `section_ramps`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ramps {
+    pub start: (f64, f64),
+    pub end: (f64, f64),
+}
+
+impl Ramps {
+    /// The same limits for both.
+    pub fn both(limits: (f64, f64)) -> Ramps {
+        Ramps {
+            start: limits,
+            end: limits,
+        }
+    }
+}
+
 /// Append the phases of one section from `va` to `vb` over `len` starting at time `t0` and
 /// position `s0`: accelerate, cruise at the highest speed up to `vmax` that fits, decelerate,
-/// with acceleration and jerk limits `(acc, jerk)`. Returns the end time.
+/// with the ramps' acceleration and jerk limits. Returns the end time.
 pub fn push_section(
     out: &mut Vec<Phase>,
     t0: f64,
@@ -173,10 +192,11 @@ pub fn push_section(
     (va, vb): (f64, f64),
     len: f64,
     vmax: f64,
-    (acc, jerk): (f64, f64),
+    ramps: Ramps,
 ) -> f64 {
+    let ((a0, j0), (a1, j1)) = (ramps.start, ramps.end);
     let lo = va.max(vb);
-    let fits = |vc: f64| change_dist(va, vc, acc, jerk) + change_dist(vc, vb, acc, jerk) <= len;
+    let fits = |vc: f64| change_dist(va, vc, a0, j0) + change_dist(vc, vb, a1, j1) <= len;
     let vc = if vmax <= lo {
         lo
     } else if fits(vmax) {
@@ -198,8 +218,8 @@ pub fn push_section(
         v: va,
         a: 0.0,
     };
-    let (t1, m1) = push_change(out, t0, start, vc, acc, jerk);
-    let d2 = change_dist(vc, vb, acc, jerk);
+    let (t1, m1) = push_change(out, t0, start, vc, a0, j0);
+    let d2 = change_dist(vc, vb, a1, j1);
     let cruise = (len - (m1.s - s0) - d2).max(0.0);
     let mut t = t1;
     let mut m = m1;
@@ -216,7 +236,7 @@ pub fn push_section(
         t += ph.dur;
         m = ph.end();
     }
-    let (t2, _) = push_change(out, t, m, vb, acc, jerk);
+    let (t2, _) = push_change(out, t, m, vb, a1, j1);
     t2
 }
 

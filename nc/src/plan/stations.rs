@@ -2,10 +2,90 @@
 //! [`super`]), made one segment at a time as segments arrive ([`Sampler`]), so that a
 //! program can be planned while it is read.
 
-use super::{PlanConfig, Station, V_FLOOR};
+use super::{PlanConfig, AXIS_SHARE, V_FLOOR};
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::segment::{Geometry, Segment, Tooling};
 use nalgebra::Vector3;
+
+/// A sample of the path used by the planner.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Station {
+    pub(super) s: f64,
+    pub(super) vlim: f64,
+    /// The joints' derivatives by path length on the way in and on the way out: the same
+    /// but at a joint of two segments, where `before` is the first's end and `after` the
+    /// second's start.
+    pub(super) before: Rates,
+    pub(super) after: Rates,
+    /// Of each axis's acceleration and jerk, the share the sections that hold this station
+    /// plan to (`limits`): lowered to half where the setpoint check finds a jerk over its
+    /// limit.
+    pub(super) share: f32,
+}
+
+/// |dq_j/ds|, |d2q_j/ds2| and |d3q_j/ds3| of each joint at a station, on one segment
+/// (single precision, rounded up: bounds, and a window holds many stations).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rates {
+    d1: [f32; 5],
+    d2: [f32; 5],
+    d3: [f32; 5],
+}
+
+/// `x >= 0` in single precision, not below it.
+fn up(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) < x {
+        // The next f32 up (x >= 0 here).
+        f32::from_bits(y.to_bits() + 1)
+    } else {
+        y
+    }
+}
+
+impl Rates {
+    pub(super) fn new(d1: [f64; 5], d2: [f64; 5], d3: [f64; 5]) -> Rates {
+        Rates {
+            d1: d1.map(|x| up(x.abs())),
+            d2: d2.map(|x| up(x.abs())),
+            d3: d3.map(|x| up(x.abs())),
+        }
+    }
+
+    pub(super) fn d1(&self, j: usize) -> f64 {
+        self.d1[j] as f64
+    }
+
+    pub(super) fn d2(&self, j: usize) -> f64 {
+        self.d2[j] as f64
+    }
+
+    pub(super) fn d3(&self, j: usize) -> f64 {
+        self.d3[j] as f64
+    }
+
+    /// Whether the joints' rates change here (else the curvature terms are zero).
+    pub(super) fn curving(&self) -> bool {
+        self.d2.iter().chain(&self.d3).any(|&x| x > 0.0)
+    }
+
+    /// Each derivative's larger magnitude of the two.
+    pub(super) fn max(&self, other: &Rates) -> Rates {
+        let m = |a: [f32; 5], b: [f32; 5]| core::array::from_fn(|j| a[j].max(b[j]));
+        Rates {
+            d1: m(self.d1, other.d1),
+            d2: m(self.d2, other.d2),
+            d3: m(self.d3, other.d3),
+        }
+    }
+}
+
+impl Station {
+    /// The larger of the two sides' rates of joint `j`.
+    pub(super) fn d1(&self, j: usize) -> f64 {
+        self.before.d1(j).max(self.after.d1(j))
+    }
+}
 
 fn joint_derivatives(q: &[Joints], h: f64, i: usize) -> ([f64; 5], [f64; 5]) {
     let n = q.len();
@@ -177,10 +257,12 @@ impl Sampler {
 
     /// Sample `seg`, the segment after the last one given: its stations go to `out` and the
     /// index of its first station (the joint with the previous segment, whose ceiling takes
-    /// both sides' limits) to `starts`.
+    /// both sides' limits) to `starts`. `smooth`: the joint is G2-continuous (the setpoint
+    /// check measures jerk across it).
     pub(super) fn push(
         &mut self,
         seg: &Segment,
+        smooth: bool,
         kin: &MachineKinematics,
         cfg: &PlanConfig,
         out: &mut Vec<Station>,
@@ -189,7 +271,8 @@ impl Sampler {
         // A line with a fixed tool axis moves every joint at a constant rate, so its ceiling
         // is the same all along: its two ends and a midpoint say all there is (a dense CAM
         // program of such moves would otherwise carry 16 stations a move).
-        let fewest = if constant_rates(seg) { 2 } else { 16 };
+        let lines = constant_rates(seg);
+        let fewest = if lines { 2 } else { 16 };
         let n = ((seg.length / (seg.feed.max(V_FLOOR) * cfg.period)).ceil() as usize)
             .clamp(fewest, 4096);
         let h = seg.length / n as f64;
@@ -202,6 +285,25 @@ impl Sampler {
         }
         self.prev = prev;
         let (start_rate, end_rate) = end_rates(seg, kin, cfg, &q, h);
+        // |d2q/ds2| at each station, and |d3q/ds3| from its change to the neighbours' (for
+        // the curvature terms of the axes' acceleration and jerk, `super::limits`): zero
+        // along a line whose joints move at constant rates (not the differences' rounding).
+        let d2s: Vec<[f64; 5]> = (0..=n)
+            .map(|i| match lines {
+                true => [0.0; 5],
+                false => joint_derivatives(&q, h, i).1,
+            })
+            .collect();
+        let curving = |i: usize| -> ([f64; 5], [f64; 5]) {
+            let d3 = core::array::from_fn(|j| {
+                let before = i
+                    .checked_sub(1)
+                    .map_or(0.0, |p| (d2s[i][j] - d2s[p][j]).abs());
+                let after = d2s.get(i + 1).map_or(0.0, |x| (x[j] - d2s[i][j]).abs());
+                before.max(after) / h
+            });
+            (d2s[i], d3)
+        };
         let mut last_d1 = [0.0; 5];
         let tangent = (!seg.rotary_only)
             .then(|| end_tangent(seg, false))
@@ -238,14 +340,19 @@ impl Sampler {
                     v = v.min((ax.acceleration / (2.0 * d2[j].abs())).sqrt());
                 }
             }
+            let (d2_rates, d3_rates) = curving(i);
+            let rates = Rates::new(peak, d2_rates, d3_rates);
             let st = Station {
                 s: self.s0 + s_loc,
                 vlim: v.max(V_FLOOR),
-                dq: peak,
+                before: rates,
+                after: rates,
+                share: AXIS_SHARE as f32,
             };
             if i == 0 {
                 if let (Some(last), Some((pd1, prev_rotary))) = (out.last_mut(), self.prev_end) {
-                    // The joint with the previous segment: one station, both sides' limits.
+                    // The joint with the previous segment: one station, both sides' limits
+                    // (and each side's rates for the section on that side).
                     let mut vc = last.vlim.min(st.vlim);
                     if prev_rotary != seg.rotary_only || seg.stop {
                         // Path units change (mm <-> degrees), or the tangent kinks inside
@@ -260,7 +367,13 @@ impl Sampler {
                         if jump > 1e-9 {
                             vc = vc.min(ax.acceleration * cfg.period / jump);
                         }
-                        last.dq[j] = last.dq[j].max(st.dq[j]);
+                    }
+                    if smooth {
+                        // The setpoints' jerk across the joint mixes both sides' rates.
+                        let both = last.before.max(&st.after);
+                        (last.before, last.after) = (both, both);
+                    } else {
+                        last.after = st.after;
                     }
                     last.vlim = vc.max(V_FLOOR);
                     starts.push(out.len() - 1);

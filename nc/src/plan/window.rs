@@ -25,10 +25,11 @@
 //! the memory is that of a window or two, whatever the program's length, and the time is
 //! linear in the program.
 
+use super::limits::section_limits;
 use super::stations::Sampler;
 use super::{
-    refuse, schedule, section_limits, too_long, with_dwells, FeedProfile, PlanConfig, PlanError,
-    Station, CAP_MARGIN, VERIFY_ROUNDS, V_FLOOR,
+    refuse, schedule, too_long, with_dwells, FeedProfile, PlanConfig, PlanError, Station,
+    AXIS_SHARE_LEAST, CAP_MARGIN, VERIFY_ROUNDS, V_FLOOR,
 };
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::program::SrcPos;
@@ -104,7 +105,7 @@ impl Top {
         for s in st.get(self.scanned..upto).unwrap_or(&[]) {
             self.v = self.v.max(s.vlim);
             for k in 0..3 {
-                self.dq[k] = self.dq[k].max(s.dq[k]);
+                self.dq[k] = self.dq[k].max(s.d1(k));
             }
         }
         self.scanned = self.scanned.max(upto);
@@ -265,14 +266,14 @@ impl<'a> Planner<'a> {
     /// commit goes to `sink`. An error refuses the program (the position of its block).
     pub fn push(&mut self, seg: Segment, sink: &mut impl Sink) -> Result<(), PlanError> {
         let (kin, cfg) = (self.kin, self.cfg);
-        self.smooth.push(
-            self.path
-                .segments
-                .last()
-                .is_none_or(|p| g2(p, &seg, kin, cfg)),
-        );
+        let smooth = self
+            .path
+            .segments
+            .last()
+            .is_none_or(|p| g2(p, &seg, kin, cfg));
+        self.smooth.push(smooth);
         self.sampler
-            .push(&seg, kin, cfg, &mut self.st, &mut self.starts);
+            .push(&seg, smooth, kin, cfg, &mut self.st, &mut self.starts);
         let s0 = self.profile.seg_start.last().copied().unwrap_or(0.0);
         self.profile.seg_start.push(s0 + seg.length);
         self.path.segments.push(seg);
@@ -604,7 +605,12 @@ impl Windows<'_> {
                     // Behind the window's start: only a slower start would help.
                     return Ok(None);
                 }
-                super::cap_stations(st, v.s, v.v * factor * CAP_MARGIN);
+                // An axis's jerk over its limit: the path's share of it is lowered there too
+                // (slowing down does not lower the path's own term, `q_s s'''`; an
+                // acceleration over it is a corner's velocity jump or the curvature's
+                // term, which slowing down lowers).
+                let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
+                super::cap_stations(st, v.s, v.v * factor * CAP_MARGIN, share);
             }
             last = Some(WindowPlan {
                 offset: committed,

@@ -2,7 +2,7 @@
 //! the program's start, every axis within its limits, all arriving together; planned before
 //! the loop, stepped in it.
 
-use nc::scurve::{push_section, Phase};
+use nc::scurve::{push_section, Phase, Ramps};
 
 /// Axis limits for the approach, in axis units (mm or degrees), joint order.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -37,7 +37,15 @@ impl Approach {
         }
         let mut phases = Vec::new();
         if v.is_finite() {
-            push_section(&mut phases, 0.0, 0.0, (0.0, 0.0), 1.0, v, (a, j));
+            push_section(
+                &mut phases,
+                0.0,
+                0.0,
+                (0.0, 0.0),
+                1.0,
+                v,
+                Ramps::both((a, j)),
+            );
         }
         let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
         Approach {

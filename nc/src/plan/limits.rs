@@ -1,0 +1,326 @@
+//! The path acceleration and jerk a section of the plan is allowed (step 4 of [`super`]).
+//!
+//! Along the path an axis moves with `q'' = q_s s'' + q_ss s'^2` and
+//! `q''' = q_s s''' + 3 q_ss s' s'' + q_sss s'^3` (derivatives of the joints by path length
+//! at the stations, `s'` the path speed). The path terms `q_s s''` and `q_s s'''` get what
+//! the curvature terms leave of each axis's share, at the highest speed the section can
+//! have at each station: a straight stretch gets the whole share, a curved one less.
+
+use super::stations::{Rates, Station};
+use super::{PlanConfig, A_FLOOR};
+use crate::scurve::{change_time, Ramps};
+
+/// Of each axis's acceleration and jerk, the share a section plans to. The rest is left
+/// for what the stations do not see: the path between them, and the parameter update's
+/// drift from the planned feed, which the setpoint check would otherwise catch and cap.
+pub(super) const AXIS_SHARE: f64 = 0.9;
+/// The least share of an axis's acceleration and jerk the path terms get, however much of
+/// it the curvature terms would take (the setpoint check lowers the ceilings where that is
+/// too much).
+pub(super) const AXIS_SHARE_LEAST: f64 = 0.5;
+/// Rounds of [`section_ramps`]: each narrows the stretch a ramp is limited over.
+const RAMP_ROUNDS: usize = 3;
+
+/// The rates of `stations[i]` on the stretch's side: a stretch starts after its first
+/// station and ends before its last (only these can be joints of two segments).
+fn side(stations: &[Station], i: usize) -> &Rates {
+    if i == 0 {
+        &stations[i].after
+    } else {
+        &stations[i].before
+    }
+}
+
+/// Path acceleration and jerk allowed over `stations`, at most `speed(station)` there.
+fn limits_over(
+    stations: &[Station],
+    cfg: &PlanConfig,
+    speed: impl Fn(&Station) -> f64,
+) -> (f64, f64) {
+    // The speed only matters where the rates change (and costs a root to bound).
+    let at = |i: usize, s: &Station| {
+        let r = side(stations, i);
+        (r, if r.curving() { speed(s) } else { 0.0 })
+    };
+    let mut acc = cfg.path_acc;
+    for (i, s) in stations.iter().enumerate() {
+        let (r, v) = at(i, s);
+        let share = s.share as f64;
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            if r.d1(j) > 1e-15 {
+                let curving = r.d2(j) * v * v;
+                let left =
+                    (ax.acceleration * share - curving).max(ax.acceleration * AXIS_SHARE_LEAST);
+                acc = acc.min(left / r.d1(j));
+            }
+        }
+    }
+    let acc = acc.max(A_FLOOR);
+    let mut jerk = cfg.path_jerk;
+    for (i, s) in stations.iter().enumerate() {
+        let (r, v) = at(i, s);
+        let share = s.share as f64;
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            if r.d1(j) > 1e-15 {
+                let curving = 3.0 * r.d2(j) * v * acc + r.d3(j) * v * v * v;
+                let left = (ax.jerk * share - curving).max(ax.jerk * AXIS_SHARE_LEAST);
+                jerk = jerk.min(left / r.d1(j));
+            }
+        }
+    }
+    (acc, jerk.max(A_FLOOR))
+}
+
+/// Path acceleration and jerk allowed over stations `a..=b` at their ceilings.
+pub(super) fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64, f64) {
+    limits_over(&st[a..=b], cfg, |s| s.vlim)
+}
+
+/// What rates `r` allow the path at `share` without the curvature terms: no stretch of path that
+/// holds them is allowed more.
+fn bare_limits(r: &Rates, share: f64, cfg: &PlanConfig) -> (f64, f64) {
+    let (mut acc, mut jerk) = (cfg.path_acc, cfg.path_jerk);
+    for (j, ax) in cfg.axes.iter().enumerate() {
+        if r.d1(j) > 1e-15 {
+            acc = acc.min(ax.acceleration * share / r.d1(j));
+            jerk = jerk.min(ax.jerk * share / r.d1(j));
+        }
+    }
+    (acc.max(A_FLOOR), jerk.max(A_FLOOR))
+}
+
+/// An upper bound of the speed any motion starting at `v0` with no acceleration, within
+/// acceleration and jerk `(a, j)`, has after `d`: the one that raises its acceleration at
+/// `j` up to `a` and keeps it (mid-ramp a motion can be faster than a whole change to
+/// acceleration zero reaches, `reachable`).
+fn fastest(v0: f64, d: f64, (a, j): (f64, f64)) -> f64 {
+    if d <= 0.0 {
+        return v0;
+    }
+    // The jerk phase: t = a / j, over v0 t + j t^3 / 6.
+    let t1 = a / j;
+    let d1 = v0 * t1 + j * t1.powi(3) / 6.0;
+    if d >= d1 {
+        let v1 = v0 + 0.5 * a * t1;
+        return (v1 * v1 + 2.0 * a * (d - d1)).sqrt();
+    }
+    // v0 t + j t^3 / 6 = d, convex and rising in t: Newton from above stays above the
+    // root, so stopping early only raises the bound.
+    let mut t = (6.0 * d / j).cbrt();
+    if v0 > 0.0 {
+        t = t.min(d / v0);
+    }
+    for _ in 0..8 {
+        let f = v0 * t + j * t.powi(3) / 6.0 - d;
+        let df = v0 + 0.5 * j * t * t;
+        if f <= 0.0 || df <= 0.0 {
+            break;
+        }
+        t -= f / df;
+    }
+    v0 + 0.5 * j * t * t
+}
+
+/// Limits of the two ramps of the section from station `a` at speed `va` to station `b` at
+/// `vb` (speeds the planner's passes can only lower), with ceilings up to `vmax`.
+///
+/// - **Speeds.** The start ramp is allowed no more than station `a` allows bare, so no speed
+///   in the section exceeds what that allows from `va` within the distance from `a`
+///   ([`fastest`]); likewise back from `b`. The curvature terms are taken at that speed where it is below
+///   the ceiling: near a slow corner they take little.
+/// - **Stretches.** A ramp covers at most `vmax` times the time of a change from rest to
+///   `vmax`, so each is limited only over the stations within that distance of its end of
+///   the section: on a
+///   long section whose tightest stretch lies in its middle, the ramps are not held to it.
+///   The distance shrinks as the limits grow; each round's limits hold over the last
+///   round's distance, which covers the next.
+pub(super) fn section_ramps(
+    st: &[Station],
+    (a, va): (usize, f64),
+    (b, vb): (usize, f64),
+    vmax: f64,
+    cfg: &PlanConfig,
+) -> Ramps {
+    let (s_a, s_b) = (st[a].s, st[b].s);
+    let ua = bare_limits(&st[a].after, st[a].share as f64, cfg);
+    let ub = bare_limits(&st[b].before, st[b].share as f64, cfg);
+    let speed = |x: &Station| {
+        x.vlim
+            .min(fastest(va, x.s - s_a, ua))
+            .min(fastest(vb, s_b - x.s, ub))
+    };
+    let stations = &st[a..=b];
+    let mut ramps = Ramps::both(limits_over(stations, cfg, speed));
+    for _ in 0..RAMP_ROUNDS {
+        // No change between speeds up to vmax takes longer than vmax * its time from
+        // rest (one from 0.3 vmax up to vmax covers more than one from rest).
+        let d0 = vmax * change_time(vmax, ramps.start.0, ramps.start.1);
+        let d1 = vmax * change_time(vmax, ramps.end.0, ramps.end.1);
+        if d0 + d1 >= s_b - s_a {
+            break;
+        }
+        // Up to the first station at or past the distance (and likewise back from b).
+        let hi = stations.partition_point(|x| x.s < s_a + d0).min(b - a);
+        let lo = stations
+            .partition_point(|x| x.s <= s_b - d1)
+            .saturating_sub(1);
+        ramps = Ramps {
+            start: limits_over(&stations[..=hi], cfg, speed),
+            end: limits_over(&stations[lo..], cfg, speed),
+        };
+    }
+    ramps
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scurve::{change_dist, push_section, reachable, Phase};
+    use proptest::prelude::*;
+
+    fn station(s: f64, vlim: f64, d1: [f64; 5], d2: [f64; 5], d3: [f64; 5]) -> Station {
+        let r = Rates::new(d1, d2, d3);
+        Station {
+            s,
+            vlim,
+            before: r,
+            after: r,
+            share: AXIS_SHARE as f32,
+        }
+    }
+
+    /// Equal but for the single-precision share (0.9 is 0.8999999762 in it).
+    fn near(x: f64, y: f64) -> bool {
+        (x - y).abs() <= 1e-7 * y.abs()
+    }
+
+    fn config() -> PlanConfig {
+        let (mut cfg, _) = crate::fixtures::small_mill(0.001);
+        (cfg.path_acc, cfg.path_jerk) = (1e6, 1e8);
+        cfg
+    }
+
+    /// A straight stretch along X gets X's whole share; one the check found over its jerk
+    /// gets the least (as every section did before the curvature terms were counted).
+    #[test]
+    fn a_straight_stretch_gets_the_axis_share() {
+        let cfg = config();
+        let x = [1.0, 0.0, 0.0, 0.0, 0.0];
+        let mut st: Vec<Station> = (0..=10)
+            .map(|i| station(i as f64, 50.0, x, [0.0; 5], [0.0; 5]))
+            .collect();
+        let (a, j) = section_limits(&st, 0, 10, &cfg);
+        assert!(near(a, 0.9 * 2500.0) && near(j, 0.9 * 50000.0), "{a} {j}");
+        st[5].share = AXIS_SHARE_LEAST as f32;
+        let (a, j) = section_limits(&st, 0, 10, &cfg);
+        assert!(near(a, 0.5 * 2500.0) && near(j, 0.5 * 50000.0), "{a} {j}");
+    }
+
+    /// A 40 mm section whose middle turns C fast: its ramps are not held to the middle, and
+    /// a ramp up from a slow corner counts the curvature at the speeds it can have.
+    #[test]
+    fn ramps_are_limited_by_the_stretch_they_cover() {
+        let cfg = config();
+        let st: Vec<Station> = (0..=400)
+            .map(|i| {
+                let s = i as f64 * 0.1;
+                let tight = (15.0..25.0).contains(&s);
+                let d1 = [1.0, 0.0, 0.0, 0.0, if tight { 0.05 } else { 0.001 }];
+                // X curves hard over the first 0.2 mm: at the ceiling its term would
+                // take more than X's share.
+                let d2 = [if s < 0.2 { 2.0 } else { 0.0 }, 0.0, 0.0, 0.0, 0.0];
+                station(s, 50.0, d1, d2, [0.0; 5])
+            })
+            .collect();
+        // The whole section is held to C's share in the middle.
+        let whole = section_limits(&st, 0, 400, &cfg);
+        let c = 0.9 * 900f64.to_radians() / 0.05;
+        assert!(near(whole.0, c), "{whole:?}");
+        let ramps = section_ramps(&st, (0, 0.0), (400, 0.0), 50.0, &cfg);
+        assert!(ramps.start.1 > 2.0 * whole.1, "{ramps:?} against {whole:?}");
+        assert!(ramps.end.1 > 2.0 * whole.1, "{ramps:?} against {whole:?}");
+        assert!(near(ramps.end.0, 0.9 * 2500.0), "{ramps:?}");
+        // From rest the speed within 0.2 mm stays low, and so does X's curvature term
+        // there: more than the least share, which it would get at the ceiling.
+        assert!(ramps.start.0 > 0.6 * 2500.0, "{ramps:?}");
+    }
+
+    /// The phase of `phases` holding path position `s`, and the time in it.
+    fn state_at(phases: &[Phase], s: f64) -> (&Phase, f64) {
+        let i = phases.partition_point(|p| p.s0 <= s).saturating_sub(1);
+        let p = &phases[i];
+        let (mut lo, mut hi) = (0.0, p.dur);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if p.at(mid).s < s {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        (p, 0.5 * (lo + hi))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// Whatever the joints' rates along a section, the section planned with its ramps'
+        /// limits keeps, at every station, each axis's path terms within what the
+        /// curvature terms leave of its share at the speed the plan has there (or the
+        /// least share): the narrowed stretches and the speed bound never let a ramp use
+        /// more than the stations it crosses allow.
+        #[test]
+        fn a_section_planned_with_its_ramps_keeps_every_station_s_share(
+            rates in proptest::collection::vec(
+                (proptest::array::uniform5(0.0f64..1.5),
+                 proptest::array::uniform5(0.0f64..0.5),
+                 proptest::array::uniform5(0.0f64..2.0)), 4..12),
+            len in 0.5f64..40.0,
+            vmax in 5.0f64..150.0,
+            (fa, fb) in (0.0f64..1.0, 0.0f64..1.0),
+        ) {
+            let cfg = config();
+            let n = 200;
+            // Rates in stretches of the section, each held over a run of stations.
+            let st: Vec<Station> = (0..=n)
+                .map(|i| {
+                    let (d1, d2, d3) = rates[i * rates.len() / (n + 1)];
+                    station(len * i as f64 / n as f64, vmax, d1, d2, d3)
+                })
+                .collect();
+            // Speeds the passes would leave: the lower end reachable from the other.
+            let (mut va, mut vb) = (fa * vmax, fb * vmax);
+            let first = section_ramps(&st, (0, va), (n, vb), vmax, &cfg);
+            if va > vb {
+                va = va.min(reachable(vb, len, first.end.0, first.end.1));
+            } else {
+                vb = vb.min(reachable(va, len, first.start.0, first.start.1));
+            }
+            let ramps = section_ramps(&st, (0, va), (n, vb), vmax, &cfg);
+            let need = if va > vb { ramps.end } else { ramps.start };
+            prop_assert!(change_dist(va, vb, need.0, need.1) <= len * (1.0 + 1e-12));
+            let mut phases = Vec::new();
+            push_section(&mut phases, 0.0, 0.0, (va, vb), len, vmax, ramps);
+            for (i, x) in st.iter().enumerate() {
+                let (p, tau) = state_at(&phases, x.s);
+                let m = p.at(tau);
+                let r = side(&st, i);
+                for (j, ax) in cfg.axes.iter().enumerate() {
+                    let acc_left = (ax.acceleration * AXIS_SHARE - r.d2(j) * m.v * m.v)
+                        .max(ax.acceleration * AXIS_SHARE_LEAST);
+                    prop_assert!(
+                        r.d1(j) * m.a.abs() <= acc_left * (1.0 + 1e-9) + 1e-9,
+                        "station {i} axis {j}: a {} v {} {ramps:?}", m.a, m.v
+                    );
+                    let jerk_left = (ax.jerk * AXIS_SHARE
+                        - 3.0 * r.d2(j) * m.v * m.a.abs()
+                        - r.d3(j) * m.v.powi(3))
+                    .max(ax.jerk * AXIS_SHARE_LEAST);
+                    prop_assert!(
+                        r.d1(j) * p.j.abs() <= jerk_left * (1.0 + 1e-9) + 1e-9,
+                        "station {i} axis {j}: j {} a {} v {} {ramps:?}", p.j, m.a, m.v
+                    );
+                }
+            }
+        }
+    }
+}
