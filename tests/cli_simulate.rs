@@ -4,34 +4,6 @@
 mod common;
 use common::*;
 
-fn f(v: &serde_json::Value, key: &str) -> f64 {
-    v[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("summary has no number {key}: {v}"))
-}
-
-fn assert_within_limits(s: &serde_json::Value) {
-    for key in [
-        "axis_velocity_fraction",
-        "axis_acceleration_fraction",
-        "axis_jerk_fraction",
-    ] {
-        let m = s[key]
-            .as_object()
-            .unwrap_or_else(|| panic!("{key} missing"));
-        assert_eq!(m.len(), 5, "{key}: {m:?}");
-        for (axis, frac) in m {
-            let frac = frac.as_f64().unwrap();
-            assert!(frac <= 1.0 + 1e-6, "{key} {axis} = {frac}");
-        }
-    }
-    assert_eq!(s["axis_travel_ok"], true);
-    assert!(
-        f(s, "chord_error_max_mm") <= f(s, "chord_tolerance_mm"),
-        "{s}"
-    );
-}
-
 #[test]
 fn paper_example_lies_on_both_curves_with_paper_kinematics() {
     let (s, rows) = simulate("paper-example.nc", "paper-ac-table.toml", &[]);

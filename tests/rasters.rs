@@ -40,26 +40,6 @@ fn programmed_points(path: &PathBuf) -> Vec<[f64; 3]> {
         .collect()
 }
 
-fn num(v: &serde_json::Value, key: &str) -> f64 {
-    v[key]
-        .as_f64()
-        .unwrap_or_else(|| panic!("no number {key} in {v}"))
-}
-
-fn assert_within_limits(s: &serde_json::Value) {
-    for key in [
-        "axis_velocity_fraction",
-        "axis_acceleration_fraction",
-        "axis_jerk_fraction",
-    ] {
-        for (axis, frac) in s[key].as_object().expect(key) {
-            let frac = frac.as_f64().unwrap();
-            assert!(frac <= 1.0 + 1e-6, "{key} {axis} = {frac}");
-        }
-    }
-    assert_eq!(s["axis_travel_ok"], true);
-}
-
 /// Distance from `p` to the segment a-b.
 fn to_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
     let d: [f64; 3] = core::array::from_fn(|i| b[i] - a[i]);
@@ -122,8 +102,8 @@ fn the_3axis_raster_compressed_runs_within_1_1x_of_its_programmed_feed_time() {
     assert_within_limits(&s);
     let c = &s["compressed"];
     assert_eq!(c["fitted_blocks"], 63, "{c}");
-    assert!(num(c, "fit_mm") <= 0.001, "{c}");
-    let time = num(&s, "machining_time_s");
+    assert!(f(c, "fit_mm") <= 0.001, "{c}");
+    let time = f(&s, "machining_time_s");
     let ratio = time / programmed;
     eprintln!("3-axis raster: {time} s against {programmed:.3} s at the feed, {ratio:.4}x");
     assert!(ratio <= 1.1, "{time} s against {programmed} s: {ratio}x");
@@ -134,7 +114,7 @@ fn the_3axis_raster_compressed_runs_within_1_1x_of_its_programmed_feed_time() {
         "largest programmed point off the commanded path: {:.3} um",
         off * 1e3
     );
-    assert!(off <= 0.001 + num(&s, "chord_tolerance_mm"), "{off} mm");
+    assert!(off <= 0.001 + f(&s, "chord_tolerance_mm"), "{off} mm");
 }
 
 /// The tool tilted 15 degrees: A and C turn on every move. As posted, every G01 junction
@@ -153,8 +133,8 @@ fn the_tilted_ac_raster_is_accepted_as_posted_and_compressed_within_the_limits()
     assert_within_limits(&compressed);
     assert_eq!(compressed["compressed"]["fitted_blocks"], 63);
     let (t0, t1) = (
-        num(&posted, "machining_time_s"),
-        num(&compressed, "machining_time_s"),
+        f(&posted, "machining_time_s"),
+        f(&compressed, "machining_time_s"),
     );
     eprintln!("tilted A/C raster: {t0} s as posted, {t1} s compressed");
     assert!(t1 < t0);

@@ -172,10 +172,10 @@ impl Near<'_> {
     }
 }
 
-/// Speed of a section's phases at path position `s` (bisection in time inside the phase).
-fn speed_at(phases: &[Phase], s: f64) -> f64 {
+/// The phase of `phases` that holds path position `s`, and the time into it (bisection).
+fn state_at(phases: &[Phase], s: f64) -> Option<(&Phase, f64)> {
     let i = phases.partition_point(|p| p.s0 <= s).saturating_sub(1);
-    let Some(p) = phases.get(i) else { return 0.0 };
+    let p = phases.get(i)?;
     let (mut lo, mut hi) = (0.0, p.dur);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
@@ -185,7 +185,12 @@ fn speed_at(phases: &[Phase], s: f64) -> f64 {
             hi = mid;
         }
     }
-    p.at(0.5 * (lo + hi)).v
+    Some((p, 0.5 * (lo + hi)))
+}
+
+/// Speed of a section's phases at path position `s`.
+fn speed_at(phases: &[Phase], s: f64) -> f64 {
+    state_at(phases, s).map_or(0.0, |(p, tau)| p.at(tau).v)
 }
 
 /// Planning rounds with the setpoint check before the program is refused.

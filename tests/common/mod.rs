@@ -385,3 +385,33 @@ pub fn within_the_limits_at_the_period(
         );
     }
 }
+
+/// A number of a `--json` summary.
+pub fn f(v: &serde_json::Value, key: &str) -> f64 {
+    v[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("summary has no number {key}: {v}"))
+}
+
+/// A `--json` summary's axes within their limits, travel and chord error included.
+pub fn assert_within_limits(s: &serde_json::Value) {
+    for key in [
+        "axis_velocity_fraction",
+        "axis_acceleration_fraction",
+        "axis_jerk_fraction",
+    ] {
+        let m = s[key]
+            .as_object()
+            .unwrap_or_else(|| panic!("{key} missing"));
+        assert_eq!(m.len(), 5, "{key}: {m:?}");
+        for (axis, frac) in m {
+            let frac = frac.as_f64().unwrap();
+            assert!(frac <= 1.0 + 1e-6, "{key} {axis} = {frac}");
+        }
+    }
+    assert_eq!(s["axis_travel_ok"], true);
+    assert!(
+        f(s, "chord_error_max_mm") <= f(s, "chord_tolerance_mm"),
+        "{s}"
+    );
+}

@@ -174,8 +174,9 @@ pub(super) fn section_ramps(
 
 #[cfg(test)]
 mod tests {
+    use super::super::state_at;
     use super::*;
-    use crate::scurve::{change_dist, push_section, reachable, Phase};
+    use crate::scurve::{change_dist, push_section, reachable};
     use proptest::prelude::*;
 
     fn station(s: f64, vlim: f64, d1: [f64; 5], d2: [f64; 5], d3: [f64; 5]) -> Station {
@@ -245,22 +246,6 @@ mod tests {
         assert!(ramps.start.0 > 0.6 * 2500.0, "{ramps:?}");
     }
 
-    /// The phase of `phases` holding path position `s`, and the time in it.
-    fn state_at(phases: &[Phase], s: f64) -> (&Phase, f64) {
-        let i = phases.partition_point(|p| p.s0 <= s).saturating_sub(1);
-        let p = &phases[i];
-        let (mut lo, mut hi) = (0.0, p.dur);
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            if p.at(mid).s < s {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        (p, 0.5 * (lo + hi))
-    }
-
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
         /// Whatever the joints' rates along a section, the section planned with its ramps'
@@ -301,7 +286,7 @@ mod tests {
             let mut phases = Vec::new();
             push_section(&mut phases, 0.0, 0.0, (va, vb), len, vmax, ramps);
             for (i, x) in st.iter().enumerate() {
-                let (p, tau) = state_at(&phases, x.s);
+                let (p, tau) = state_at(&phases, x.s).expect("a phase at every station");
                 let m = p.at(tau);
                 let r = side(&st, i);
                 for (j, ax) in cfg.axes.iter().enumerate() {
