@@ -73,6 +73,98 @@ fn methods_rank_taylor1_taylor2_arclength() {
     );
 }
 
+/// The Taylor methods drift from the plan, which is checked on the arclength setpoints only:
+/// where their own setpoints break a limit, the summary lists each axis and quantity over
+/// its limit with the worst fraction, its time, block and line, and the trace agrees (every
+/// fraction recomputed from it by finite differences at the period). Arc length on the same
+/// program lists nothing.
+#[test]
+fn a_taylor_excess_is_listed_where_it_happens() {
+    let m = config::load(&machine("xyzac-trt-mill.toml")).unwrap();
+    let (s, rows) = simulate(
+        "classics/dual-spline.nc",
+        "xyzac-trt-mill.toml",
+        &["--method", "taylor1"],
+    );
+    let listed = s["limits_exceeded"].as_array().expect("limits_exceeded");
+    assert!(
+        !listed.is_empty(),
+        "taylor1 on dual-spline is over a limit: {s}"
+    );
+    let ts = f(&s, "period_s");
+    // (fraction, row) of the largest velocity and acceleration of each axis.
+    let mut worst = [[(0.0f64, 0usize); 2]; 5];
+    for k in 1..rows.len() {
+        for (j, (_, l)) in m.axes.all().iter().enumerate() {
+            let q = |i: usize| rows[i].axes[j];
+            let v = (q(k) - q(k - 1)).abs() / ts / l.velocity;
+            let a = (k >= 2).then(|| (q(k) - 2.0 * q(k - 1) + q(k - 2)).abs() / (ts * ts));
+            for (n, x) in [(0, Some(v)), (1, a.map(|a| a / l.acceleration))] {
+                if let Some(x) = x.filter(|&x| x > worst[j][n].0) {
+                    worst[j][n] = (x, k);
+                }
+            }
+        }
+    }
+    let mut expected = vec![];
+    for (n, quantity) in ["velocity", "acceleration"].iter().enumerate() {
+        for (j, (name, _)) in m.axes.all().iter().enumerate() {
+            let (frac, k) = worst[j][n];
+            if frac > 1.0 + 1e-6 {
+                expected.push((
+                    name.to_string(),
+                    quantity.to_string(),
+                    frac,
+                    rows[k].t,
+                    rows[k].block,
+                ));
+            }
+        }
+    }
+    assert_eq!(
+        listed.len(),
+        expected.len(),
+        "{listed:?} against the trace's {expected:?}"
+    );
+    let text = std::fs::read_to_string(data("classics/dual-spline.nc")).unwrap();
+    for (e, (axis, quantity, frac, t, block)) in listed.iter().zip(&expected) {
+        assert_eq!(e["axis"], axis.as_str(), "{e}");
+        assert_eq!(e["quantity"], quantity.as_str(), "{e}");
+        assert!(
+            (f(e, "fraction") / frac - 1.0).abs() < 1e-6,
+            "{e}: the trace gives {frac}"
+        );
+        assert_eq!(f(e, "t_s"), *t, "{e}");
+        assert_eq!(f(e, "block") as u32, *block, "{e}");
+        let key = format!("axis_{quantity}_fraction");
+        assert_eq!(f(&s[key.as_str()], axis), f(e, "fraction"), "{e}");
+        // The line named is the block's first: a motion line of the program.
+        let line = text.lines().nth(f(e, "line") as usize - 1).unwrap_or("");
+        assert!(line.contains("G06.5"), "{e}: line {line:?}");
+    }
+    let (s, _) = simulate(
+        "classics/dual-spline.nc",
+        "xyzac-trt-mill.toml",
+        &["--method", "arclength"],
+    );
+    assert_within_limits(&s);
+    let out = dnurbs(&[
+        "simulate",
+        data("classics/dual-spline.nc").to_str().unwrap(),
+        "--machine",
+        machine("xyzac-trt-mill.toml").to_str().unwrap(),
+        "--method",
+        "taylor1",
+    ]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("limits             EXCEEDED by these taylor1 setpoints: ")
+            && text.contains("which run sends"),
+        "{text}"
+    );
+}
+
 #[test]
 fn tight_curvature_is_slowed_by_centripetal_and_c_axis_limits() {
     let (s, rows) = simulate("tight-curvature.nc", "paper-ac-table.toml", &[]);

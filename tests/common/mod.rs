@@ -410,6 +410,12 @@ pub fn assert_within_limits(s: &serde_json::Value) {
         }
     }
     assert_eq!(s["axis_travel_ok"], true);
+    assert_eq!(
+        s["limits_exceeded"].as_array().map(Vec::len),
+        Some(0),
+        "limits_exceeded: {}",
+        s["limits_exceeded"]
+    );
     assert!(
         f(s, "chord_error_max_mm") <= f(s, "chord_tolerance_mm"),
         "{s}"

@@ -146,6 +146,10 @@ pub struct Summary {
     /// across G2-continuous junctions, by third differences at the period).
     pub axis_jerk_fraction: AxisMap,
     pub axis_travel_ok: bool,
+    /// Each axis velocity and acceleration over its limit on these setpoints, at its
+    /// largest. Empty when every one is within its limit: the plan is checked on the
+    /// `arclength` setpoints, so only the Taylor methods (which drift from it) can fill it.
+    pub limits_exceeded: Vec<Exceeded>,
     pub tool_axis_deviation_max_deg: f64,
     pub end_position_error_mm: f64,
     /// Spindle, coolant, tool, stop and dwell words, one line each (`crate::words`).
@@ -158,6 +162,57 @@ pub struct Summary {
     /// What on-line compression did, when it was on.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compressed: Option<Compression>,
+}
+
+/// An axis over its velocity or acceleration limit ([`Summary::limits_exceeded`]): the
+/// largest fraction of the limit, and the first setpoint that reaches it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Exceeded {
+    pub axis: String,
+    /// `velocity` or `acceleration`.
+    pub quantity: &'static str,
+    pub fraction: f64,
+    /// The setpoint's time, its NC block (1-based) and the program line the block starts on.
+    pub t_s: f64,
+    pub block: u32,
+    pub line: u32,
+}
+
+impl Summary {
+    /// The summary's `limits` line: within, or each limit exceeded and where.
+    fn limits_line(&self) -> String {
+        if self.limits_exceeded.is_empty() {
+            return "limits             axis velocity and acceleration within limits\n".into();
+        }
+        let each: Vec<String> = self
+            .limits_exceeded
+            .iter()
+            .map(|e| {
+                format!(
+                    "{} {} {:.1}% at {:.3} s (block {}, line {})",
+                    e.axis,
+                    e.quantity,
+                    e.fraction * 100.0,
+                    e.t_s,
+                    e.block,
+                    e.line
+                )
+            })
+            .collect();
+        let why = if self.method == Method::ArcLength.name() {
+            "the plan was checked on these setpoints: a planner fault, please report it".to_string()
+        } else {
+            format!(
+                "the plan is checked on the arclength setpoints, which run sends; {} drifts from it",
+                self.method
+            )
+        };
+        format!(
+            "limits             EXCEEDED by these {} setpoints: {}\n                   ({why})\n",
+            self.method,
+            each.join("; ")
+        )
+    }
 }
 
 /// See [`Summary::spindle_waits`].
@@ -227,6 +282,7 @@ impl Summary {
              axis acceleration  {}  (of limit)\n\
              axis jerk          {}  (of limit; inside blocks and over G2 junctions)\n\
              axis travel        {}\n\
+             {}\
              tool axis at knots max deviation {:.3e} deg\n\
              end position error {:.3e} mm\n",
             self.machine,
@@ -249,6 +305,7 @@ impl Summary {
             } else {
                 "OUTSIDE LIMITS"
             },
+            self.limits_line(),
             self.tool_axis_deviation_max_deg,
             self.end_position_error_mm,
         ) + &self

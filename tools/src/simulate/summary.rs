@@ -3,7 +3,7 @@
 //! setpoints however long the program (at 10^6 G01 moves they were 2.4 M, the run's largest
 //! allocation).
 
-use super::{arc_between, axis_map, SpindleWaits, Summary};
+use super::{arc_between, axis_map, Exceeded, SpindleWaits, Summary};
 use crate::setup::MachineSetup;
 use nc::interp::{Method, Setpoint, Window};
 use nc::kinematics::Kinematics;
@@ -21,6 +21,8 @@ use nc::verify::dist_to_chord;
 struct BlockSegs {
     /// Block number (0 before the first is loaded).
     number: u32,
+    /// The program line the block starts on.
+    src_line: u32,
     /// Every segment of the block has been seen (a later block's came after them).
     complete: bool,
     /// The block has a straight move (a setpoint without u belongs to it).
@@ -70,6 +72,9 @@ impl BlockSegs {
         }
         if number != self.number {
             self.number = number;
+            self.src_line = seg_at(*cursor)
+                .filter(|s| s.block == number)
+                .map_or(0, |s| s.src.line);
             self.complete = false;
             self.line = false;
             self.turns = false;
@@ -137,8 +142,9 @@ pub struct Summarizer<'a> {
     fsq: f64,
     fn_: u64,
     chord: f64,
-    vfrac: [f64; 5],
-    afrac: [f64; 5],
+    /// Each axis's largest velocity and acceleration fraction, and where.
+    vfrac: [Worst; 5],
+    afrac: [Worst; 5],
     travel_ok: bool,
     tool_dev: f64,
 }
@@ -157,8 +163,8 @@ impl<'a> Summarizer<'a> {
             fsq: 0.0,
             fn_: 0,
             chord: 0.0,
-            vfrac: [0.0; 5],
-            afrac: [0.0; 5],
+            vfrac: [Worst::default(); 5],
+            afrac: [Worst::default(); 5],
             travel_ok: true,
             tool_dev: 0.0,
         }
@@ -225,10 +231,10 @@ impl<'a> Summarizer<'a> {
             self.travel_ok &= q >= l.min - 1e-9 && q <= l.max + 1e-9;
             if let Some(p1) = &self.last[1] {
                 let v = unit(j, sp.joints[j] - p1.joints[j]) / ts;
-                self.vfrac[j] = self.vfrac[j].max(v.abs() / l.velocity);
+                self.vfrac[j].take(v.abs() / l.velocity, sp, self.block.src_line);
                 if let Some(p2) = &self.last[0] {
                     let a = unit(j, sp.joints[j] - 2.0 * p1.joints[j] + p2.joints[j]) / (ts * ts);
-                    self.afrac[j] = self.afrac[j].max(a.abs() / l.acceleration);
+                    self.afrac[j].take(a.abs() / l.acceleration, sp, self.block.src_line);
                 }
             }
         }
@@ -312,8 +318,9 @@ impl<'a> Summarizer<'a> {
             feed_fluctuation_periods: self.fn_,
             chord_error_max_mm: self.chord,
             chord_tolerance_mm: self.setup.plan.chord_tol,
-            axis_velocity_fraction: axis_map(&names, self.vfrac),
-            axis_acceleration_fraction: axis_map(&names, self.afrac),
+            axis_velocity_fraction: axis_map(&names, self.vfrac.map(|w| w.frac)),
+            axis_acceleration_fraction: axis_map(&names, self.afrac.map(|w| w.frac)),
+            limits_exceeded: exceeded(&names, &self.vfrac, &self.afrac),
             axis_jerk_fraction: axis_map(&names, plan.margins.jerk),
             axis_travel_ok: self.travel_ok,
             tool_axis_deviation_max_deg: self.tool_dev,
@@ -323,4 +330,52 @@ impl<'a> Summarizer<'a> {
             compressed: None,
         }
     }
+}
+
+/// The largest fraction of a limit one axis reaches, and the setpoint where it first does.
+#[derive(Clone, Copy, Default)]
+struct Worst {
+    frac: f64,
+    t: f64,
+    block: u32,
+    line: u32,
+}
+
+impl Worst {
+    fn take(&mut self, frac: f64, sp: &Setpoint, line: u32) {
+        if frac > self.frac {
+            *self = Worst {
+                frac,
+                t: sp.t,
+                block: sp.block,
+                line,
+            };
+        }
+    }
+}
+
+/// A fraction above this is over the limit (the rounding of the finite differences
+/// themselves stays far below it).
+const OVER: f64 = 1.0 + 1e-6;
+
+/// The velocities and accelerations over their limits, velocity first, in axis order.
+fn exceeded(names: &[&str; 5], v: &[Worst; 5], a: &[Worst; 5]) -> Vec<Exceeded> {
+    let each = |quantity: &'static str, w: &[Worst; 5]| {
+        names
+            .iter()
+            .zip(w)
+            .filter(|(_, w)| w.frac > OVER)
+            .map(|(axis, w)| Exceeded {
+                axis: axis.to_string(),
+                quantity,
+                fraction: w.frac,
+                t_s: w.t,
+                block: w.block,
+                line: w.line,
+            })
+            .collect::<Vec<_>>()
+    };
+    let mut out = each("velocity", v);
+    out.extend(each("acceleration", a));
+    out
 }
