@@ -163,6 +163,40 @@ fn a_taylor_excess_is_listed_where_it_happens() {
             && text.contains("which run sends"),
         "{text}"
     );
+    // `compare` puts the same in its last column, and `within` for arc length.
+    let out = dnurbs(&[
+        "compare",
+        data("classics/dual-spline.nc").to_str().unwrap(),
+        "--machine",
+        machine("xyzac-trt-mill.toml").to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let table = String::from_utf8_lossy(&out.stdout);
+    let cell = |method: &str| {
+        let row = table
+            .lines()
+            .find(|l| l.starts_with(&format!("| dual-spline.nc | {method} |")))
+            .unwrap_or_else(|| panic!("no {method} row: {table}"));
+        row.trim_end_matches(" |")
+            .rsplit(" | ")
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    let brief: Vec<String> = listed
+        .iter()
+        .map(|e| {
+            let q = &e["quantity"].as_str().unwrap()[..3];
+            format!(
+                "{} {q} {:.1}% at {:.3} s",
+                e["axis"].as_str().unwrap(),
+                f(e, "fraction") * 100.0,
+                f(e, "t_s")
+            )
+        })
+        .collect();
+    assert_eq!(cell("taylor1"), brief.join(", "), "{table}");
+    assert_eq!(cell("arclength"), "within", "{table}");
 }
 
 #[test]

@@ -288,7 +288,8 @@ pub enum Command {
     /// Compare the parameter-update methods on programs (a Markdown table).
     ///
     /// Simulates each program with taylor1, taylor2 and arclength and prints feed
-    /// fluctuation and chord error.
+    /// fluctuation, chord error and the axis velocities and accelerations over their limits
+    /// (the plan is checked on the arclength setpoints; the Taylor methods drift from it).
     #[command(after_help = crate::exit::TABLE)]
     Compare {
         /// NC programs to compare on.

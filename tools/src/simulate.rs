@@ -179,6 +179,30 @@ pub struct Exceeded {
 }
 
 impl Summary {
+    /// `within`, or each velocity and acceleration over its limit: `C acc 239.1% at 55.936 s`.
+    pub fn limits_brief(&self) -> String {
+        if self.limits_exceeded.is_empty() {
+            return "within".into();
+        }
+        self.limits_exceeded
+            .iter()
+            .map(|e| {
+                let q = if e.quantity == "velocity" {
+                    "vel"
+                } else {
+                    "acc"
+                };
+                format!(
+                    "{} {q} {:.1}% at {:.3} s",
+                    e.axis,
+                    e.fraction * 100.0,
+                    e.t_s
+                )
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
     /// The summary's `limits` line: within, or each limit exceeded and where.
     fn limits_line(&self) -> String {
         if self.limits_exceeded.is_empty() {

@@ -124,9 +124,9 @@ pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow:
     let parse = parse_setup(&machine, &shop);
     let setup = MachineSetup::new(&machine).with_compress(shop.compress);
     println!(
-        "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles |"
+        "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles | axis limits |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|");
     for program in programs {
         let (prog, _) = setup.prepare(load_program(program, &parse)?);
         let name = program.file_name().map_or_else(
@@ -137,12 +137,13 @@ pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow:
             let result = run(&prog, &setup, method).map_err(|e| InputError::program(program, e))?;
             let s = summarize(&result, &setup, prog.blocks.len());
             println!(
-                "| {name} | {} | {:.2e} | {:.2e} | {:.2e} | {} |",
+                "| {name} | {} | {:.2e} | {:.2e} | {:.2e} | {} | {} |",
                 s.method,
                 s.feed_fluctuation_max,
                 s.feed_fluctuation_rms,
                 s.chord_error_max_mm,
-                s.cycles
+                s.cycles,
+                s.limits_brief()
             );
         }
     }
