@@ -7,7 +7,7 @@
 //! have at each station: a straight stretch gets the whole share, a curved one less.
 
 use super::stations::{Rates, Station};
-use super::{PlanConfig, A_FLOOR};
+use super::{AxisLimit, PlanConfig, A_FLOOR};
 use crate::scurve::{change_time, Ramps};
 
 /// Of each axis's acceleration and jerk, the share a section plans to. The rest is left
@@ -37,38 +37,51 @@ fn limits_over(
     cfg: &PlanConfig,
     speed: impl Fn(&Station) -> f64,
 ) -> (f64, f64) {
-    // The speed only matters where the rates change (and costs a root to bound).
-    let at = |i: usize, s: &Station| {
+    let acc = least_left(
+        stations,
+        cfg,
+        &speed,
+        cfg.path_acc,
+        |ax| ax.acceleration,
+        |r, j, v| r.d2(j) * v * v,
+    );
+    let jerk = least_left(
+        stations,
+        cfg,
+        &speed,
+        cfg.path_jerk,
+        |ax| ax.jerk,
+        |r, j, v| 3.0 * r.d2(j) * v * acc + r.d3(j) * v * v * v,
+    );
+    (acc, jerk)
+}
+
+/// The least, over `stations` and the axes that move there, of what each station's share of
+/// `limit(axis)` leaves after `curving(rates, axis, speed)` (never less than the least
+/// share), per unit of `|dq/ds|`; at most `cap`, at least [`A_FLOOR`].
+fn least_left(
+    stations: &[Station],
+    cfg: &PlanConfig,
+    speed: &impl Fn(&Station) -> f64,
+    cap: f64,
+    limit: impl Fn(&AxisLimit) -> f64,
+    curving: impl Fn(&Rates, usize, f64) -> f64,
+) -> f64 {
+    let mut out = cap;
+    for (i, s) in stations.iter().enumerate() {
         let r = side(stations, i);
-        (r, if r.curving() { speed(s) } else { 0.0 })
-    };
-    let mut acc = cfg.path_acc;
-    for (i, s) in stations.iter().enumerate() {
-        let (r, v) = at(i, s);
+        // The speed only matters where the rates change (and costs a root to bound).
+        let v = if r.curving() { speed(s) } else { 0.0 };
         let share = s.share as f64;
         for (j, ax) in cfg.axes.iter().enumerate() {
             if r.d1(j) > 1e-15 {
-                let curving = r.d2(j) * v * v;
-                let left =
-                    (ax.acceleration * share - curving).max(ax.acceleration * AXIS_SHARE_LEAST);
-                acc = acc.min(left / r.d1(j));
+                let l = limit(ax);
+                let left = (l * share - curving(r, j, v)).max(l * AXIS_SHARE_LEAST);
+                out = out.min(left / r.d1(j));
             }
         }
     }
-    let acc = acc.max(A_FLOOR);
-    let mut jerk = cfg.path_jerk;
-    for (i, s) in stations.iter().enumerate() {
-        let (r, v) = at(i, s);
-        let share = s.share as f64;
-        for (j, ax) in cfg.axes.iter().enumerate() {
-            if r.d1(j) > 1e-15 {
-                let curving = 3.0 * r.d2(j) * v * acc + r.d3(j) * v * v * v;
-                let left = (ax.jerk * share - curving).max(ax.jerk * AXIS_SHARE_LEAST);
-                jerk = jerk.min(left / r.d1(j));
-            }
-        }
-    }
-    (acc, jerk.max(A_FLOOR))
+    out.max(A_FLOOR)
 }
 
 /// Path acceleration and jerk allowed over stations `a..=b` at their ceilings.
