@@ -143,3 +143,57 @@ fn simulate_compresses_on_request_and_says_so() {
     assert_eq!(both.status.code(), Some(2));
     let _ = std::fs::remove_file(&src);
 }
+
+/// A post's program (NX's swarf pass: machine angles on every move, a `G28 Z` with the
+/// table still tilted after it) is fitted, the move that ends the run stays as written so
+/// the angles are modal after the block, and what is written runs in `simulate` on the
+/// post's machine. A refused program leaves no file, and no partial one.
+#[test]
+fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
+    let posts = root().join("tests/data/posts");
+    let (mach, tools) = (posts.join("machine.toml"), posts.join("tool.tbl"));
+    let dir = temp("fit-posts");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("nx-fitted.nc");
+    let on_posts_machine = |cmd: &str, file: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
+        args.extend_from_slice(&["--tools", tools.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        dnurbs(&args)
+    };
+    let nx = posts.join("nx-5axis-g43-4.nc");
+    let r = on_posts_machine("fit", &nx, &["-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("63 in, 59 fitted into 1 G06.5 blocks"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        text.contains("K1 K1 K1 K1\nN0740 X55.426 Y32. Z-12. A25. C73.737\n"),
+        "{text}"
+    );
+    let sim = on_posts_machine("simulate", &out, &[]);
+    let serr = String::from_utf8_lossy(&sim.stderr).to_string();
+    assert_eq!(sim.status.code(), Some(0), "{serr}");
+    let summary = String::from_utf8_lossy(&sim.stdout).to_string();
+    assert!(
+        summary.contains("axis velocity and acceleration within limits"),
+        "{summary}"
+    );
+    // Refused: the output is not written, and nothing is left beside it.
+    let bad = dir.join("bad.nc");
+    std::fs::write(&bad, "G90 G21\nG01 X0 Y0 Z0 F100\nG01 X1 Q5\nM30\n").unwrap();
+    let refused = dir.join("refused.nc");
+    let r = on_posts_machine("fit", &bad, &["-o", refused.to_str().unwrap()]);
+    assert_eq!(r.status.code(), Some(2));
+    let left: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(!refused.exists(), "{left:?}");
+    assert!(!left.iter().any(|f| f.contains("partial")), "{left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -42,7 +42,14 @@ pub fn compress(
             *w = true;
         }
     }
-    let runs = find_runs(program, kin, opts, |_| true, |k| !word_before[k]);
+    let runs = find_runs(
+        program,
+        kin,
+        opts,
+        |_| true,
+        |k| !word_before[k],
+        |_, _| true,
+    );
     let mut out = Compressed {
         moves_in: moves_in(program),
         blocks_in: n,

@@ -158,7 +158,31 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
         if !best_d.is_finite() {
             best_d = (out.p[j] - pose.p).norm();
         }
-        let deg = best_axis.angle(&pose.axis(kin)).to_degrees();
+        // Where the output stands still while the tool turns (the rotary axes alone move),
+        // every sample of the turn is as near: the programmed axis is compared with the
+        // nearest of their axes, and the next point is looked for from there.
+        let target = pose.axis(kin);
+        let mut deg = best_axis.angle(&target).to_degrees();
+        // (Sample j may stand before the nearest position: the ties start at j or j + 1.)
+        let mut k = j;
+        while k < out.p.len() {
+            if (out.p[k] - pose.p).norm() > best_d + 1e-9 {
+                if k > j {
+                    break;
+                }
+                k += 1;
+                continue;
+            }
+            let (seg, s) = out.at[k];
+            if let Some(segment) = output.segments.get(seg) {
+                let a = segment.pose(s).axis(kin).angle(&target).to_degrees();
+                if a < deg {
+                    deg = a;
+                    cursor = k;
+                }
+            }
+            k += 1;
+        }
         if best_d > dev.point_mm {
             dev.point_mm = best_d;
             dev.point_mm_line = line;

@@ -89,13 +89,16 @@ pub fn is_corner(a: &LinearMove, m: &LinearMove, c: &LinearMove, corner_deg: f64
 }
 
 /// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
-/// run; `may_join(k)`: block k may follow block k - 1 in one.
+/// run; `may_join(k)`: block k may follow block k - 1 in one; `may_end(k, e)`: a fitted
+/// block may end at block k of a run that could go on to block e (the run is cut back to
+/// the last such block, and the moves after it stay as they are).
 pub fn find_runs(
     program: &Program,
     kin: &MachineKinematics,
     opts: &Options,
     may_start: impl Fn(usize) -> bool,
     may_join: impl Fn(usize) -> bool,
+    may_end: impl Fn(usize, usize) -> bool,
 ) -> Vec<Found> {
     let linear = |b: usize| match program.blocks.get(b) {
         Some(Block::Linear(m)) => Some(m),
@@ -130,12 +133,16 @@ pub fn find_runs(
         {
             e += 1;
         }
-        if e + 1 - b >= opts.min_moves {
-            let points: Vec<Point> = (b - 1..=e)
+        let mut end = e;
+        while end >= b && !may_end(end, e) {
+            end -= 1;
+        }
+        if end + 1 - b >= opts.min_moves {
+            let points: Vec<Point> = (b - 1..=end)
                 .filter_map(|k| linear(k).map(|m| point(m, kin)))
                 .collect();
             runs.push(Found {
-                blocks: (b, e),
+                blocks: (b, end),
                 fitted: fit(&points, opts.tol, opts.degree),
                 points,
                 feed_mm_min: first.feed_mm_min,

@@ -4,17 +4,22 @@
 //! A run is a sequence of `G01` moves on consecutive lines that hold nothing else (no
 //! comment, no other word), all at one feed and tool length, in absolute millimetres with
 //! a feed per minute (`G90 G21 G94`), each moving the cutter and turning the tool by at
-//! most [`MAX_TURN_DEG`], with no corner sharper than the corner angle between two moves.
-//! It starts where the move before it ends (that move must be a `G00`/`G01`). Every other
-//! line is written as it was; so is a run the fit cannot bring within the tolerances (it
-//! is counted). A run begins where the modal motion is already `G01`, so that the
-//! mode after it is the same without its lines. Work offsets are left out of the parse (the program's own numbers are
-//! written back, and the offsets apply to them at run time as they did to the moves).
+//! most [`super::find::MAX_TURN_DEG`], with no corner sharper than the corner angle
+//! between two moves. It starts where the move before it ends (that move must be a
+//! `G00`/`G01`). Every other line is written as it was; so is a run the fit cannot bring
+//! within the tolerances (it is counted).
+//!
+//! The modes after a block are those after its moves: a run begins where the modal motion
+//! is already `G01`; a run given in machine angles ends its block before a move of its own
+//! that gives both angles, which stays as written (after a `G06.5` block the tool axis is
+//! modal as a vector, and a move that gives one angle, or a `G28` with the table tilted,
+//! would be refused). Work offsets are left out of the parse (the program's own numbers
+//! are written back, and the offsets apply to them at run time as they did to the moves).
 
 use super::find::{find_runs, moves_in, Found};
 use super::{Fitted, Tolerance};
 use crate::kinematics::MachineKinematics;
-use crate::program::Program;
+use crate::program::{Block, Orientation, Program};
 use std::fmt::Write;
 
 /// Length the orientation points stand off the cutter points (mm): `U V W` = `X Y Z` +
@@ -88,24 +93,48 @@ pub struct FitOutput {
 /// it is not, with a `G01` word of its own, would leave the motion mode changed once that
 /// word is gone).
 fn modes(src: &str) -> Vec<(bool, bool)> {
-    let (mut abs, mut mm, mut per_min, mut motion) = (true, true, true, 0);
-    let mut out = Vec::new();
-    for line in src.split('\n') {
-        out.push((abs && mm && per_min, motion == 10));
+    let mut modes = Modes::default();
+    src.split('\n').map(|line| modes.line(line)).collect()
+}
+
+/// The modes [`modes`] follows, a line at a time.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Modes {
+    abs: bool,
+    mm: bool,
+    per_min: bool,
+    motion: u32,
+}
+
+impl Default for Modes {
+    fn default() -> Self {
+        Modes {
+            abs: true,
+            mm: true,
+            per_min: true,
+            motion: 0,
+        }
+    }
+}
+
+impl Modes {
+    /// The modes at the start of `line` (plain modes, modal `G01`); then its G codes apply.
+    pub(super) fn line(&mut self, line: &str) -> (bool, bool) {
+        let at_start = (self.abs && self.mm && self.per_min, self.motion == 10);
         for g in g_codes(&strip_comments(line)) {
             match g {
-                0 | 10 | 20 | 30 => motion = g,
-                900 => abs = true,
-                910 => abs = false,
-                210 => mm = true,
-                200 => mm = false,
-                940 => per_min = true,
-                930 | 950 => per_min = false,
+                0 | 10 | 20 | 30 => self.motion = g,
+                900 => self.abs = true,
+                910 => self.abs = false,
+                210 => self.mm = true,
+                200 => self.mm = false,
+                940 => self.per_min = true,
+                930 | 950 => self.per_min = false,
                 _ => {}
             }
         }
+        at_start
     }
-    out
 }
 
 /// The G codes of a line (comments stripped), in tenths: `G91` is 910, `G06.5` 65.
@@ -140,7 +169,7 @@ fn strip_comments(line: &str) -> String {
 }
 
 /// A line that holds one linear move and nothing else: words N, G1/G01, X Y Z A B C I J K, F.
-fn pure_move_line(line: &str) -> bool {
+pub(super) fn pure_move_line(line: &str) -> bool {
     let mut chars = line.trim_end_matches('\r').chars().peekable();
     let mut words = 0;
     while let Some(ch) = chars.next() {
@@ -176,6 +205,21 @@ fn pure_move_line(line: &str) -> bool {
     words > 0
 }
 
+/// Whether `b` is a move whose tool axis the program gives by machine angles.
+pub(super) fn in_angles(b: &Block) -> bool {
+    matches!(b, Block::Linear(m) if matches!(m.orientation, Orientation::Angles { .. }))
+}
+
+/// Whether a move line gives both machine angles (its tilt and its `C`). After a `G06.5`
+/// block the tool axis is modal as a vector, and a move that gives one angle alone, or a
+/// `G28` with the table tilted, is refused; so a run given in angles ends its block one
+/// move before such a line of its own, which then stands as written and makes the angles
+/// modal again.
+pub(super) fn sets_angles(line: &str) -> bool {
+    let code = strip_comments(line).to_ascii_uppercase();
+    code.contains('C') && (code.contains('A') || code.contains('B'))
+}
+
 /// Fit every run of `program` (parsed from `src` without work offsets).
 pub fn fit_program(
     src: &str,
@@ -199,6 +243,13 @@ pub fn fit_program(
         opts,
         |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.1),
         |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
+        |k, e| {
+            !in_angles(&program.blocks[k])
+                || (k < e
+                    && lines
+                        .get(line_of(k + 1) - 1)
+                        .is_some_and(|t| sets_angles(t)))
+        },
     );
     let mut summary = Summary {
         blocks_in: program.blocks.len(),
@@ -251,7 +302,7 @@ pub fn fit_program(
 }
 
 /// The line's `N` word, if it starts with one.
-fn n_word(line: &str) -> Option<String> {
+pub(super) fn n_word(line: &str) -> Option<String> {
     let t = line.trim_start();
     let rest = t.strip_prefix(['N', 'n'])?;
     let digits: String = rest.chars().take_while(char::is_ascii_digit).collect();
@@ -269,7 +320,7 @@ fn num(x: f64) -> String {
     }
 }
 
-fn write_block(out: &mut String, f: &Fitted, feed: f64, n: Option<&str>, eol: &str) {
+pub(super) fn write_block(out: &mut String, f: &Fitted, feed: f64, n: Option<&str>, eol: &str) {
     let p = f.degree;
     for (i, (c, t)) in f.ctrl.iter().zip(&f.tool).enumerate() {
         if i == 0 {
