@@ -90,6 +90,45 @@ fn every_post_plans_within_the_machine_limits() {
     }
 }
 
+/// `dnurbs fit` streams the program (`nc::fit::rewrite`): on every post it writes what the
+/// whole-text fit writes, byte for byte, and its own check finds the result within the
+/// tolerances.
+#[test]
+fn every_post_is_fitted_as_the_whole_text_fit_fits_it() {
+    let m = machine();
+    let mut parse = parse_setup(&m, &shop());
+    parse.work_offsets = [Some([0.0; 3]); 6];
+    let setup = MachineSetup::new(&m);
+    let opts = nc::fit::runs::Options::default();
+    let mut fitted = 0;
+    for name in POSTS {
+        let src = std::fs::read_to_string(posts(name)).expect("the post");
+        let prog = nc::parse::parse_with(&src, &parse).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let whole = nc::fit::runs::fit_program(&src, &prog, &setup.kin, &opts);
+        let mut out = Vec::new();
+        let done = nc::fit::rewrite::rewrite(
+            src.as_bytes(),
+            &parse,
+            &setup.kin,
+            &setup.build,
+            &opts,
+            0.002,
+            &mut out,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(String::from_utf8(out).unwrap(), whole.text, "{name}");
+        assert_eq!(done.summary, whole.summary, "{name}");
+        assert!(
+            done.dev.point_mm <= opts.tol.mm + 5e-7,
+            "{name}: {:?}",
+            done.dev
+        );
+        assert!(done.dev.point_deg <= 0.01 * 1.001, "{name}: {:?}", done.dev);
+        fitted += done.summary.fitted_blocks;
+    }
+    assert!(fitted >= 1, "no post had a run fitted");
+}
+
 /// What each simulated node recorded, per SYNC, indexed by node id.
 type PerNode = Vec<Vec<drives::sim::Record>>;
 

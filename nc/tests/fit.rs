@@ -28,6 +28,33 @@ fn fit_and_measure(src: &str, opts: &Options) -> (FitOutput, Deviation) {
     let b = build(&fitted, &KIN, &bl)
         .unwrap_or_else(|e| panic!("the result does not build: {e}\n{}", out.text));
     let dev = measure(&a, &b, &KIN, 0.002);
+    // The streamed rewrite (`dnurbs fit`) writes the very same program, and its own check,
+    // a piece at a time, finds it within what the whole paths' check finds plus the sampling.
+    let mut streamed = Vec::new();
+    let setup = nc::parse::Setup::default();
+    let done = nc::fit::rewrite::rewrite(
+        src.as_bytes(),
+        &setup,
+        &KIN,
+        &bl,
+        opts,
+        0.002,
+        &mut streamed,
+    )
+    .unwrap_or_else(|e| panic!("the streamed rewrite fails: {e}\n{src}"));
+    assert_eq!(String::from_utf8(streamed).unwrap(), out.text);
+    assert_eq!(done.summary, out.summary);
+    assert!(
+        (done.dev.point_mm - dev.point_mm).abs() < 1e-6,
+        "{:?} {dev:?}",
+        done.dev
+    );
+    assert!(
+        (done.dev.point_deg - dev.point_deg).abs() < 1e-4,
+        "{:?} {dev:?}",
+        done.dev
+    );
+    assert_eq!(done.dev.points, dev.points);
     // Every block not fitted is there as it was: same kind, end, feed and rapid flag.
     let fitted_lines: Vec<(u32, u32)> = out
         .runs

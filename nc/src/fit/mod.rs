@@ -12,14 +12,17 @@
 //! normal equations are banded and solved by Cholesky). Each insertion splits the data in
 //! the span in two, so a run costs a few refits, each linear in its points.
 //!
-//! [`runs`] finds the runs in a program's text and writes the result; [`deviation`]
-//! measures the result against the input independently of the fit, through the segment
-//! builder's own geometry.
+//! [`runs`] finds the runs in a program's text and writes the result; [`rewrite`] does the
+//! same as the text is read, a window of moves at a time (what `dnurbs fit` runs), and
+//! checks each piece as it is written (`check`); [`deviation`] measures the result against
+//! the input independently of the fit, through the segment builder's own geometry.
 
+mod check;
 pub mod compress;
 pub mod deviation;
 pub mod find;
 pub mod online;
+pub mod rewrite;
 pub mod runs;
 mod spline;
 

@@ -100,6 +100,10 @@ pub struct ReadLines<R> {
     text: String,
     count: usize,
     last_chars: usize,
+    /// The ending the last line had: `"\n"`, `"\r\n"`, or `""` (the file's end).
+    ending: &'static str,
+    /// Where the last line's text starts in `text` (after a byte-order mark).
+    start: usize,
     failed: bool,
 }
 
@@ -110,8 +114,18 @@ impl<R: BufRead> ReadLines<R> {
             text: String::new(),
             count: 0,
             last_chars: 0,
+            ending: "",
+            start: 0,
             failed: false,
         }
+    }
+
+    /// The last line read, as [`LineSource::next_line`] gave it, with the ending it had:
+    /// `"\n"`, `"\r\n"` or `""` (it ended the file), what a rewrite that keeps the
+    /// program's bytes writes after it.
+    pub fn last_line(&self) -> (u32, &str, &'static str) {
+        let text = self.text.get(self.start..).unwrap_or_default();
+        (to_u32(self.count), text, self.ending)
     }
 
     fn fail(
@@ -153,10 +167,13 @@ impl<R: BufRead> LineSource for ReadLines<R> {
             false => 0,
         };
         let mut end = buf.len();
+        self.ending = "";
         if buf.get(start..end).is_some_and(|b| b.ends_with(b"\n")) {
             end -= 1;
+            self.ending = "\n";
             if buf.get(start..end).is_some_and(|b| b.ends_with(b"\r")) {
                 end -= 1;
+                self.ending = "\r\n";
             }
         }
         buf.truncate(end);
@@ -172,6 +189,7 @@ impl<R: BufRead> LineSource for ReadLines<R> {
                 return self.fail(col, ParseErrorKind::NotUtf8 { byte });
             }
         }
+        self.start = start;
         let text = self.text.get(start..).unwrap_or_default();
         self.last_chars = text.chars().count();
         Some(Ok((to_u32(self.count), text)))

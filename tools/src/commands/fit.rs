@@ -2,16 +2,17 @@
 //! the input before it is written.
 
 use crate::exit::{InputError, Outcome};
+use crate::load_machine;
 use crate::setup::MachineSetup;
 use crate::shop::parse_setup;
-use crate::{load_machine, parse_text, read_program};
 use anyhow::{bail, Context};
-use nc::fit::deviation::{measure, Deviation};
-use nc::fit::runs::{fit_program, Options, Summary};
+use nc::fit::deviation::Deviation;
+use nc::fit::rewrite::rewrite;
+use nc::fit::runs::{Options, Summary};
 use nc::fit::Tolerance;
+use nc::parse::ReadLines;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// The command line's tolerances.
 #[derive(Clone, Copy, Debug)]
@@ -58,10 +59,35 @@ pub fn fit(
     let mut parse = parse_setup(&machine, &shop);
     parse.work_offsets = [Some([0.0; 3]); 6];
     let file = program.display().to_string();
-    let text = read_program(program)?;
-    let input = parse_text(&text, &file, &parse)?;
-    let in_path = nc::segment::build(&input, &setup.kin, &setup.build)
-        .map_err(|e| InputError::program(program, e))?;
+    let open = || {
+        std::fs::File::open(program)
+            .map(|f| std::io::BufReader::with_capacity(1 << 16, f))
+            .map_err(|error| InputError::ReadProgram {
+                file: file.clone(),
+                error,
+            })
+    };
+    // The whole program is checked first, as `simulate` checks it (every parse error, the
+    // first the segment builder refuses), without the travel: the fit reads the program's
+    // own numbers.
+    let anywhere = [(f64::NEG_INFINITY, f64::INFINITY); 5];
+    let passed = nc::prepass::check(
+        ReadLines::new(open()?),
+        &parse,
+        &setup.kin,
+        &setup.build,
+        &anywhere,
+    )
+    .map_err(|error| match error {
+        nc::prepass::Refused::Parse(errors) => InputError::Parse {
+            file: file.clone(),
+            errors,
+        },
+        error => InputError::Checked {
+            file: file.clone(),
+            error,
+        },
+    })?;
     let opts = Options {
         tol: Tolerance {
             mm: tol.mm,
@@ -70,22 +96,26 @@ pub fn fit(
         corner_deg: tol.corner_deg,
         ..Options::default()
     };
-    let t0 = Instant::now();
-    let out = fit_program(&text, &input, &setup.kin, &opts);
-    let fit_s = t0.elapsed().as_secs_f64();
-    // The result, read back as `simulate` and `run` would read it.
-    let fitted = nc::parse::parse_with(&out.text, &parse)
-        .map_err(|e| anyhow::anyhow!("the fitted program does not parse: {:?}", e.first()))?;
-    let out_path = nc::segment::build(&fitted, &setup.kin, &setup.build)
-        .map_err(|e| anyhow::anyhow!("the fitted program does not build: {e}"))?;
-    let length: f64 = in_path.segments.iter().map(|s| s.length).sum();
-    let step = STEP.max(length / MAX_SAMPLES);
-    let dev = measure(&in_path, &out_path, &setup.kin, step);
+    let step = STEP.max(passed.length / MAX_SAMPLES);
+    // Written to a file beside the output (or in the temporary directory for standard
+    // output) and moved there only once the whole program is within the tolerances.
+    let partial = Partial::new(output)?;
+    let writer = std::io::BufWriter::with_capacity(1 << 16, partial.create()?);
+    let done = rewrite(
+        open()?,
+        &parse,
+        &setup.kin,
+        &setup.build,
+        &opts,
+        step,
+        writer,
+    )
+    .map_err(|e| anyhow::anyhow!("{file}: {e}; nothing written"))?;
     let report = Report {
         file: &file,
-        summary: &out.summary,
-        dev: &dev,
-        fit_s,
+        summary: &done.summary,
+        dev: &done.dev,
+        fit_s: done.fit_s,
         step,
         tol,
     };
@@ -94,6 +124,7 @@ pub fn fit(
     } else {
         eprint!("{}", report.text());
     }
+    let dev = &done.dev;
     // Half a micrometre of slack for the six decimals written and the sampling.
     if dev.point_mm > tol.mm + 5e-7 || dev.point_deg > tol.deg * (1.0 + 1e-3) {
         bail!(
@@ -105,16 +136,66 @@ pub fn fit(
             dev.point_deg_line
         );
     }
-    match output {
-        Some(path) => std::fs::write(path, &out.text)
-            .with_context(|| format!("{}: cannot write the fitted program", path.display()))?,
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            stdout.write_all(out.text.as_bytes())?;
-            stdout.flush()?;
+    partial.keep()?;
+    Ok(Outcome::Completed)
+}
+
+/// The output as it is written: a file beside the destination (or in the temporary
+/// directory, for standard output), removed unless [`Partial::keep`] moves it there.
+struct Partial {
+    path: PathBuf,
+    dest: Option<PathBuf>,
+    kept: bool,
+}
+
+impl Partial {
+    fn new(dest: Option<&Path>) -> anyhow::Result<Partial> {
+        let name = format!(".dnurbs-fit-{}.partial", std::process::id());
+        let path = match dest {
+            Some(d) => {
+                let dir = d.parent().filter(|p| !p.as_os_str().is_empty());
+                let file = d.file_name().map(|f| f.to_string_lossy().into_owned());
+                let name = format!("{}{name}", file.unwrap_or_default());
+                dir.map_or_else(|| PathBuf::from(&name), |dir| dir.join(&name))
+            }
+            None => std::env::temp_dir().join(name.trim_start_matches('.')),
+        };
+        Ok(Partial {
+            path,
+            dest: dest.map(Path::to_path_buf),
+            kept: false,
+        })
+    }
+
+    fn create(&self) -> anyhow::Result<std::fs::File> {
+        let shown = self.dest.as_deref().unwrap_or(&self.path).display();
+        std::fs::File::create(&self.path)
+            .with_context(|| format!("{shown}: cannot write the fitted program"))
+    }
+
+    /// The whole output checked: moved to its destination, or copied to standard output.
+    fn keep(mut self) -> anyhow::Result<()> {
+        match &self.dest {
+            Some(dest) => std::fs::rename(&self.path, dest)
+                .with_context(|| format!("{}: cannot write the fitted program", dest.display()))?,
+            None => {
+                let mut f = std::fs::File::open(&self.path)?;
+                let mut stdout = std::io::stdout().lock();
+                std::io::copy(&mut f, &mut stdout)?;
+                stdout.flush()?;
+            }
+        }
+        self.kept = self.dest.is_some();
+        Ok(())
+    }
+}
+
+impl Drop for Partial {
+    fn drop(&mut self) {
+        if !self.kept {
+            let _ = std::fs::remove_file(&self.path);
         }
     }
-    Ok(Outcome::Completed)
 }
 
 struct Report<'a> {

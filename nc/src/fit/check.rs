@@ -1,0 +1,195 @@
+//! The streamed rewrite ([`super::rewrite`]) checked as it is written, independently of the
+//! fit: the input's blocks and the written text, parsed again as `simulate` reads it, are
+//! built into segments by the segment builder, and each piece (a stretch that no run
+//! crosses, so both sides start and end on the same programmed point) is measured by
+//! [`measure`]: the input's programmed points against the output path, the output's samples
+//! against the input path. Only one piece of each side is held at a time.
+
+use super::deviation::{measure, Deviation};
+use super::rewrite::RewriteError;
+use crate::kinematics::MachineKinematics;
+use crate::parse::{Entries, Entry, LineSource, ParseError, Setup};
+use crate::program::{Action, Block, SrcPos};
+use crate::segment::{BuildError, BuildLimits, Builder, Path, Pose, Segment};
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::rc::Rc;
+
+/// The written lines, as the output's parser reads them: what the rewrite has written and
+/// the parser not yet read. It is only read up to a block known to be written, so an empty
+/// queue is the output's end.
+struct Queue {
+    written: Rc<RefCell<VecDeque<String>>>,
+    line: String,
+    count: u32,
+}
+
+impl LineSource for Queue {
+    fn next_line(&mut self) -> Option<Result<(u32, &str), ParseError>> {
+        self.line = self.written.borrow_mut().pop_front()?;
+        self.count = self.count.saturating_add(1);
+        Some(Ok((self.count, &self.line)))
+    }
+
+    fn eof(&self) -> SrcPos {
+        SrcPos {
+            line: self.count.max(1),
+            col: u32::try_from(self.line.chars().count() + 1).unwrap_or(u32::MAX),
+        }
+    }
+}
+
+/// Both sides of the rewrite, built a piece at a time, and what was measured so far.
+pub(super) struct Check<'a> {
+    kin: &'a MachineKinematics,
+    /// Sampling step of the measurement (mm, or degrees on rotary-only segments).
+    step: f64,
+    input: Builder<'a>,
+    in_segs: Vec<Segment>,
+    written: Rc<RefCell<VecDeque<String>>>,
+    output: Entries<'a, Queue>,
+    out_builder: Builder<'a>,
+    out_segs: Vec<Segment>,
+    /// Motion blocks of the output read so far.
+    out_blocks: usize,
+    /// Where the next piece starts (the same programmed point on both sides).
+    start: Option<(Pose, SrcPos)>,
+    pieces: usize,
+    pub dev: Deviation,
+}
+
+impl<'a> Check<'a> {
+    pub fn new(
+        kin: &'a MachineKinematics,
+        limits: &'a BuildLimits,
+        setup: &'a Setup,
+        step: f64,
+    ) -> Self {
+        let written = Rc::new(RefCell::new(VecDeque::new()));
+        let queue = Queue {
+            written: Rc::clone(&written),
+            line: String::new(),
+            count: 0,
+        };
+        Check {
+            kin,
+            step,
+            input: Builder::new(kin, limits),
+            in_segs: Vec::new(),
+            written,
+            output: Entries::new(queue, setup),
+            out_builder: Builder::new(kin, limits),
+            out_segs: Vec::new(),
+            out_blocks: 0,
+            start: None,
+            pieces: 0,
+            dev: Deviation::default(),
+        }
+    }
+
+    /// An input action, before the next input block.
+    pub fn action(&mut self, a: &Action) {
+        self.input.action(a);
+    }
+
+    /// Input block `i` (from 0), built into the current piece.
+    pub fn block(&mut self, i: usize, b: &Block) -> Result<(), BuildError> {
+        self.input.block(i, b, &mut self.in_segs)
+    }
+
+    /// A line the rewrite wrote (without its ending).
+    pub fn written(&mut self, line: &str) {
+        self.written.borrow_mut().push_back(line.to_owned());
+    }
+
+    /// The piece ends: the output is read up to its `out_blocks`-th motion block, and both
+    /// sides are measured.
+    pub fn piece(&mut self, out_blocks: usize) -> Result<(), RewriteError> {
+        while self.out_blocks < out_blocks {
+            match self.output.next() {
+                Some(Ok(Entry::Action(a))) => self.out_builder.action(&a),
+                Some(Ok(Entry::Block(i, b))) => {
+                    self.out_builder
+                        .block(i, &b, &mut self.out_segs)
+                        .map_err(RewriteError::OutputBuild)?;
+                    self.out_blocks += 1;
+                }
+                Some(Err(e)) => return Err(RewriteError::OutputParse(e)),
+                None => {
+                    return Err(RewriteError::OutputBlocks {
+                        expected: out_blocks,
+                        read: self.out_blocks,
+                    })
+                }
+            }
+        }
+        if self.in_segs.is_empty() && self.out_segs.is_empty() {
+            return Ok(());
+        }
+        let start = match self.start {
+            Some(s) => s,
+            None => match self.input.start() {
+                Ok((pose, src, _)) => (pose, src),
+                Err(e) => return Err(RewriteError::Build(e)),
+            },
+        };
+        let path = |segments| Path {
+            start: start.0,
+            start_src: start.1,
+            start_joints: [0.0; 5],
+            segments,
+        };
+        let (inp, out) = (
+            path(std::mem::take(&mut self.in_segs)),
+            path(std::mem::take(&mut self.out_segs)),
+        );
+        let d = measure(&inp, &out, self.kin, self.step);
+        self.merge(&d);
+        self.start = inp
+            .segments
+            .last()
+            .map(|s| (s.pose(s.length), s.src))
+            .or(Some(start));
+        // The vectors' room is kept for the next piece.
+        self.in_segs = inp.segments;
+        self.in_segs.clear();
+        self.out_segs = out.segments;
+        self.out_segs.clear();
+        Ok(())
+    }
+
+    fn merge(&mut self, d: &Deviation) {
+        let dev = &mut self.dev;
+        if d.point_mm > dev.point_mm {
+            dev.point_mm = d.point_mm;
+            dev.point_mm_line = d.point_mm_line;
+        }
+        if d.point_deg > dev.point_deg {
+            dev.point_deg = d.point_deg;
+            dev.point_deg_line = d.point_deg_line;
+        }
+        dev.path_mm = dev.path_mm.max(d.path_mm);
+        // Each piece after the first starts on the point the last one ended on.
+        dev.points += d.points - usize::from(self.pieces > 0 && d.points > 0);
+        dev.samples += d.samples;
+        self.pieces += 1;
+    }
+
+    /// The output is read to its end: it must hold `out_blocks` motion blocks, no more.
+    pub fn finish(&mut self, out_blocks: usize) -> Result<(), RewriteError> {
+        self.piece(out_blocks)?;
+        for entry in self.output.by_ref() {
+            match entry {
+                Ok(Entry::Action(_)) => {}
+                Ok(Entry::Block(..)) => {
+                    return Err(RewriteError::OutputBlocks {
+                        expected: out_blocks,
+                        read: out_blocks + 1,
+                    })
+                }
+                Err(e) => return Err(RewriteError::OutputParse(e)),
+            }
+        }
+        Ok(())
+    }
+}
