@@ -142,7 +142,7 @@ fn a_run_longer_than_the_window_is_cut_on_a_programmed_point() {
 }
 
 #[test]
-fn line_endings_and_lines_that_move_nothing_are_kept() {
+fn line_endings_continued_lines_and_lines_that_move_nothing_are_kept() {
     let src = sweep(300);
     let opts = Options::default();
     let parse = |s: &str| nc::parse::parse(s).expect("parses");
@@ -169,4 +169,125 @@ fn line_endings_and_lines_that_move_nothing_are_kept() {
         text.lines().filter(|l| *l == "F3000").count(),
         2 * MAX_RUN + 100
     );
+    // A move continued on the next line (a backslash) between two runs: the check parses
+    // each written line as it goes, the continued one with its next.
+    let mut lines: Vec<&str> = src.lines().collect();
+    lines.splice(150..150, ["(a note) G01 X30 \\", " Y-10 Z12"]);
+    let continued = lines.join("\n") + "\n";
+    let whole = fit_program(&continued, &parse(&continued), &PAPER, &opts);
+    let (text, done) = stream(&continued, &PAPER, &opts);
+    assert_eq!(text, whole.text);
+    assert_eq!(done.summary.fitted_blocks, 2, "{:?}", done.summary);
+    assert!(text.contains("G01 X30 \\\n Y-10 Z12\n"), "{text}");
+}
+
+/// A run given in machine angles, followed by `after`: 400 moves of about 0.1 mm along an
+/// arc, A and C turning a little on every move, as an A/C post writes them.
+fn in_angles(after: &str) -> String {
+    use std::fmt::Write;
+    let mut s = String::from("%\nG90 G21 G94\n");
+    for k in 0..=400 {
+        let t = k as f64 * 0.1 / 20.0;
+        let (x, y) = (20.0 * t.cos(), 20.0 * t.sin());
+        let (a, c) = (10.0 + 5.0 * (3.0 * t).sin(), 30.0 * t.to_degrees() / 57.3);
+        let g = if k < 2 { "G01 " } else { "" };
+        let f = if k == 0 { " F2000" } else { "" };
+        let _ = writeln!(s, "{g}X{x:.4} Y{y:.4} Z5 A{a:.4} C{c:.4}{f}");
+    }
+    s.push_str(after);
+    s.push_str("M30\n%\n");
+    s
+}
+
+/// After a `G06.5` block the tool axis is modal as a vector: a block fitted to moves given
+/// in angles is followed by a line that gives both angles, the line after the run where it
+/// does, else the run's last move kept as written; so a move that gives one angle, or a
+/// `G28` under the tilted table, still reads as it did.
+#[test]
+fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
+    let trt = MachineKinematics::Trt {
+        tilt: Tilt::A,
+        tilt_point: Vector3::new(0.0, 0.0, -50.0),
+        c_point: Vector3::zeros(),
+    };
+    let setup = nc::parse::Setup {
+        reference: Some([0.0, 0.0, 300.0]),
+        kinematics: Some(trt),
+        ..nc::parse::Setup::default()
+    };
+    let (_, bl) = small_mill(0.002);
+    let opts = Options::default();
+    for (after, fitted) in [
+        // The next move gives both angles: the whole run is one block.
+        ("X19.9 Y2.5 Z6 A12 C20 F1000\n", 400),
+        // A move that gives C alone, a move with no angle, a G28 with A at 10 degrees: the
+        // run's last move stays as written.
+        ("X19.9 Y2.5 Z6 C20 F1000\n", 399),
+        ("X19.9 Y2.5 Z6 F1000\nG91 G28 Z0\nG90\n", 399),
+    ] {
+        let src = in_angles(after);
+        let input = nc::parse::parse_with(&src, &setup).expect("input parses");
+        let whole = fit_program(&src, &input, &trt, &opts);
+        let mut out = Vec::new();
+        let done = rewrite(src.as_bytes(), &setup, &trt, &bl, &opts, 0.002, &mut out)
+            .unwrap_or_else(|e| panic!("{after}: {e}"));
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(text, whole.text, "{after}");
+        assert_eq!(
+            done.summary.moves_fitted, fitted,
+            "{after}: {:?}",
+            done.summary
+        );
+        assert_eq!(done.summary.fitted_blocks, 1, "{after}");
+        let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
+        let (a, b) = (
+            build(&input, &trt, &bl).expect("input builds"),
+            build(&output, &trt, &bl).expect("output builds"),
+        );
+        let dev = measure(&a, &b, &trt, 0.002);
+        assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{after}: {dev:?}");
+        assert!(
+            dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
+            "{after}: {dev:?}"
+        );
+    }
+}
+
+/// A finishing raster as `tests/data/fit/raster.py` writes it (rows of 0.1 mm moves over a
+/// wavy surface, step-overs of 10 moves, 90-degree corners), `rows` rows of `steps` moves.
+fn raster(rows: usize, steps: usize) -> String {
+    let z = |x: f64, y: f64| 2.0 * (x / 8.0).sin() * (y / 10.0).cos();
+    let mut pts = Vec::new();
+    for r in 0..rows {
+        let y = r as f64;
+        let mut xs: Vec<f64> = (0..=steps).map(|k| k as f64 * 0.1).collect();
+        if r % 2 == 1 {
+            xs.reverse();
+        }
+        if r > 0 {
+            pts.extend((1..10).map(|k| (xs[0], y - 1.0 + k as f64 * 0.1)));
+        }
+        pts.extend(xs.iter().map(|&x| (x, y)));
+    }
+    let points: Vec<_> = pts
+        .iter()
+        .map(|&(x, y)| (Vector3::new(x, y, z(x, y)), Vector3::z()))
+        .collect();
+    g01_program(&points, 3000.0)
+}
+
+/// Where a window of more than 5 000 moves holds many runs (a raster's rows), it is cut
+/// where a run ends or before one begins, so the blocks are those of the whole text.
+#[test]
+fn a_window_full_of_short_runs_is_cut_between_them() {
+    let src = raster(30, 400);
+    let input = nc::parse::parse(&src).expect("parses");
+    let opts = Options::default();
+    let whole = fit_program(&src, &input, &PAPER, &opts);
+    let (text, done) = stream(&src, &PAPER, &opts);
+    assert!(done.summary.moves_in > 2 * MAX_RUN, "{:?}", done.summary);
+    assert_eq!(done.summary.fitted_blocks, 59, "{:?}", done.summary);
+    assert_eq!(text, whole.text);
+    assert_eq!(done.summary, whole.summary);
+    assert!(done.dev.point_mm <= opts.tol.mm + 5e-7, "{:?}", done.dev);
 }

@@ -15,9 +15,9 @@ use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::rc::Rc;
 
-/// The written lines, as the output's parser reads them: what the rewrite has written and
-/// the parser not yet read. It is only read up to a block known to be written, so an empty
-/// queue is the output's end.
+/// The written lines, as the output's parser reads them: each is parsed as soon as it is
+/// written (a line continued with a backslash, with the next), so the queue holds a line
+/// or two, and an empty queue is not the output's end until [`Check::finish`].
 struct Queue {
     written: Rc<RefCell<VecDeque<String>>>,
     line: String,
@@ -97,33 +97,49 @@ impl<'a> Check<'a> {
         self.input.block(i, b, &mut self.in_segs)
     }
 
-    /// A line the rewrite wrote (without its ending).
-    pub fn written(&mut self, line: &str) {
+    /// A line the rewrite wrote (without its ending): parsed, and its blocks built.
+    pub fn written(&mut self, line: &str) -> Result<(), RewriteError> {
         self.written.borrow_mut().push_back(line.to_owned());
+        if line.trim_end().ends_with('\\') {
+            return Ok(());
+        }
+        while let Some(read) = self.output.read_line() {
+            read.map_err(RewriteError::OutputParse)?;
+        }
+        while let Some(entry) = self.output.take_read() {
+            self.output_entry(entry)?;
+        }
+        Ok(())
     }
 
-    /// The piece ends: the output is read up to its `out_blocks`-th motion block, and both
-    /// sides are measured.
-    pub fn piece(&mut self, out_blocks: usize) -> Result<(), RewriteError> {
-        while self.out_blocks < out_blocks {
-            match self.output.next() {
-                Some(Ok(Entry::Action(a))) => self.out_builder.action(&a),
-                Some(Ok(Entry::Block(i, b))) => {
-                    self.out_builder
-                        .block(i, &b, &mut self.out_segs)
-                        .map_err(RewriteError::OutputBuild)?;
-                    self.out_blocks += 1;
-                }
-                Some(Err(e)) => return Err(RewriteError::OutputParse(e)),
-                None => {
-                    return Err(RewriteError::OutputBlocks {
-                        expected: out_blocks,
-                        read: self.out_blocks,
-                    })
-                }
+    fn output_entry(&mut self, entry: Entry) -> Result<(), RewriteError> {
+        match entry {
+            Entry::Action(a) => self.out_builder.action(&a),
+            Entry::Block(i, b) => {
+                self.out_builder
+                    .block(i, &b, &mut self.out_segs)
+                    .map_err(RewriteError::OutputBuild)?;
+                self.out_blocks += 1;
             }
         }
-        if self.in_segs.is_empty() && self.out_segs.is_empty() {
+        Ok(())
+    }
+
+    /// The piece ends with the input's `in_blocks`-th motion block and the output's
+    /// `out_blocks`-th, both written: both sides are measured (the segments of later
+    /// blocks wait for the next piece).
+    pub fn piece(&mut self, out_blocks: usize, in_blocks: usize) -> Result<(), RewriteError> {
+        if self.out_blocks < out_blocks {
+            return Err(RewriteError::OutputBlocks {
+                expected: out_blocks,
+                read: self.out_blocks,
+            });
+        }
+        // Segments know their block from 1.
+        let upto = |n: usize| move |s: &Segment| usize::try_from(s.block).is_ok_and(|b| b <= n);
+        let cut = self.in_segs.partition_point(upto(in_blocks));
+        let out_cut = self.out_segs.partition_point(upto(out_blocks));
+        if cut == 0 && out_cut == 0 {
             return Ok(());
         }
         let start = match self.start {
@@ -139,9 +155,13 @@ impl<'a> Check<'a> {
             start_joints: [0.0; 5],
             segments,
         };
+        let (later, out_later) = (
+            self.in_segs.split_off(cut),
+            self.out_segs.split_off(out_cut),
+        );
         let (inp, out) = (
-            path(std::mem::take(&mut self.in_segs)),
-            path(std::mem::take(&mut self.out_segs)),
+            path(std::mem::replace(&mut self.in_segs, later)),
+            path(std::mem::replace(&mut self.out_segs, out_later)),
         );
         let d = measure(&inp, &out, self.kin, self.step);
         self.merge(&d);
@@ -150,11 +170,6 @@ impl<'a> Check<'a> {
             .last()
             .map(|s| (s.pose(s.length), s.src))
             .or(Some(start));
-        // The vectors' room is kept for the next piece.
-        self.in_segs = inp.segments;
-        self.in_segs.clear();
-        self.out_segs = out.segments;
-        self.out_segs.clear();
         Ok(())
     }
 
@@ -176,19 +191,16 @@ impl<'a> Check<'a> {
     }
 
     /// The output is read to its end: it must hold `out_blocks` motion blocks, no more.
-    pub fn finish(&mut self, out_blocks: usize) -> Result<(), RewriteError> {
-        self.piece(out_blocks)?;
-        for entry in self.output.by_ref() {
-            match entry {
-                Ok(Entry::Action(_)) => {}
-                Ok(Entry::Block(..)) => {
-                    return Err(RewriteError::OutputBlocks {
-                        expected: out_blocks,
-                        read: out_blocks + 1,
-                    })
-                }
-                Err(e) => return Err(RewriteError::OutputParse(e)),
-            }
+    pub fn finish(&mut self, out_blocks: usize, in_blocks: usize) -> Result<(), RewriteError> {
+        self.piece(out_blocks, in_blocks)?;
+        while let Some(entry) = self.output.next() {
+            self.output_entry(entry.map_err(RewriteError::OutputParse)?)?;
+        }
+        if self.out_blocks != out_blocks {
+            return Err(RewriteError::OutputBlocks {
+                expected: out_blocks,
+                read: self.out_blocks,
+            });
         }
         Ok(())
     }

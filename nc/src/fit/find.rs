@@ -24,6 +24,8 @@ pub const MAX_TURN_DEG: f64 = 10.0;
 pub struct Found {
     /// Its first and last block (indices into [`Program::blocks`]).
     pub blocks: (usize, usize),
+    /// The last block it could have taken, before it was cut back to one it may end at.
+    pub reach: usize,
     /// The programmed points: where the run starts, then each move's end.
     pub points: Vec<Point>,
     /// Programmed feed, mm/min.
@@ -143,6 +145,7 @@ pub fn find_runs(
                 .collect();
             runs.push(Found {
                 blocks: (b, end),
+                reach: e,
                 fitted: fit(&points, opts.tol, opts.degree),
                 points,
                 feed_mm_min: first.feed_mm_min,

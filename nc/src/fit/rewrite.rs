@@ -105,11 +105,11 @@ impl<W: Write> State<'_, W> {
         if !pure_move_line(text) {
             // No run takes this line, so none goes on past it: every line before it is
             // decided, and so is this one.
-            self.close(None)?;
+            self.close(None, Some((no, text)), false)?;
             return self.emit(text, ending);
         }
         if self.held.len() >= MAX_HELD_LINES {
-            self.close(None)?;
+            self.close(None, Some((no, text)), false)?;
         }
         self.held.push_back(Held {
             no,
@@ -136,8 +136,9 @@ impl<W: Write> State<'_, W> {
                 .lines
                 .last()
                 .is_some_and(|l| l.no.checked_add(1) == Some(no));
-        if self.window.blocks.len() > 1 && (!joins || self.window.blocks.len() > MAX_RUN) {
-            self.close(Some(no))?;
+        let len = self.window.blocks.len();
+        if len > 1 && (!joins || len > MAX_RUN) {
+            self.close(Some(no), None, joins)?;
         }
         if i > 0 && matches!(&block, Block::Linear(m) if !m.rapid) {
             self.summary.moves_in += 1;
@@ -151,31 +152,61 @@ impl<W: Write> State<'_, W> {
 
     /// The window's runs are fitted and written, the held lines before line `upto` (all
     /// of them if `None`) written, and the piece checked; the window keeps its last block.
-    fn close(&mut self, upto: Option<u32>) -> Result<(), RewriteError> {
-        if self.window.blocks.len() > 1 {
+    /// `next`: the line being read, if it is not held. `full`: the window is cut only
+    /// because it holds [`MAX_RUN`] moves, so it keeps what may still become a run (from
+    /// the end of its last run, or the start of a run that reaches its end) if that is at
+    /// most half of it.
+    fn close(
+        &mut self,
+        upto: Option<u32>,
+        next: Option<(u32, &str)>,
+        full: bool,
+    ) -> Result<(), RewriteError> {
+        let len = self.window.blocks.len();
+        let mut keep = len.saturating_sub(1);
+        if len > 1 {
             let t0 = Instant::now();
             let (lines, held, blocks) = (&self.lines, &self.held, &self.window.blocks);
-            let found = find_runs(
+            let mut found = find_runs(
                 &self.window,
                 self.kin,
                 self.opts,
                 |b| lines[b].plain && lines[b].g01,
                 |k| lines[k].plain && lines[k - 1].no.checked_add(1) == Some(lines[k].no),
-                |k, e| {
+                // The line after block k (the next move of the run, or the line after it).
+                |k, _| {
+                    let after = lines[k].no.checked_add(1);
                     !in_angles(&blocks[k])
-                        || (k < e
-                            && held
-                                .iter()
-                                .find(|h| h.no == lines[k + 1].no)
-                                .is_some_and(|h| sets_angles(&h.text)))
+                        || held
+                            .iter()
+                            .find(|h| Some(h.no) == after)
+                            .map(|h| h.text.as_str())
+                            .or(next.filter(|n| Some(n.0) == after).map(|n| n.1))
+                            .is_some_and(sets_angles)
                 },
             );
             self.fit_s += t0.elapsed().as_secs_f64();
+            if full {
+                let tail = match found.last() {
+                    Some(r) if r.reach + 1 == len => r.blocks.0 - 1,
+                    Some(r) => r.reach,
+                    None => keep,
+                };
+                if keep - tail <= MAX_RUN / 2 {
+                    keep = tail;
+                    found.retain(|r| r.reach < keep + 1);
+                }
+            }
             for f in &found {
                 let (l0, l1) = (self.lines[f.blocks.0].no, self.lines[f.blocks.1].no);
                 self.write_run(f, l0, l1)?;
             }
         }
+        // The lines of the blocks kept stay held.
+        let upto = match self.lines.get(keep + 1) {
+            Some(l) => Some(l.no),
+            None => upto,
+        };
         while let Some(h) = self.held.front() {
             if upto.is_some_and(|u| h.no >= u) {
                 break;
@@ -184,10 +215,12 @@ impl<W: Write> State<'_, W> {
                 self.emit(&h.text, h.ending)?;
             }
         }
+        // Input blocks up to the one kept first are decided (`blocks` counts every block
+        // read; the last kept is the window's last).
+        let decided = self.blocks - (len.saturating_sub(1) - keep);
         let s = &self.summary;
         self.check
-            .piece(self.blocks - s.moves_fitted + s.fitted_blocks)?;
-        let keep = self.window.blocks.len().saturating_sub(1);
+            .piece(decided - s.moves_fitted + s.fitted_blocks, decided)?;
         self.window.blocks.drain(..keep);
         self.lines.drain(..keep);
         Ok(())
@@ -234,8 +267,7 @@ impl<W: Write> State<'_, W> {
         self.out.write_all(text.as_bytes())?;
         self.out.write_all(ending.as_bytes())?;
         self.summary.bytes_out += text.len() + ending.len();
-        self.check.written(text);
-        Ok(())
+        self.check.written(text)
     }
 }
 
@@ -313,13 +345,13 @@ pub fn rewrite<R: BufRead, W: Write>(
         return Err(e);
     }
     let mut s = state.borrow_mut();
-    s.close(None)?;
+    s.close(None, None, false)?;
     let blocks = s.blocks;
     let sm = &mut s.summary;
     sm.blocks_in = blocks;
     sm.blocks_out = blocks - sm.moves_fitted + sm.fitted_blocks;
     let expected = sm.blocks_out;
-    s.check.finish(expected)?;
+    s.check.finish(expected, blocks)?;
     s.out.flush()?;
     Ok(Rewritten {
         summary: s.summary.clone(),

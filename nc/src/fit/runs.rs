@@ -10,10 +10,10 @@
 //! within the tolerances (it is counted).
 //!
 //! The modes after a block are those after its moves: a run begins where the modal motion
-//! is already `G01`; a run given in machine angles ends its block before a move of its own
-//! that gives both angles, which stays as written (after a `G06.5` block the tool axis is
-//! modal as a vector, and a move that gives one angle, or a `G28` with the table tilted,
-//! would be refused). Work offsets are left out of the parse (the program's own numbers
+//! is already `G01`; a block fitted to moves given in machine angles is followed by a line
+//! that gives both angles, the line after the run or else a move of its own kept as
+//! written (after a `G06.5` block the tool axis is modal as a vector, and a move that
+//! gives one angle, or a `G28` with the table tilted, would be refused). Work offsets are left out of the parse (the program's own numbers
 //! are written back, and the offsets apply to them at run time as they did to the moves).
 
 use super::find::{find_runs, moves_in, Found};
@@ -210,11 +210,11 @@ pub(super) fn in_angles(b: &Block) -> bool {
     matches!(b, Block::Linear(m) if matches!(m.orientation, Orientation::Angles { .. }))
 }
 
-/// Whether a move line gives both machine angles (its tilt and its `C`). After a `G06.5`
-/// block the tool axis is modal as a vector, and a move that gives one angle alone, or a
-/// `G28` with the table tilted, is refused; so a run given in angles ends its block one
-/// move before such a line of its own, which then stands as written and makes the angles
-/// modal again.
+/// Whether a line gives both machine angles (its tilt and its `C`). After a `G06.5` block
+/// the tool axis is modal as a vector, and a move that gives one angle alone, or a `G28`
+/// with the table tilted, is refused; so a block fitted to moves given in angles must be
+/// followed by a line that gives both (the run's next move, kept as written, or the line
+/// after the run).
 pub(super) fn sets_angles(line: &str) -> bool {
     let code = strip_comments(line).to_ascii_uppercase();
     code.contains('C') && (code.contains('A') || code.contains('B'))
@@ -243,12 +243,9 @@ pub fn fit_program(
         opts,
         |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.1),
         |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
-        |k, e| {
-            !in_angles(&program.blocks[k])
-                || (k < e
-                    && lines
-                        .get(line_of(k + 1) - 1)
-                        .is_some_and(|t| sets_angles(t)))
+        // The line after block k (the next move of the run, or the line after it).
+        |k, _| {
+            !in_angles(&program.blocks[k]) || lines.get(line_of(k)).is_some_and(|t| sets_angles(t))
         },
     );
     let mut summary = Summary {

@@ -88,6 +88,34 @@ impl<'s, S: LineSource> Entries<'s, S> {
     }
 }
 
+impl<S: LineSource> Entries<'_, S> {
+    /// Reads one line, if the source has one now, and keeps what it produced for
+    /// [`Self::take`]; `None` when the source has no line yet (nothing is finished: a source
+    /// fed as it goes can be read again). For a reader that must parse each line as soon as
+    /// it is written (`dnurbs fit`'s check of its own output).
+    pub(crate) fn read_line(&mut self) -> Option<Result<(), ParseError>> {
+        if self.finished {
+            return None;
+        }
+        let result = match self.lexer.next_line(&mut self.words) {
+            Ok(true) => self.parser.line(&self.words),
+            Ok(false) => return None,
+            Err(e) => Err(e),
+        };
+        self.drain();
+        if let Err(e) = result {
+            self.parser.recover();
+            return Some(Err(e));
+        }
+        Some(Ok(()))
+    }
+
+    /// What the lines read so far produced, in order.
+    pub(crate) fn take_read(&mut self) -> Option<Entry> {
+        self.pending.pop_front()
+    }
+}
+
 impl<S: LineSource> Iterator for Entries<'_, S> {
     type Item = Result<Entry, ParseError>;
 
