@@ -291,3 +291,49 @@ fn a_window_full_of_short_runs_is_cut_between_them() {
     assert_eq!(done.summary, whole.summary);
     assert!(done.dev.point_mm <= opts.tol.mm + 5e-7, "{:?}", done.dev);
 }
+
+/// The moves of `pts` (cutter points, tool vertical) as a post writes them.
+fn program_through(pts: &[(f64, f64)]) -> String {
+    let points: Vec<_> = pts
+        .iter()
+        .map(|&(x, y)| (Vector3::new(x, y, (x / 7.0).sin()), Vector3::z()))
+        .collect();
+    g01_program(&points, 2000.0)
+}
+
+/// Where the window fills in the middle of a run, or a few moves into one (too few yet to
+/// be fitted), or a `;` comment ends in a backslash, or only the header's line ends in CRLF:
+/// the stream still writes what the whole text gives.
+#[test]
+fn the_stream_matches_the_whole_text_where_the_window_fills_mid_run() {
+    let opts = Options::default();
+    let check = |src: &str, what: &str| {
+        let input = nc::parse::parse(src).expect("parses");
+        let whole = fit_program(src, &input, &PAPER, &opts);
+        let (text, done) = stream(src, &PAPER, &opts);
+        assert_eq!(text, whole.text, "{what}");
+        assert_eq!(done.summary, whole.summary, "{what}");
+        done.summary
+    };
+    // 1 000 moves along X, a corner, 4 500 along Y: the window fills inside the second run.
+    let mut pts: Vec<(f64, f64)> = (0..=1000).map(|k| (k as f64 * 0.1, 0.0)).collect();
+    pts.extend((1..=4500).map(|k| (100.0, k as f64 * 0.1)));
+    let s = check(&program_through(&pts), "a run across the cut");
+    assert_eq!((s.fitted_blocks, s.moves_fitted), (2, 5500), "{s:?}");
+    // 4 997 moves with a corner at every one, then 100 along a line: the window fills three
+    // moves into the line.
+    let mut pts: Vec<(f64, f64)> = (0..=4997)
+        .map(|k| (k as f64 * 0.1, if k % 2 == 0 { 0.0 } else { 0.1 }))
+        .collect();
+    let (x0, y0) = pts[pts.len() - 1];
+    pts.extend((1..=100).map(|k| (x0 + k as f64 * 0.1, y0 + k as f64 * 0.05)));
+    let s = check(&program_through(&pts), "a run starting at the cut");
+    assert_eq!((s.fitted_blocks, s.moves_fitted), (1, 100), "{s:?}");
+    // A `;` comment that ends in a backslash ends the line; a CRLF header in an LF file.
+    let src = sweep(200).replacen(
+        "G90 G21 G94\n",
+        "G90 G21 G94\r\nG00 X0 Y0 Z50 ; C:\\NC\\\n",
+        1,
+    );
+    check(&src, "a comment ending in a backslash");
+}

@@ -253,10 +253,17 @@ pub enum Command {
     /// most 10 degrees) becomes one G06.5 block: a cubic cutter curve and an orientation
     /// curve on one knot vector, weights 1, with every programmed point within --tol-mm of
     /// the cutter curve and every programmed tool axis within --tol-deg of the interpolated
-    /// one. Every other line passes through as it was. The result is then parsed again, both
-    /// programs are built into paths on the machine, and their deviations are measured by
-    /// dense sampling, independently of the fit; over the tolerances, nothing is written and
-    /// the exit code is 1. A summary goes to standard error.
+    /// one. Every other line passes through as it was. A run given in machine angles is
+    /// followed by a line that gives both angles (its last move is kept as written if the
+    /// line after it does not), so the angles stay modal as in the program.
+    ///
+    /// The program is read as a stream, in the memory of a few thousand moves whatever its
+    /// length (a run longer than 5 000 moves becomes several blocks that join on programmed
+    /// points). As it is written, the result is parsed again, both programs are built into
+    /// paths on the machine, and their deviations are measured by dense sampling,
+    /// independently of the fit; over the tolerances, nothing is written (OUT.nc is created
+    /// only at the end, standard output only gets a checked program) and the exit code is 1.
+    /// A summary goes to standard error.
     #[command(after_help = crate::exit::TABLE)]
     Fit {
         /// NC program with G01 moves (X Y Z with I J K, or with the machine's angles).

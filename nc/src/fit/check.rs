@@ -100,7 +100,7 @@ impl<'a> Check<'a> {
     /// A line the rewrite wrote (without its ending): parsed, and its blocks built.
     pub fn written(&mut self, line: &str) -> Result<(), RewriteError> {
         self.written.borrow_mut().push_back(line.to_owned());
-        if line.trim_end().ends_with('\\') {
+        if crate::parse::continues(line) {
             return Ok(());
         }
         while let Some(read) = self.output.read_line() {

@@ -102,6 +102,20 @@ pub fn find_runs(
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
 ) -> Vec<Found> {
+    find_open_runs(program, kin, opts, may_start, may_join, may_end).0
+}
+
+/// [`find_runs`], and the first block of the run that reaches the program's last block,
+/// if one does (fitted or not, whatever its length): where a program read a piece at a
+/// time may have a run that goes on.
+pub fn find_open_runs(
+    program: &Program,
+    kin: &MachineKinematics,
+    opts: &Options,
+    may_start: impl Fn(usize) -> bool,
+    may_join: impl Fn(usize) -> bool,
+    may_end: impl Fn(usize, usize) -> bool,
+) -> (Vec<Found>, Option<usize>) {
     let linear = |b: usize| match program.blocks.get(b) {
         Some(Block::Linear(m)) => Some(m),
         _ => None,
@@ -120,6 +134,7 @@ pub fn find_runs(
     };
     let key = run_key;
     let mut runs = Vec::new();
+    let mut open = None;
     let mut b = 1;
     while b < program.blocks.len() {
         let Some(first) = linear(b).filter(|_| eligible(b) && may_start(b)) else {
@@ -134,6 +149,9 @@ pub fn find_runs(
             && !corner(e)
         {
             e += 1;
+        }
+        if e + 1 == program.blocks.len() {
+            open = Some(b);
         }
         let mut end = e;
         while end >= b && !may_end(end, e) {
@@ -153,5 +171,5 @@ pub fn find_runs(
         }
         b = e + 1;
     }
-    runs
+    (runs, open)
 }

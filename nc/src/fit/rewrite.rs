@@ -14,7 +14,7 @@
 
 use super::check::Check;
 use super::deviation::Deviation;
-use super::find::{find_runs, Found};
+use super::find::{find_open_runs, Found};
 use super::online::MAX_RUN;
 use super::runs::{
     in_angles, n_word, pure_move_line, sets_angles, write_block, Modes, Options, Summary,
@@ -30,8 +30,10 @@ use std::rc::Rc;
 use std::time::Instant;
 
 /// Lines held while no block is read from them (lines of a move and nothing else that
-/// move nothing, such as `F` alone): past this many the window is cut there.
+/// move nothing, such as `F` alone): past this many, or this many bytes (a line may be
+/// padded), the window is cut there.
 const MAX_HELD_LINES: usize = 2 * MAX_RUN + 16;
+const MAX_HELD_BYTES: usize = 64 << 20;
 
 /// Why the rewrite stopped. Nothing it wrote should be kept.
 #[derive(Debug, thiserror::Error)]
@@ -83,6 +85,7 @@ struct State<'a, W> {
     opts: &'a Options,
     modes: Modes,
     held: VecDeque<Held>,
+    held_bytes: usize,
     /// The blocks not yet decided, after the last block of the previous piece (block 0 of
     /// the window: the point the next run may start from).
     window: Program,
@@ -108,9 +111,10 @@ impl<W: Write> State<'_, W> {
             self.close(None, Some((no, text)), false)?;
             return self.emit(text, ending);
         }
-        if self.held.len() >= MAX_HELD_LINES {
+        if self.held.len() >= MAX_HELD_LINES || self.held_bytes >= MAX_HELD_BYTES {
             self.close(None, Some((no, text)), false)?;
         }
+        self.held_bytes += text.len();
         self.held.push_back(Held {
             no,
             text: text.to_owned(),
@@ -153,9 +157,7 @@ impl<W: Write> State<'_, W> {
     /// The window's runs are fitted and written, the held lines before line `upto` (all
     /// of them if `None`) written, and the piece checked; the window keeps its last block.
     /// `next`: the line being read, if it is not held. `full`: the window is cut only
-    /// because it holds [`MAX_RUN`] moves, so it keeps what may still become a run (from
-    /// the end of its last run, or the start of a run that reaches its end) if that is at
-    /// most half of it.
+    /// because it holds [`MAX_RUN`] moves, so it keeps the run that reaches its end.
     fn close(
         &mut self,
         upto: Option<u32>,
@@ -167,7 +169,14 @@ impl<W: Write> State<'_, W> {
         if len > 1 {
             let t0 = Instant::now();
             let (lines, held, blocks) = (&self.lines, &self.held, &self.window.blocks);
-            let mut found = find_runs(
+            // The held line numbered `no` (held lines are in order).
+            let held_line = |no: u32| {
+                held.binary_search_by_key(&no, |h| h.no)
+                    .ok()
+                    .and_then(|i| held.get(i))
+                    .map(|h| h.text.as_str())
+            };
+            let (mut found, open) = find_open_runs(
                 &self.window,
                 self.kin,
                 self.opts,
@@ -175,27 +184,21 @@ impl<W: Write> State<'_, W> {
                 |k| lines[k].plain && lines[k - 1].no.checked_add(1) == Some(lines[k].no),
                 // The line after block k (the next move of the run, or the line after it).
                 |k, _| {
-                    let after = lines[k].no.checked_add(1);
+                    let Some(after) = lines[k].no.checked_add(1) else {
+                        return false;
+                    };
                     !in_angles(&blocks[k])
-                        || held
-                            .iter()
-                            .find(|h| Some(h.no) == after)
-                            .map(|h| h.text.as_str())
-                            .or(next.filter(|n| Some(n.0) == after).map(|n| n.1))
+                        || held_line(after)
+                            .or(next.filter(|n| n.0 == after).map(|n| n.1))
                             .is_some_and(sets_angles)
                 },
             );
             self.fit_s += t0.elapsed().as_secs_f64();
-            if full {
-                let tail = match found.last() {
-                    Some(r) if r.reach + 1 == len => r.blocks.0 - 1,
-                    Some(r) => r.reach,
-                    None => keep,
-                };
-                if keep - tail <= MAX_RUN / 2 {
-                    keep = tail;
-                    found.retain(|r| r.reach < keep + 1);
-                }
+            // A window cut for its size keeps the run that reaches its end (it is fitted
+            // again with what follows), unless that run is the whole window.
+            if let Some(b) = open.filter(|&b| full && b > 1) {
+                keep = b - 1;
+                found.retain(|r| r.blocks.0 < b);
             }
             for f in &found {
                 let (l0, l1) = (self.lines[f.blocks.0].no, self.lines[f.blocks.1].no);
@@ -211,7 +214,7 @@ impl<W: Write> State<'_, W> {
             if upto.is_some_and(|u| h.no >= u) {
                 break;
             }
-            if let Some(h) = self.held.pop_front() {
+            if let Some(h) = self.pop_held() {
                 self.emit(&h.text, h.ending)?;
             }
         }
@@ -236,13 +239,13 @@ impl<W: Write> State<'_, W> {
             if h.no >= l0 {
                 break;
             }
-            if let Some(h) = self.held.pop_front() {
+            if let Some(h) = self.pop_held() {
                 self.emit(&h.text, h.ending)?;
             }
         }
         let (mut n, mut eol) = (None, "\n");
         while self.held.front().is_some_and(|h| h.no <= l1) {
-            if let Some(h) = self.held.pop_front().filter(|h| h.no == l0) {
+            if let Some(h) = self.pop_held().filter(|h| h.no == l0) {
                 n = n_word(&h.text);
                 if h.ending == "\r\n" {
                     eol = "\r\n";
@@ -261,6 +264,12 @@ impl<W: Write> State<'_, W> {
         s.fit_mm = s.fit_mm.max(fitted.dev_mm);
         s.fit_deg = s.fit_deg.max(fitted.dev_rad.to_degrees());
         Ok(())
+    }
+
+    fn pop_held(&mut self) -> Option<Held> {
+        let h = self.held.pop_front()?;
+        self.held_bytes -= h.text.len();
+        Some(h)
     }
 
     fn emit(&mut self, text: &str, ending: &str) -> Result<(), RewriteError> {
@@ -316,6 +325,7 @@ pub fn rewrite<R: BufRead, W: Write>(
         opts,
         modes: Modes::default(),
         held: VecDeque::new(),
+        held_bytes: 0,
         window: Program::default(),
         lines: Vec::new(),
         blocks: 0,

@@ -261,7 +261,6 @@ pub fn fit_program(
             found: f,
         })
         .collect();
-    let eol = if src.contains("\r\n") { "\r\n" } else { "\n" };
     let mut text = String::with_capacity(src.len() / 2);
     let mut next = 0;
     for run in &runs {
@@ -275,6 +274,12 @@ pub fn fit_program(
             text.push('\n');
         }
         let n_word = n_word(lines[l0 - 1]);
+        // The block's lines end as its first move's line did.
+        let eol = if lines[l0 - 1].ends_with('\r') {
+            "\r\n"
+        } else {
+            "\n"
+        };
         write_block(&mut text, f, run.found.feed_mm_min, n_word.as_deref(), eol);
         next = l1;
         summary.fitted_blocks += 1;

@@ -86,6 +86,12 @@ impl<S: LineSource> Lexer<S> {
 }
 
 /// Scans one physical line, appending its words. Returns the position of a trailing `\`.
+/// Whether the lexer reads `text` on with the next line (it ends with a backslash outside
+/// any comment).
+pub(crate) fn continues(text: &str) -> bool {
+    text.contains('\\') && matches!(scan_line(1, text, &mut Vec::new()), Ok(Some(_)))
+}
+
 fn scan_line(line: u32, text: &str, words: &mut Vec<Word>) -> Result<Option<SrcPos>, ParseError> {
     let mut chars = text.char_indices().peekable();
     let mut col = 0u32;

@@ -76,6 +76,7 @@ mod arc;
 pub(crate) mod codes;
 mod error;
 mod lexer;
+pub(crate) use lexer::continues;
 mod line;
 mod modal;
 mod moves;

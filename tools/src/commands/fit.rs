@@ -99,7 +99,7 @@ pub fn fit(
     let step = STEP.max(passed.length / MAX_SAMPLES);
     // Written to a file beside the output (or in the temporary directory for standard
     // output) and moved there only once the whole program is within the tolerances.
-    let partial = Partial::new(output)?;
+    let mut partial = Partial::new(output)?;
     let writer = std::io::BufWriter::with_capacity(1 << 16, partial.create()?);
     let done = rewrite(
         open()?,
@@ -145,12 +145,17 @@ pub fn fit(
 struct Partial {
     path: PathBuf,
     dest: Option<PathBuf>,
+    /// Whether this run created the file (only then is it removed).
+    created: bool,
     kept: bool,
 }
 
 impl Partial {
     fn new(dest: Option<&Path>) -> anyhow::Result<Partial> {
-        let name = format!(".dnurbs-fit-{}.partial", std::process::id());
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let name = format!(".dnurbs-fit-{}-{nanos}.partial", std::process::id());
         let path = match dest {
             Some(d) => {
                 let dir = d.parent().filter(|p| !p.as_os_str().is_empty());
@@ -163,14 +168,26 @@ impl Partial {
         Ok(Partial {
             path,
             dest: dest.map(Path::to_path_buf),
+            created: false,
             kept: false,
         })
     }
 
-    fn create(&self) -> anyhow::Result<std::fs::File> {
+    fn create(&mut self) -> anyhow::Result<std::fs::File> {
         let shown = self.dest.as_deref().unwrap_or(&self.path).display();
-        std::fs::File::create(&self.path)
-            .with_context(|| format!("{shown}: cannot write the fitted program"))
+        // A new file only: nothing already there (a file, a link) is written through.
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&self.path)
+            .with_context(|| {
+                format!(
+                    "{shown}: cannot write the fitted program ({})",
+                    self.path.display()
+                )
+            })?;
+        self.created = true;
+        Ok(file)
     }
 
     /// The whole output checked: moved to its destination, or copied to standard output.
@@ -192,7 +209,7 @@ impl Partial {
 
 impl Drop for Partial {
     fn drop(&mut self) {
-        if !self.kept {
+        if self.created && !self.kept {
             let _ = std::fs::remove_file(&self.path);
         }
     }
