@@ -197,3 +197,35 @@ fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
     assert!(!left.iter().any(|f| f.contains("partial")), "{left:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A program that can be read once (a pipe: `dnurbs fit /dev/stdin`, or `<(...)`) is read
+/// into memory and fitted as a file is; it is never taken for an empty program.
+#[test]
+fn fit_reads_a_pipe_as_a_file() {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let mach = machine("paper-ac-table.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args(["fit", "/dev/stdin", "-m", mach.to_str().unwrap()])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("dnurbs runs");
+    let text = helix(300);
+    let mut stdin = child.stdin.take().unwrap();
+    let writer = std::thread::spawn(move || stdin.write_all(text.as_bytes()));
+    let out = child.wait_with_output().unwrap();
+    writer.join().unwrap().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("300 in, 300 fitted into 1 G06.5 blocks"),
+        "{err}"
+    );
+    let written = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        written.contains("G06.5 P3") && written.contains("M30"),
+        "{written}"
+    );
+}

@@ -60,6 +60,8 @@ pub struct Rewritten {
     /// Seconds spent fitting (finding the runs and fitting them; reading, writing and the
     /// check excluded).
     pub fit_s: f64,
+    /// Physical lines read.
+    pub lines: u32,
 }
 
 /// A line read and not yet written: one of a move and nothing else, which a run may take.
@@ -86,6 +88,7 @@ struct State<'a, W> {
     modes: Modes,
     held: VecDeque<Held>,
     held_bytes: usize,
+    lines_read: u32,
     /// The blocks not yet decided, after the last block of the previous piece (block 0 of
     /// the window: the point the next run may start from).
     window: Program,
@@ -105,6 +108,7 @@ impl<W: Write> State<'_, W> {
     fn on_line(&mut self, no: u32, text: &str, ending: &'static str) -> Result<(), RewriteError> {
         let (plain, g01) = self.modes.line(text);
         self.summary.bytes_in += text.len() + ending.len();
+        self.lines_read = no;
         if !pure_move_line(text) {
             // No run takes this line, so none goes on past it: every line before it is
             // decided, and so is this one.
@@ -326,6 +330,7 @@ pub fn rewrite<R: BufRead, W: Write>(
         modes: Modes::default(),
         held: VecDeque::new(),
         held_bytes: 0,
+        lines_read: 0,
         window: Program::default(),
         lines: Vec::new(),
         blocks: 0,
@@ -367,5 +372,6 @@ pub fn rewrite<R: BufRead, W: Write>(
         summary: s.summary.clone(),
         dev: s.check.dev,
         fit_s: s.fit_s,
+        lines: s.lines_read,
     })
 }

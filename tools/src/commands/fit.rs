@@ -59,13 +59,24 @@ pub fn fit(
     let mut parse = parse_setup(&machine, &shop);
     parse.work_offsets = [Some([0.0; 3]); 6];
     let file = program.display().to_string();
-    let open = || {
-        std::fs::File::open(program)
-            .map(|f| std::io::BufReader::with_capacity(1 << 16, f))
-            .map_err(|error| InputError::ReadProgram {
-                file: file.clone(),
-                error,
-            })
+    let unreadable = |error| InputError::ReadProgram {
+        file: file.clone(),
+        error,
+    };
+    // The program is read twice (checked, then fitted): a pipe, which can be read once, is
+    // read into memory first.
+    let piped = match std::fs::metadata(program) {
+        Ok(m) if m.is_file() => None,
+        _ => Some(std::fs::read(program).map_err(unreadable)?),
+    };
+    let open = || -> Result<Box<dyn std::io::BufRead + '_>, InputError> {
+        Ok(match &piped {
+            Some(bytes) => Box::new(bytes.as_slice()),
+            None => Box::new(std::io::BufReader::with_capacity(
+                1 << 16,
+                std::fs::File::open(program).map_err(unreadable)?,
+            )),
+        })
     };
     // The whole program is checked first, as `simulate` checks it (every parse error, the
     // first the segment builder refuses), without the travel: the fit reads the program's
@@ -111,6 +122,14 @@ pub fn fit(
         writer,
     )
     .map_err(|e| anyhow::anyhow!("{file}: {e}; nothing written"))?;
+    if done.lines != passed.lines {
+        bail!(
+            "{file}: the program changed while it was read ({} lines checked, {} fitted); \
+             nothing written",
+            passed.lines,
+            done.lines
+        );
+    }
     let report = Report {
         file: &file,
         summary: &done.summary,
