@@ -229,3 +229,34 @@ fn fit_reads_a_pipe_as_a_file() {
         "{written}"
     );
 }
+
+/// An output that is not a regular file (`-o /dev/null`, a link, a FIFO) is written into
+/// once the program is checked, and stays what it is: a link stays a link to the file that
+/// gets the program (a rename over it would have replaced `/dev/null` by a file).
+#[test]
+fn fit_writes_into_a_link_and_keeps_it_a_link() {
+    let dir = temp("fit-link");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (src, real, link) = (dir.join("in.nc"), dir.join("real.nc"), dir.join("link.nc"));
+    std::fs::write(&src, helix(200)).unwrap();
+    std::fs::write(&real, "old\n").unwrap();
+    std::os::unix::fs::symlink(&real, &link).unwrap();
+    let r = on_paper_machine("fit", &src, &["-o", link.to_str().unwrap()]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let meta = std::fs::symlink_metadata(&link).unwrap();
+    assert!(meta.file_type().is_symlink(), "{meta:?}");
+    let text = std::fs::read_to_string(&real).unwrap();
+    assert!(
+        text.contains("G06.5 P3") && !text.starts_with("old"),
+        "{text}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(left.len(), 3, "{left:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -159,11 +159,22 @@ pub fn fit(
     Ok(Outcome::Completed)
 }
 
-/// The output as it is written: a file beside the destination (or in the temporary
-/// directory, for standard output), removed unless [`Partial::keep`] moves it there.
+/// Where the checked output goes.
+enum Dest {
+    Stdout,
+    /// A file that does not exist yet, or a regular file: replaced by a rename.
+    Replace(PathBuf),
+    /// Anything else (`/dev/null`, a FIFO, a link): opened and written only at the end, so
+    /// the device, the pipe or the link stays what it is.
+    Into(PathBuf),
+}
+
+/// The output as it is written: a new file beside the destination it replaces (or in the
+/// temporary directory, for standard output and what is written into), removed unless
+/// [`Partial::keep`] moves it there.
 struct Partial {
     path: PathBuf,
-    dest: Option<PathBuf>,
+    dest: Dest,
     /// Whether this run created the file (only then is it removed).
     created: bool,
     kept: bool,
@@ -174,26 +185,37 @@ impl Partial {
         let nanos = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .map_or(0, |d| d.subsec_nanos());
-        let name = format!(".dnurbs-fit-{}-{nanos}.partial", std::process::id());
-        let path = match dest {
-            Some(d) => {
-                let dir = d.parent().filter(|p| !p.as_os_str().is_empty());
-                let file = d.file_name().map(|f| f.to_string_lossy().into_owned());
-                let name = format!("{}{name}", file.unwrap_or_default());
-                dir.map_or_else(|| PathBuf::from(&name), |dir| dir.join(&name))
-            }
-            None => std::env::temp_dir().join(name.trim_start_matches('.')),
+        let name = format!("dnurbs-fit-{}-{nanos}.partial", std::process::id());
+        let in_temp = std::env::temp_dir().join(&name);
+        let (path, dest) = match dest {
+            None => (in_temp, Dest::Stdout),
+            Some(d) => match std::fs::symlink_metadata(d) {
+                Ok(m) if !m.file_type().is_file() => (in_temp, Dest::Into(d.to_path_buf())),
+                _ => {
+                    let dir = d.parent().filter(|p| !p.as_os_str().is_empty());
+                    let file = d.file_name().map(|f| f.to_string_lossy().into_owned());
+                    let name = format!(".{}.{name}", file.unwrap_or_default());
+                    let beside = dir.map_or_else(|| PathBuf::from(&name), |dir| dir.join(&name));
+                    (beside, Dest::Replace(d.to_path_buf()))
+                }
+            },
         };
         Ok(Partial {
             path,
-            dest: dest.map(Path::to_path_buf),
+            dest,
             created: false,
             kept: false,
         })
     }
 
+    fn shown(&self) -> std::path::Display<'_> {
+        match &self.dest {
+            Dest::Replace(d) | Dest::Into(d) => d.display(),
+            Dest::Stdout => self.path.display(),
+        }
+    }
+
     fn create(&mut self) -> anyhow::Result<std::fs::File> {
-        let shown = self.dest.as_deref().unwrap_or(&self.path).display();
         // A new file only: nothing already there (a file, a link) is written through.
         let file = std::fs::OpenOptions::new()
             .write(true)
@@ -201,7 +223,8 @@ impl Partial {
             .open(&self.path)
             .with_context(|| {
                 format!(
-                    "{shown}: cannot write the fitted program ({})",
+                    "{}: cannot write the fitted program ({})",
+                    self.shown(),
                     self.path.display()
                 )
             })?;
@@ -209,19 +232,29 @@ impl Partial {
         Ok(file)
     }
 
-    /// The whole output checked: moved to its destination, or copied to standard output.
+    /// The whole output checked: moved to its destination, or copied into it.
     fn keep(mut self) -> anyhow::Result<()> {
+        let cannot = || format!("{}: cannot write the fitted program", self.shown());
+        let copy = |to: &mut dyn Write| -> std::io::Result<()> {
+            let mut f = std::fs::File::open(&self.path)?;
+            std::io::copy(&mut f, to)?;
+            to.flush()
+        };
         match &self.dest {
-            Some(dest) => std::fs::rename(&self.path, dest)
-                .with_context(|| format!("{}: cannot write the fitted program", dest.display()))?,
-            None => {
-                let mut f = std::fs::File::open(&self.path)?;
-                let mut stdout = std::io::stdout().lock();
-                std::io::copy(&mut f, &mut stdout)?;
-                stdout.flush()?;
+            Dest::Replace(dest) => {
+                std::fs::rename(&self.path, dest).with_context(cannot)?;
+                self.kept = true;
             }
+            Dest::Into(dest) => {
+                let mut to = std::fs::OpenOptions::new()
+                    .write(true)
+                    .truncate(true)
+                    .open(dest)
+                    .with_context(cannot)?;
+                copy(&mut to).with_context(cannot)?;
+            }
+            Dest::Stdout => copy(&mut std::io::stdout().lock()).with_context(cannot)?,
         }
-        self.kept = self.dest.is_some();
         Ok(())
     }
 }
