@@ -164,13 +164,11 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
         let target = pose.axis(kin);
         let mut deg = best_axis.angle(&target).to_degrees();
         // (Sample j may stand before the nearest position: the ties start at j or j + 1.)
-        let mut k = j;
-        while k < out.p.len() {
+        for k in j..out.p.len() {
             if (out.p[k] - pose.p).norm() > best_d + 1e-9 {
                 if k > j {
                     break;
                 }
-                k += 1;
                 continue;
             }
             let (seg, s) = out.at[k];
@@ -181,7 +179,6 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
                     cursor = k;
                 }
             }
-            k += 1;
         }
         if best_d > dev.point_mm {
             dev.point_mm = best_d;

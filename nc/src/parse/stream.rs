@@ -90,9 +90,10 @@ impl<'s, S: LineSource> Entries<'s, S> {
 
 impl<S: LineSource> Entries<'_, S> {
     /// Reads one line, if the source has one now, and keeps what it produced for
-    /// [`Self::take`]; `None` when the source has no line yet (nothing is finished: a source
-    /// fed as it goes can be read again). For a reader that must parse each line as soon as
-    /// it is written (`dnurbs fit`'s check of its own output).
+    /// [`Self::take_read`]; `None` when the source has no line yet (nothing is finished: a
+    /// source fed as it goes can be read again). The iterator reads through it; a reader
+    /// that must parse each line as soon as it is written (`dnurbs fit`'s check of its own
+    /// output) calls it directly.
     pub(crate) fn read_line(&mut self) -> Option<Result<(), ParseError>> {
         if self.finished {
             return None;
@@ -127,18 +128,18 @@ impl<S: LineSource> Iterator for Entries<'_, S> {
             if self.finished {
                 return None;
             }
-            let result = match self.lexer.next_line(&mut self.words) {
-                Ok(true) => self.parser.line(&self.words),
-                Ok(false) => {
+            match self.read_line() {
+                Some(Ok(())) => {}
+                Some(Err(e)) => return Some(Err(e)),
+                None => {
                     self.finished = true;
-                    self.parser.check_end(self.lexer.eof())
+                    let result = self.parser.check_end(self.lexer.eof());
+                    self.drain();
+                    if let Err(e) = result {
+                        self.parser.recover();
+                        return Some(Err(e));
+                    }
                 }
-                Err(e) => Err(e),
-            };
-            self.drain();
-            if let Err(e) = result {
-                self.parser.recover();
-                return Some(Err(e));
             }
         }
     }
