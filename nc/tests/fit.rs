@@ -396,3 +396,29 @@ fn a_compressed_row_end_is_passed_without_creeping() {
         assert_eq!(corners, 6, "three row ends, two corners each");
     }
 }
+
+/// The check measures a path against itself as zero, whatever its moves' lengths: a long
+/// rapid approach, turns of the rotary axes alone, short moves and a long straight one, so
+/// the input's straight moves, measured as whole chords, are followed however far the
+/// output's samples run along one.
+#[test]
+fn a_path_measured_against_itself_is_not_off() {
+    let mut src = String::from("G90 G21 G94\nG00 X250 Y0 Z50\nG01 A10 F1000\nG01 C30\n");
+    for k in 1..=200 {
+        let t = f64::from(k) * 0.01;
+        let _ = writeln!(
+            src,
+            "G01 X{:.4} Y{:.4} Z{:.4} F2000",
+            250.0 - 20.0 * t,
+            5.0 * t.sin(),
+            50.0 - t
+        );
+    }
+    src.push_str("G01 X0 Y-40 Z10\nG01 A0 C0\nG01 X0.1 Y-40.05\n");
+    let (_, bl) = nc::fixtures::small_mill(0.002);
+    let path = build(&nc::parse::parse(&src).unwrap(), &KIN, &bl).unwrap();
+    let dev = measure(&path, &path, &KIN, 0.002);
+    assert!(dev.point_mm < 1e-9 && dev.path_mm < 1e-9, "{dev:?}");
+    assert!(dev.point_deg < 1e-6, "{dev:?}");
+    assert_eq!(dev.points, 206);
+}

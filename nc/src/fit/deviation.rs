@@ -5,14 +5,15 @@
 //! * Every programmed point (each input segment's end) against the output path: the
 //!   nearest sample's neighbourhood is searched for the exact nearest path position (a
 //!   ternary search on the segment's own evaluation), where the tool axes are compared.
-//! * Every output sample against the input path's samples (for `G01` moves those lie on the
-//!   programmed chords): how far the output strays between the points.
+//! * Every output sample against the input path: its samples, or for a straight move the
+//!   programmed chord itself: how far the output strays between the points.
 //!
-//! Both walk forward with the paths (a cursor that searches a reach of twice the step ahead),
-//! so the cost is linear in the samples.
+//! Both walk forward with the paths (a cursor that searches a reach of twice the step ahead,
+//! skipping the chords the triangle inequality rules out), so the cost is linear in the
+//! samples.
 
 use crate::kinematics::MachineKinematics;
-use crate::segment::Path;
+use crate::segment::{Geometry, Path, Pose, Segment};
 use nalgebra::Vector3;
 
 pub use crate::verify::dist_to_chord as to_segment;
@@ -42,8 +43,10 @@ struct Track {
     along: Vec<f64>,
 }
 
-/// Samples every `h` (mm, or degrees on rotary-only segments), at least 4 a segment.
-fn sample(path: &Path, h: f64) -> Track {
+/// Samples every `h` (mm, or degrees on rotary-only segments), at least 4 a segment; with
+/// `lines_whole`, a straight move of the cutter by its end alone (its samples would lie on
+/// the chord to it, which measures the same distances).
+fn sample(path: &Path, h: f64, lines_whole: bool) -> Track {
     let mut t = Track {
         p: Vec::new(),
         at: Vec::new(),
@@ -58,19 +61,138 @@ fn sample(path: &Path, h: f64) -> Track {
     };
     push(&mut t, 0, 0.0, path.start.p);
     for (k, seg) in path.segments.iter().enumerate() {
-        let n = ((seg.length / h).ceil() as usize).clamp(4, 10_000_000);
+        let line = matches!(seg.geometry, Geometry::Line { .. }) && !seg.rotary_only;
+        let n = if lines_whole && line {
+            1
+        } else {
+            ((seg.length / h).ceil() as usize).clamp(4, 10_000_000)
+        };
         for j in 1..=n {
             let s = seg.length * j as f64 / n as f64;
-            push(&mut t, k, s, seg.pose(s).p);
+            push(&mut t, k, s, point(seg, s));
         }
     }
     t
 }
 
-/// Nearest sample segment (j, j + 1) to `q`, searched from `from` over `reach` of path.
-fn nearest(t: &Track, q: &Vector3<f64>, from: usize, reach: f64) -> (usize, f64) {
-    let start = from.saturating_sub(2);
-    let limit = t.along[from.min(t.p.len() - 1)] + reach;
+/// The cutter's position `s` along a segment: `seg.pose(s).p`, without the tool.
+fn point(seg: &Segment, s: f64) -> Vector3<f64> {
+    match &seg.geometry {
+        Geometry::Nurbs { curve, table } => {
+            curve
+                .cutter(table.u_of_s(curve, s.clamp(0.0, seg.length)), 0)
+                .p
+        }
+        Geometry::Line { .. } => seg.pose(s).p,
+    }
+}
+
+/// Where a search along a track found its nearest chord.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Near {
+    /// The chord from sample `j` to `j + 1`, ...
+    j: usize,
+    /// ... `d` from the query ...
+    d: f64,
+    /// ... whose foot there lies `along` the track from its start.
+    along: f64,
+}
+
+impl Near {
+    const START: Near = Near {
+        j: 0,
+        d: f64::INFINITY,
+        along: 0.0,
+    };
+}
+
+/// Nearest chord (samples j, j + 1) to `q`, searched from `from` (two chords back) to
+/// `reach` of track beyond `from`'s foot (a straight move is one chord however long).
+///
+/// Chords that cannot be nearer are skipped, not measured: a point of the track `a` mm
+/// along from sample `j + 1` is at least `|q - p[j + 1]| - a` from `q` (the track between
+/// them is at least as long as the straight line), so while that bound exceeds the best
+/// distance found, no chord there can beat it. The answer is the scan's over every chord
+/// of the reach ([`nearest_scan`], which the tests compare it with), found in a few chord
+/// measurements where the track runs away from `q` instead of one for every sample.
+fn nearest(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
+    let n = t.p.len();
+    if n == 1 {
+        return near(t, q, 0);
+    }
+    let start = from.j.saturating_sub(2);
+    let limit = from.along + reach;
+    let mut best = (start, f64::INFINITY);
+    let mut j = start;
+    while j + 1 < n {
+        let d = to_segment(q, &t.p[j], &t.p[j + 1]);
+        if d < best.1 {
+            best = (j, d);
+        }
+        if t.along[j] > limit {
+            break;
+        }
+        // (Less a margin far above the rounding of the distances along.)
+        let gap = (q - t.p[j + 1]).norm() - best.1 - 1e-9 * (1.0 + t.along[j + 1]);
+        // The next chord that may be nearer: the first whose end reaches `along[j + 1] +
+        // gap` (every chord before it ends nearer the start, all of it farther than best).
+        let next = if gap > 0.0 {
+            first_at_least(&t.along, j + 2, t.along[j + 1] + gap).saturating_sub(1)
+        } else {
+            j + 1
+        };
+        // Skipped past the reach: the scan would have stopped among the skipped chords.
+        if next > j + 1 && t.along[next - 1] > limit {
+            break;
+        }
+        j = next;
+    }
+    near(t, q, best.0)
+}
+
+/// `q`'s foot on chord `j` of the track (the one sample, on a track of one).
+fn near(t: &Track, q: &Vector3<f64>, j: usize) -> Near {
+    let Some(b) = t.p.get(j + 1) else {
+        return Near {
+            j,
+            d: (q - t.p[j]).norm(),
+            along: t.along[j],
+        };
+    };
+    let (a, ab) = (&t.p[j], t.p[j + 1] - t.p[j]);
+    let l2 = ab.norm_squared();
+    let f = if l2 > 0.0 {
+        ((q - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    Near {
+        j,
+        d: to_segment(q, a, b),
+        along: t.along[j] + f * (t.along[j + 1] - t.along[j]),
+    }
+}
+
+/// The first index from `from` whose value is at least `x` in the nondecreasing `v`
+/// (`v.len()` if none): a galloping search, since the answer is usually near `from`.
+fn first_at_least(v: &[f64], from: usize, x: f64) -> usize {
+    let mut lo = from;
+    let mut step = 1;
+    loop {
+        let hi = lo.saturating_add(step).min(v.len());
+        if hi == v.len() || v[hi] >= x {
+            return lo + v[lo..hi].partition_point(|&a| a < x);
+        }
+        lo = hi;
+        step *= 2;
+    }
+}
+
+/// [`nearest`] by measuring every chord of the reach (the tests' reference).
+#[cfg(test)]
+fn nearest_scan(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
+    let start = from.j.saturating_sub(2);
+    let limit = from.along + reach;
     let mut best = (start, f64::INFINITY);
     let mut j = start;
     while j + 1 < t.p.len() {
@@ -83,10 +205,7 @@ fn nearest(t: &Track, q: &Vector3<f64>, from: usize, reach: f64) -> (usize, f64)
         }
         j += 1;
     }
-    if t.p.len() == 1 {
-        best = (0, (q - t.p[0]).norm());
-    }
-    best
+    near(t, q, if t.p.len() == 1 { 0 } else { best.0 })
 }
 
 /// The minimum of a unimodal `f` on lo..hi (golden-section search, to 1e-9 of the interval).
@@ -116,10 +235,45 @@ fn golden(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
     }
 }
 
+/// A position on a segment: by its curve parameter, or along a straight move.
+#[derive(Clone, Copy)]
+enum At {
+    U(f64),
+    S(f64),
+}
+
+impl At {
+    fn pose(self, seg: &Segment) -> Pose {
+        match (self, seg.nurbs()) {
+            (At::U(u), Some((curve, table))) => seg.pose_u(curve, table, u),
+            (At::U(_), None) => seg.pose(0.0),
+            (At::S(s), _) => seg.pose(s),
+        }
+    }
+}
+
+/// The nearest position to `q` of `seg` between `lo` and `hi` along it, and its distance:
+/// a golden-section search on the cutter's position alone (on a curve, in its parameter
+/// between those of `lo` and `hi`, which the arc length maps one to one).
+fn nearest_on(seg: &Segment, lo: f64, hi: f64, q: &Vector3<f64>) -> (f64, At) {
+    match &seg.geometry {
+        Geometry::Nurbs { curve, table } => {
+            let dist = |u: f64| (curve.cutter(u, 0).p - q).norm();
+            let u = golden(table.u_of_s(curve, lo), table.u_of_s(curve, hi), dist);
+            (dist(u), At::U(u))
+        }
+        Geometry::Line { .. } => {
+            let dist = |s: f64| (point(seg, s) - q).norm();
+            let s = golden(lo, hi, dist);
+            (dist(s), At::S(s))
+        }
+    }
+}
+
 /// Measure `output` against `input` (both from the segment builder), sampling every `h`.
 pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> Deviation {
-    let out = sample(output, h);
-    let inp = sample(input, h);
+    let out = sample(output, h, false);
+    let inp = sample(input, h, true);
     let mut dev = Deviation {
         samples: out.p.len(),
         ..Deviation::default()
@@ -132,29 +286,28 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
             .iter()
             .map(|s| (s.pose(s.length), s.src.line)),
     );
-    let mut cursor = 0;
+    let mut cursor = Near::START;
     let mut prev = input.start.p;
     for (pose, line) in points {
         let step = (pose.p - prev).norm();
         prev = pose.p;
-        let (j, _) = nearest(&out, &pose.p, cursor, 2.0 * step + 0.5);
-        cursor = j;
+        cursor = nearest(&out, &pose.p, cursor, 2.0 * step + 0.5);
+        let j = cursor.j;
         // The exact nearest position around samples j - 1 .. j + 2, on their segments.
-        let (mut best_d, mut best_axis) = (f64::INFINITY, Vector3::z());
+        let (mut best_d, mut best_at) = (f64::INFINITY, None);
         for k in j.saturating_sub(1)..(j + 1).min(out.p.len() - 1) {
             let ((sa, a), (sb, b)) = (out.at[k], out.at[k + 1]);
             let (seg, lo, hi) = if sa == sb { (sb, a, b) } else { (sb, 0.0, b) };
             let Some(segment) = output.segments.get(seg) else {
                 continue;
             };
-            let dist = |s: f64| (segment.pose(s).p - pose.p).norm();
-            let s = golden(lo, hi, dist);
-            let d = dist(s);
+            let (d, at) = nearest_on(segment, lo, hi, &pose.p);
             if d < best_d {
                 best_d = d;
-                best_axis = segment.pose(s).axis(kin);
+                best_at = Some((segment, at));
             }
         }
+        let best_axis = best_at.map_or(Vector3::z(), |(seg, at)| at.pose(seg).axis(kin));
         if !best_d.is_finite() {
             best_d = (out.p[j] - pose.p).norm();
         }
@@ -176,7 +329,7 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
                 let a = segment.pose(s).axis(kin).angle(&target).to_degrees();
                 if a < deg {
                     deg = a;
-                    cursor = k;
+                    cursor = near(&out, &pose.p, k);
                 }
             }
         }
@@ -191,16 +344,95 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
         dev.points += 1;
     }
     // Output samples against the input path.
-    let mut cursor = 0;
+    let mut cursor = Near::START;
     for j in 0..out.p.len() {
         let step = if j > 0 {
             out.along[j] - out.along[j - 1]
         } else {
             0.0
         };
-        let (k, d) = nearest(&inp, &out.p[j], cursor, 2.0 * step + 0.5);
-        cursor = k;
-        dev.path_mm = dev.path_mm.max(d);
+        cursor = nearest(&inp, &out.p[j], cursor, 2.0 * step + 0.5);
+        dev.path_mm = dev.path_mm.max(cursor.d);
     }
     dev
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A track through `p` (its distances along summed as `sample` sums them).
+    fn track(p: Vec<Vector3<f64>>) -> Track {
+        let mut along = Vec::with_capacity(p.len());
+        let mut a = 0.0;
+        for (k, q) in p.iter().enumerate() {
+            if k > 0 {
+                a += (q - p[k - 1]).norm();
+            }
+            along.push(a);
+        }
+        Track {
+            at: vec![(0, 0.0); p.len()],
+            p,
+            along,
+        }
+    }
+
+    /// Random walks: steps of 0 to `h` (repeated samples too), turning by up to `turn`
+    /// radians a step, so straight runs, wiggles, hairpins and rasters that come back
+    /// along themselves.
+    fn walks() -> impl Strategy<Value = Vec<Vector3<f64>>> {
+        (
+            1usize..400,
+            1e-4f64..2.0,
+            0.0f64..3.2,
+            prop::collection::vec((0.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0), 400),
+        )
+            .prop_map(|(n, h, turn, steps)| {
+                let (mut p, mut dir) = (Vector3::zeros(), Vector3::x());
+                let mut out = vec![p];
+                for &(len, a, b) in steps.iter().take(n - 1) {
+                    let len = if len < 0.1 { 0.0 } else { len * h };
+                    let r = nalgebra::Rotation3::from_euler_angles(a * turn, b * turn, 0.0);
+                    dir = (r * dir).normalize();
+                    p += dir * len;
+                    out.push(p);
+                }
+                out
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(2000))]
+
+        /// The skipping search gives the full scan's chord and distance exactly.
+        #[test]
+        fn nearest_skips_only_what_cannot_be_nearer(
+            p in walks(),
+            queries in prop::collection::vec((0.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, 0.0f64..1.0), 1..20),
+            spread in prop::sample::select(vec![0.0, 1e-6, 1e-3, 0.1, 1.0, 10.0]),
+        ) {
+            let t = track(p);
+            let n = t.p.len();
+            for (at, x, y, z, reach) in queries {
+                let j = ((at * n as f64) as usize).min(n - 1);
+                let q = t.p[j] + Vector3::new(x, y, z) * spread;
+                let from = near(&t, &(q + Vector3::new(z, x, y) * spread), j);
+                let reach = reach * t.along[n - 1] * 1.2;
+                prop_assert_eq!(nearest(&t, &q, from, reach), nearest_scan(&t, &q, from, reach));
+            }
+        }
+    }
+
+    #[test]
+    fn galloping_finds_the_first_at_least() {
+        let v: Vec<f64> = (0..100).map(|k| f64::from(k / 3)).collect();
+        for from in 0..=v.len() {
+            for x in [-1.0, 0.0, 0.5, 1.0, 7.0, 32.0, 33.0, 34.0] {
+                let want = from + v[from..].partition_point(|&a| a < x);
+                assert_eq!(first_at_least(&v, from, x), want, "from {from} x {x}");
+            }
+        }
+    }
 }
