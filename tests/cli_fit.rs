@@ -260,3 +260,84 @@ fn fit_writes_into_a_link_and_keeps_it_a_link() {
     assert_eq!(left.len(), 3, "{left:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// SIGINT while `dnurbs fit` works ends it with exit 4 and says so: the output it replaces
+/// is left as it was and the partial file beside it is removed. (The signal is sent once
+/// the partial file exists, so the fit is under way, whatever the machine's speed.)
+#[test]
+fn fit_stopped_by_sigint_writes_nothing_and_leaves_nothing() {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    let dir = temp("fit-sigint");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (src, out) = (dir.join("long.nc"), dir.join("out.nc"));
+    std::fs::write(&src, helix(100_000)).unwrap();
+    std::fs::write(&out, "old\n").unwrap();
+    let mach = machine("paper-ac-table.toml");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args(["fit", src.to_str().unwrap(), "-m", mach.to_str().unwrap()])
+        .args(["-o", out.to_str().unwrap()])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("dnurbs runs");
+    let partial = || {
+        std::fs::read_dir(&dir).unwrap().any(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .ends_with(".partial")
+        })
+    };
+    while !partial() {
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("dnurbs fit ended ({status}) before it began to write");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let _ = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(4), "{err}");
+    assert!(
+        err.contains("stop requested (SIGINT/SIGTERM) while fitting")
+            && err.contains("nothing written"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old\n");
+    assert!(!partial(), "a partial file is left");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A file `-o` replaces keeps its permissions (the fitted program is written beside it and
+/// renamed over it).
+#[test]
+fn fit_keeps_the_permissions_of_the_file_it_replaces() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = temp("fit-mode");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (src, out) = (dir.join("in.nc"), dir.join("out.nc"));
+    std::fs::write(&src, helix(200)).unwrap();
+    std::fs::write(&out, "old\n").unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o640)).unwrap();
+    let r = on_paper_machine("fit", &src, &["-o", out.to_str().unwrap()]);
+    assert_eq!(
+        r.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&r.stderr)
+    );
+    let meta = std::fs::metadata(&out).unwrap();
+    assert_eq!(meta.permissions().mode() & 0o777, 0o640);
+    assert!(std::fs::read_to_string(&out).unwrap().contains("G06.5 P3"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -263,7 +263,8 @@ pub enum Command {
     /// paths on the machine, and their deviations are measured by dense sampling,
     /// independently of the fit; over the tolerances, nothing is written (OUT.nc is created
     /// only at the end, standard output only gets a checked program) and the exit code is 1.
-    /// A summary goes to standard error.
+    /// A file OUT.nc replaces keeps its permissions. SIGINT or SIGTERM stops the fit at the
+    /// next line with exit 4, and nothing is written. A summary goes to standard error.
     #[command(after_help = crate::exit::TABLE)]
     Fit {
         /// NC program with G01 moves (X Y Z with I J K, or with the machine's angles).

@@ -33,7 +33,8 @@ pub const TABLE: &str = "Exit codes (every subcommand):
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
   4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,
-     or before anything moved (a stop while `run` plans or sets up the drives)
+     or before anything moved (a stop while `run` plans or sets up the drives); `fit`
+     stopped before it wrote its output
   5  completed, with real-time overruns (missed deadlines: see the report)";
 
 /// How a command that ran ended.
@@ -122,6 +123,15 @@ pub struct StoppedBeforeMotion {
     pub stage: &'static str,
 }
 
+/// A stop requested (SIGINT, SIGTERM) while a command that moves nothing was under way and
+/// before it wrote its result (exit code 4): `fit`'s output is not written.
+#[derive(Debug, thiserror::Error)]
+#[error("stop requested (SIGINT/SIGTERM) while {doing}")]
+pub struct StoppedUnfinished {
+    /// What was under way and what it leaves: "fitting prog.nc: nothing written".
+    pub doing: String,
+}
+
 /// `file:line:col: message` per error, and a last line when the parse stopped early.
 fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
     let mut out: Vec<String> = e.errors.iter().map(|x| format!("{file}:{x}")).collect();
@@ -172,7 +182,9 @@ impl InputError {
 pub fn code_of(e: &anyhow::Error) -> u8 {
     if e.downcast_ref::<InputError>().is_some() {
         BAD_INPUT
-    } else if e.downcast_ref::<StoppedBeforeMotion>().is_some() {
+    } else if e.downcast_ref::<StoppedBeforeMotion>().is_some()
+        || e.downcast_ref::<StoppedUnfinished>().is_some()
+    {
         STOPPED_OPERATOR
     } else {
         FAILED

@@ -1,7 +1,7 @@
 //! `fit`: runs of G01 moves into G06.5 blocks ([`nc::fit`]), the result measured against
 //! the input before it is written.
 
-use crate::exit::{InputError, Outcome};
+use crate::exit::{InputError, Outcome, StoppedUnfinished};
 use crate::load_machine;
 use crate::setup::MachineSetup;
 use crate::shop::parse_setup;
@@ -11,8 +11,9 @@ use nc::fit::rewrite::rewrite;
 use nc::fit::runs::{Options, Summary};
 use nc::fit::Tolerance;
 use nc::parse::ReadLines;
-use std::io::Write;
+use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The command line's tolerances.
 #[derive(Clone, Copy, Debug)]
@@ -69,12 +70,23 @@ pub fn fit(
         Ok(m) if m.is_file() => None,
         _ => Some(std::fs::read(program).map_err(unreadable)?),
     };
+    // From here on SIGINT or SIGTERM stops the fit at the next line it reads and removes
+    // what it wrote (a pipe, read above, is left to the signal's default: a read that waits
+    // is not ended by a handler).
+    rt_loop::os::install_stop_handler()?;
+    let stop = rt_loop::os::stop_requested();
+    let stopped = || StoppedUnfinished {
+        doing: format!("fitting {file}: nothing written"),
+    };
     let open = || -> Result<Box<dyn std::io::BufRead + '_>, InputError> {
         Ok(match &piped {
-            Some(bytes) => Box::new(bytes.as_slice()),
-            None => Box::new(std::io::BufReader::with_capacity(
-                1 << 16,
-                std::fs::File::open(program).map_err(unreadable)?,
+            Some(bytes) => Box::new(Stoppable(bytes.as_slice(), stop)),
+            None => Box::new(Stoppable(
+                std::io::BufReader::with_capacity(
+                    1 << 16,
+                    std::fs::File::open(program).map_err(unreadable)?,
+                ),
+                stop,
             )),
         })
     };
@@ -90,14 +102,17 @@ pub fn fit(
         &anywhere,
     )
     .map_err(|error| match error {
+        _ if stop.load(Ordering::Relaxed) => anyhow::Error::new(stopped()),
         nc::prepass::Refused::Parse(errors) => InputError::Parse {
             file: file.clone(),
             errors,
-        },
+        }
+        .into(),
         error => InputError::Checked {
             file: file.clone(),
             error,
-        },
+        }
+        .into(),
     })?;
     let opts = Options {
         tol: Tolerance {
@@ -121,7 +136,10 @@ pub fn fit(
         step,
         writer,
     )
-    .map_err(|e| anyhow::anyhow!("{file}: {e}; nothing written"))?;
+    .map_err(|e| match stop.load(Ordering::Relaxed) {
+        true => anyhow::Error::new(stopped()),
+        false => anyhow::anyhow!("{file}: {e}; nothing written"),
+    })?;
     if done.lines != passed.lines {
         bail!(
             "{file}: the program changed while it was read ({} lines checked, {} fitted); \
@@ -155,8 +173,43 @@ pub fn fit(
             dev.point_deg_line
         );
     }
+    if stop.load(Ordering::Relaxed) {
+        return Err(stopped().into());
+    }
     partial.keep()?;
     Ok(Outcome::Completed)
+}
+
+/// The program's reader: once SIGINT or SIGTERM has asked for a stop, every read fails.
+struct Stoppable<R>(R, &'static AtomicBool);
+
+impl<R> Stoppable<R> {
+    fn go_on(&self) -> std::io::Result<()> {
+        if self.1.load(Ordering::Relaxed) {
+            // Not `Interrupted`, which the readers of lines retry.
+            Err(std::io::Error::other("stop requested"))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl<R: Read> Read for Stoppable<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        self.go_on()?;
+        self.0.read(buf)
+    }
+}
+
+impl<R: BufRead> BufRead for Stoppable<R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        self.go_on()?;
+        self.0.fill_buf()
+    }
+
+    fn consume(&mut self, n: usize) {
+        self.0.consume(n);
+    }
 }
 
 /// Where the checked output goes.
@@ -242,6 +295,10 @@ impl Partial {
         };
         match &self.dest {
             Dest::Replace(dest) => {
+                // A file replaced keeps its permissions (a new one gets the umask's).
+                if let Ok(m) = std::fs::metadata(dest) {
+                    std::fs::set_permissions(&self.path, m.permissions()).with_context(cannot)?;
+                }
                 std::fs::rename(&self.path, dest).with_context(cannot)?;
                 self.kept = true;
             }
