@@ -13,6 +13,7 @@
 //! samples.
 
 use crate::kinematics::MachineKinematics;
+use crate::nurbs::DoubleNurbs;
 use crate::segment::{Geometry, Path, Pose, Segment};
 use nalgebra::Vector3;
 
@@ -208,6 +209,51 @@ fn nearest_scan(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
     near(t, q, if t.p.len() == 1 { 0 } else { best.0 })
 }
 
+/// The parameter in `a..=b` where the cutter is nearest `q`, where its distance has one
+/// minimum there: the root of `g(u) = (C(u) - q) . C'(u)` where it changes sign in
+/// between, by Newton's steps kept inside the bracket (bisecting where a step would leave
+/// it), to 1e-12 of the interval; or the nearer end. (Where the distance has more than one
+/// minimum, the answer is still a point of the curve, never nearer than the nearest.)
+fn project(curve: &DoubleNurbs, a: f64, b: f64, q: &Vector3<f64>) -> f64 {
+    let g = |u: f64| {
+        let c = curve.cutter(u, 2);
+        let r = c.p - q;
+        (r.dot(&c.d1), c.d1.norm_squared() + r.dot(&c.d2), r.norm())
+    };
+    let (ga, _, da) = g(a);
+    let (gb, _, db) = g(b);
+    let end = if da <= db { a } else { b };
+    if b <= a || ga >= 0.0 || gb <= 0.0 {
+        return end;
+    }
+    let (mut lo, mut hi, mut u) = (a, b, 0.5 * (a + b));
+    let tol = 1e-12 * (b - a);
+    // Bisection alone would take 40 halvings to the tolerance; Newton's steps take a few.
+    for _ in 0..100 {
+        let (gu, dg, du) = g(u);
+        if gu < 0.0 {
+            lo = u;
+        } else if gu > 0.0 {
+            hi = u;
+        }
+        let newton = u - gu / dg;
+        let next = if dg > 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if gu == 0.0 || (next - u).abs() <= tol || hi - lo <= tol {
+            return if du <= da.min(db) { u } else { end };
+        }
+        u = next;
+    }
+    if (curve.cutter(u, 0).p - q).norm() <= da.min(db) {
+        u
+    } else {
+        end
+    }
+}
+
 /// The minimum of a unimodal `f` on lo..hi (golden-section search, to 1e-9 of the interval).
 fn golden(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
     const R: f64 = 0.618_033_988_749_894_8;
@@ -252,15 +298,15 @@ impl At {
     }
 }
 
-/// The nearest position to `q` of `seg` between `lo` and `hi` along it, and its distance:
-/// a golden-section search on the cutter's position alone (on a curve, in its parameter
-/// between those of `lo` and `hi`, which the arc length maps one to one).
+/// The nearest position to `q` of `seg` between `lo` and `hi` along it, and its distance,
+/// where the distance has one minimum there: on a curve, [`project`] in its parameter
+/// between those of `lo` and `hi` (which the arc length maps one to one); on a straight
+/// move, a golden-section search (a move of the rotary axes alone stands still).
 fn nearest_on(seg: &Segment, lo: f64, hi: f64, q: &Vector3<f64>) -> (f64, At) {
     match &seg.geometry {
         Geometry::Nurbs { curve, table } => {
-            let dist = |u: f64| (curve.cutter(u, 0).p - q).norm();
-            let u = golden(table.u_of_s(curve, lo), table.u_of_s(curve, hi), dist);
-            (dist(u), At::U(u))
+            let u = project(curve, table.u_of_s(curve, lo), table.u_of_s(curve, hi), q);
+            ((curve.cutter(u, 0).p - q).norm(), At::U(u))
         }
         Geometry::Line { .. } => {
             let dist = |s: f64| (point(seg, s) - q).norm();
@@ -423,6 +469,58 @@ mod tests {
                 prop_assert_eq!(nearest(&t, &q, from, reach), nearest_scan(&t, &q, from, reach));
             }
         }
+    }
+
+    /// Random cubic curves (weights 0.5..2), points off them at a random parameter and
+    /// offset, and parameter intervals around them: the projection is never farther than
+    /// the interval's ends, and where the distance has one minimum there it finds it at
+    /// least as closely as the golden-section search does.
+    #[test]
+    fn projection_is_as_near_as_the_golden_search() {
+        let nets = prop::collection::vec(
+            ((-5.0f64..5.0, -5.0f64..5.0, -5.0f64..5.0), 0.5f64..2.0),
+            4..9,
+        );
+        let cases = (
+            nets,
+            0.0f64..1.0,
+            1e-4f64..0.2,
+            (-1.0f64..1.0, -1.0f64..1.0),
+            0.0f64..0.5,
+        );
+        let mut runner = proptest::test_runner::TestRunner::new(ProptestConfig::with_cases(3000));
+        runner
+            .run(&cases, |(net, at, width, (x, y), off)| {
+                let n = net.len();
+                let ctrl: Vec<[f64; 3]> = net.iter().map(|((a, b, c), _)| [*a, *b, *c]).collect();
+                let w: Vec<f64> = net.iter().map(|(_, w)| *w).collect();
+                let mut knots = vec![0.0; 4];
+                knots.extend((1..n - 3).map(|k| k as f64 / (n - 3) as f64));
+                knots.extend([1.0; 4]);
+                let curve = DoubleNurbs::new(3, &ctrl, &[], &w, &knots).unwrap();
+                let c: Vector3<f64> = curve.cutter(at, 0).p;
+                let q: Vector3<f64> = c + Vector3::new(x, y, 0.3) * off;
+                let (a, b) = ((at - width).max(0.0), (at + width).min(1.0));
+                let dist = |u: f64| (curve.cutter(u, 0).p - q).norm();
+                let dp = dist(project(&curve, a, b, &q));
+                prop_assert!(dp <= dist(a).min(dist(b)), "projection {dp} beyond an end");
+                // Where the distance has one minimum (its derivative's sign, at 401 points,
+                // goes from - to + once at most), the projection finds it at least as
+                // closely as the golden-section search does.
+                let grows = |u: f64| {
+                    let c = curve.cutter(u, 1);
+                    (c.p - q).dot(&c.d1) > 0.0
+                };
+                let signs: Vec<bool> = (0..=400)
+                    .map(|k| grows(a + (b - a) * f64::from(k) / 400.0))
+                    .collect();
+                if signs.windows(2).all(|w| w[0] <= w[1]) {
+                    let dg = dist(golden(a, b, dist));
+                    prop_assert!(dp <= dg + 1e-9, "projection {dp} golden {dg}");
+                }
+                Ok(())
+            })
+            .unwrap();
     }
 
     #[test]
