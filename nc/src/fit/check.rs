@@ -3,7 +3,8 @@
 //! built into segments by the segment builder, and each piece (a stretch that no run
 //! crosses, so both sides start and end on the same programmed point) is measured by
 //! [`measure`]: the input's programmed points against the output path, the output's samples
-//! against the input path. Only one piece of each side is held at a time.
+//! against the input path, on a second thread while the rewrite goes on. Four pieces of
+//! each side are held at most: the one being built, two waiting, one being measured.
 
 use super::deviation::{measure, Deviation};
 use super::rewrite::RewriteError;
@@ -14,6 +15,8 @@ use crate::segment::{BuildError, BuildLimits, Builder, Path, Pose, Segment};
 use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::rc::Rc;
+use std::sync::mpsc::{sync_channel, SyncSender};
+use std::thread::JoinHandle;
 
 /// The written lines, as the output's parser reads them: each is parsed as soon as it is
 /// written (a line continued with a backslash, with the next), so the queue holds a line
@@ -54,8 +57,94 @@ pub(super) struct Check<'a> {
     out_blocks: usize,
     /// Where the next piece starts (the same programmed point on both sides).
     start: Option<(Pose, SrcPos)>,
+    measurer: Measurer,
+}
+
+/// The pieces' measurement, on a second thread while the rewrite reads, fits and builds
+/// on (at most two pieces wait for it), or here if no thread can be started; either way in
+/// the pieces' order, with the same result.
+enum Measurer {
+    Thread {
+        pieces: Option<SyncSender<(Path, Path)>>,
+        worker: Option<JoinHandle<Deviation>>,
+    },
+    Here(Sum),
+}
+
+/// The deviations of the pieces measured so far.
+#[derive(Default)]
+struct Sum {
+    dev: Deviation,
     pieces: usize,
-    pub dev: Deviation,
+}
+
+impl Sum {
+    fn add(&mut self, d: &Deviation) {
+        let dev = &mut self.dev;
+        if d.point_mm > dev.point_mm {
+            dev.point_mm = d.point_mm;
+            dev.point_mm_line = d.point_mm_line;
+        }
+        if d.point_deg > dev.point_deg {
+            dev.point_deg = d.point_deg;
+            dev.point_deg_line = d.point_deg_line;
+        }
+        dev.path_mm = dev.path_mm.max(d.path_mm);
+        // Each piece after the first starts on the point the last one ended on.
+        dev.points += d.points - usize::from(self.pieces > 0 && d.points > 0);
+        dev.samples += d.samples;
+        self.pieces += 1;
+    }
+}
+
+impl Measurer {
+    fn new(kin: MachineKinematics, step: f64) -> Self {
+        let (tx, rx) = sync_channel::<(Path, Path)>(2);
+        let spawned = std::thread::Builder::new()
+            .name("dnurbs-fit-check".into())
+            .spawn(move || {
+                let mut sum = Sum::default();
+                for (inp, out) in rx {
+                    sum.add(&measure(&inp, &out, &kin, step));
+                }
+                sum.dev
+            });
+        match spawned {
+            Ok(worker) => Measurer::Thread {
+                pieces: Some(tx),
+                worker: Some(worker),
+            },
+            Err(_) => Measurer::Here(Sum::default()),
+        }
+    }
+
+    fn measure(&mut self, inp: Path, out: Path, kin: &MachineKinematics, step: f64) {
+        match self {
+            Measurer::Thread { pieces, .. } => {
+                // The worker ends only when the sender is dropped, or by a panic, which
+                // `finish` passes on.
+                if let Some(tx) = pieces {
+                    let _ = tx.send((inp, out));
+                }
+            }
+            Measurer::Here(sum) => sum.add(&measure(&inp, &out, kin, step)),
+        }
+    }
+
+    /// Every piece measured: the largest deviations.
+    fn finish(&mut self) -> Deviation {
+        match self {
+            Measurer::Thread { pieces, worker } => {
+                drop(pieces.take());
+                match worker.take().map(JoinHandle::join) {
+                    Some(Ok(dev)) => dev,
+                    Some(Err(panic)) => std::panic::resume_unwind(panic),
+                    None => Deviation::default(),
+                }
+            }
+            Measurer::Here(sum) => sum.dev,
+        }
+    }
 }
 
 impl<'a> Check<'a> {
@@ -82,8 +171,7 @@ impl<'a> Check<'a> {
             out_segs: Vec::new(),
             out_blocks: 0,
             start: None,
-            pieces: 0,
-            dev: Deviation::default(),
+            measurer: Measurer::new(*kin, step),
         }
     }
 
@@ -163,35 +251,22 @@ impl<'a> Check<'a> {
             path(std::mem::replace(&mut self.in_segs, later)),
             path(std::mem::replace(&mut self.out_segs, out_later)),
         );
-        let d = measure(&inp, &out, self.kin, self.step);
-        self.merge(&d);
         self.start = inp
             .segments
             .last()
             .map(|s| (s.pose(s.length), s.src))
             .or(Some(start));
+        self.measurer.measure(inp, out, self.kin, self.step);
         Ok(())
     }
 
-    fn merge(&mut self, d: &Deviation) {
-        let dev = &mut self.dev;
-        if d.point_mm > dev.point_mm {
-            dev.point_mm = d.point_mm;
-            dev.point_mm_line = d.point_mm_line;
-        }
-        if d.point_deg > dev.point_deg {
-            dev.point_deg = d.point_deg;
-            dev.point_deg_line = d.point_deg_line;
-        }
-        dev.path_mm = dev.path_mm.max(d.path_mm);
-        // Each piece after the first starts on the point the last one ended on.
-        dev.points += d.points - usize::from(self.pieces > 0 && d.points > 0);
-        dev.samples += d.samples;
-        self.pieces += 1;
-    }
-
     /// The output is read to its end: it must hold `out_blocks` motion blocks, no more.
-    pub fn finish(&mut self, out_blocks: usize, in_blocks: usize) -> Result<(), RewriteError> {
+    /// The largest deviations of the whole program.
+    pub fn finish(
+        &mut self,
+        out_blocks: usize,
+        in_blocks: usize,
+    ) -> Result<Deviation, RewriteError> {
         self.piece(out_blocks, in_blocks)?;
         while let Some(entry) = self.output.next() {
             self.output_entry(entry.map_err(RewriteError::OutputParse)?)?;
@@ -202,6 +277,6 @@ impl<'a> Check<'a> {
                 read: self.out_blocks,
             });
         }
-        Ok(())
+        Ok(self.measurer.finish())
     }
 }

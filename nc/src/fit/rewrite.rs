@@ -366,11 +366,11 @@ pub fn rewrite<R: BufRead, W: Write>(
     sm.blocks_in = blocks;
     sm.blocks_out = blocks - sm.moves_fitted + sm.fitted_blocks;
     let expected = sm.blocks_out;
-    s.check.finish(expected, blocks)?;
+    let dev = s.check.finish(expected, blocks)?;
     s.out.flush()?;
     Ok(Rewritten {
         summary: s.summary.clone(),
-        dev: s.check.dev,
+        dev,
         fit_s: s.fit_s,
         lines: s.lines_read,
     })
