@@ -324,6 +324,20 @@ impl Drop for Partial {
     }
 }
 
+/// `x` to `digits` significant digits, without trailing zeros (0.005, 0.02516).
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return x.to_string();
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).clamp(0, 17) as usize;
+    let text = format!("{x:.decimals$}");
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        text
+    }
+}
+
 struct Report<'a> {
     file: &'a str,
     summary: &'a Summary,
@@ -367,7 +381,7 @@ impl Report<'_> {
             tc = self.tol.corner_deg,
             np = d.points,
             ns = d.samples,
-            st = self.step,
+            st = significant(self.step, 4),
             pm = d.point_mm,
             pml = d.point_mm_line,
             pd = d.point_deg,
@@ -405,5 +419,20 @@ impl Report<'_> {
             "sample_step": self.step,
             "fit_seconds": self.fit_s,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::significant;
+
+    #[test]
+    fn the_sample_step_is_printed_to_four_significant_digits() {
+        assert_eq!(significant(0.005, 4), "0.005");
+        assert_eq!(significant(0.025_161_491_283_480_79, 4), "0.02516");
+        assert_eq!(significant(0.25, 4), "0.25");
+        assert_eq!(significant(1.0 / 3.0, 4), "0.3333");
+        assert_eq!(significant(12.5, 4), "12.5");
+        assert_eq!(significant(0.0, 4), "0");
     }
 }
