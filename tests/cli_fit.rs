@@ -167,12 +167,12 @@ fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
     let err = String::from_utf8_lossy(&r.stderr).to_string();
     assert_eq!(r.status.code(), Some(0), "{err}");
     assert!(
-        err.contains("63 in, 59 fitted into 1 G06.5 blocks"),
+        err.contains("63 in, 60 fitted into 1 G06.5 blocks"),
         "{err}"
     );
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(
-        text.contains("K1 K1 K1 K1\nN0740 X55.426 Y32. Z-12. A25. C73.737\n"),
+        text.contains("K1 K1 K1 K1\nN0750 X56.643 Y32.355 Z-9.281 F2000. A25 C73.737\n"),
         "{text}"
     );
     let sim = on_posts_machine("simulate", &out, &[]);

@@ -200,9 +200,10 @@ fn in_angles(after: &str) -> String {
 }
 
 /// After a `G06.5` block the tool axis is modal as a vector: a block fitted to moves given
-/// in angles is followed by a line that gives both angles, the line after the run where it
-/// does, else the run's last move kept as written; so a move that gives one angle, or a
-/// `G28` under the tilted table, still reads as it did.
+/// in angles is followed by a line that gives both angles: the line after the run where it
+/// does, else, where that line is a move that leaves an angle modal, that move with the
+/// modal angle written out (else the run's last move, kept as written); so a move that
+/// gives one angle, or a `G28` under the tilted table, still reads as it did.
 #[test]
 fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
     let trt = MachineKinematics::Trt {
@@ -217,13 +218,32 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
     };
     let (_, bl) = small_mill(0.002);
     let opts = Options::default();
-    for (after, fitted) in [
+    for (after, fitted, written) in [
         // The next move gives both angles: the whole run is one block.
-        ("X19.9 Y2.5 Z6 A12 C20 F1000\n", 400),
-        // A move that gives C alone, a move with no angle, a G28 with A at 10 degrees: the
-        // run's last move stays as written.
-        ("X19.9 Y2.5 Z6 C20 F1000\n", 399),
-        ("X19.9 Y2.5 Z6 F1000\nG91 G28 Z0\nG90\n", 399),
+        (
+            "X19.9 Y2.5 Z6 A12 C20 F1000\n",
+            400,
+            "X19.9 Y2.5 Z6 A12 C20 F1000\n",
+        ),
+        // A move that gives C alone, or no angle (then a G28 with A at 10 degrees): the
+        // whole run is one block, and the move gives both angles.
+        (
+            "X19.9 Y2.5 Z6 C20 F1000\n",
+            400,
+            "X19.9 Y2.5 Z6 C20 F1000 A8.6029\n",
+        ),
+        (
+            "X19.9 Y2.5 Z6 F1000\nG91 G28 Z0\nG90\n",
+            400,
+            "X19.9 Y2.5 Z6 F1000 A8.6029 C59.9956\nG91 G28 Z0\n",
+        ),
+        // A line that is not a move, then a move with C alone: the run's last move stays
+        // as written (it gives both angles).
+        (
+            "(next)\nX19.9 Y2.5 Z6 C20 F1000\n",
+            399,
+            "Z5 A8.6029 C59.9956\n(next)\nX19.9 Y2.5 Z6 C20 F1000\n",
+        ),
     ] {
         let src = in_angles(after);
         let input = nc::parse::parse_with(&src, &setup).expect("input parses");
@@ -233,6 +253,7 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
             .unwrap_or_else(|e| panic!("{after}: {e}"));
         let text = String::from_utf8(out).unwrap();
         assert_eq!(text, whole.text, "{after}");
+        assert!(text.contains(written), "{after}: {text}");
         assert_eq!(
             done.summary.moves_fitted, fitted,
             "{after}: {:?}",
@@ -249,6 +270,82 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
         assert!(
             dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
             "{after}: {dev:?}"
+        );
+    }
+}
+
+/// A post that writes only the words that change (the tilt given once, `C` on every move,
+/// as Fanuc-style posts suppress modal words), on an A/C and a B/C table: each of the two
+/// runs (a 90-degree corner between them) becomes one block, the move after each is
+/// written with the tilt it left modal, and the result reads back within the tolerances.
+#[test]
+fn a_post_that_writes_only_the_changing_angle_is_fitted() {
+    use std::fmt::Write;
+    for (tilt, letter) in [(Tilt::A, 'A'), (Tilt::B, 'B')] {
+        let kin = MachineKinematics::Trt {
+            tilt,
+            tilt_point: Vector3::new(0.0, 0.0, -50.0),
+            c_point: Vector3::zeros(),
+        };
+        let setup = nc::parse::Setup {
+            reference: Some([0.0, 0.0, 300.0]),
+            kinematics: Some(kin),
+            ..nc::parse::Setup::default()
+        };
+        let mut src = format!("%\nG90 G21 G94\nG01 X0 Y0 Z5 {letter}15 C0 F2000\n");
+        for k in 1..=150 {
+            let x = f64::from(k) * 0.1;
+            let _ = writeln!(
+                src,
+                "X{x:.4} Y{:.4} C{:.3}",
+                0.2 * (x / 3.0).sin(),
+                0.05 * f64::from(k)
+            );
+        }
+        // The corner: the next run goes along Y, C turning back.
+        for k in 1..=150 {
+            let y = 0.2 * (15.0f64 / 3.0).sin() + f64::from(k) * 0.1;
+            let _ = writeln!(
+                src,
+                "Y{y:.4} X{:.4} C{:.3}",
+                15.0 + 0.2 * (y / 3.0).sin(),
+                7.5 - 0.05 * f64::from(k)
+            );
+        }
+        src.push_str("Y20 C0.5 F1000\nM30\n%\n");
+        let input = nc::parse::parse_with(&src, &setup).expect("input parses");
+        let opts = Options::default();
+        let whole = fit_program(&src, &input, &kin, &opts);
+        let (_, bl) = small_mill(0.002);
+        let mut out = Vec::new();
+        let done = rewrite(src.as_bytes(), &setup, &kin, &bl, &opts, 0.002, &mut out)
+            .unwrap_or_else(|e| panic!("{letter}: {e}"));
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(text, whole.text, "{letter}");
+        assert_eq!(
+            done.summary.fitted_blocks, 2,
+            "{letter}: {:?}\n{text}",
+            done.summary
+        );
+        assert_eq!(
+            done.summary.moves_fitted, 300,
+            "{letter}: {:?}",
+            done.summary
+        );
+        assert!(
+            text.contains(&format!("Y20 C0.5 F1000 {letter}15\n")),
+            "{text}"
+        );
+        let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
+        let (a, b) = (
+            build(&input, &kin, &bl).expect("input builds"),
+            build(&output, &kin, &bl).expect("output builds"),
+        );
+        let dev = measure(&a, &b, &kin, 0.002);
+        assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{letter}: {dev:?}");
+        assert!(
+            dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
+            "{letter}: {dev:?}"
         );
     }
 }

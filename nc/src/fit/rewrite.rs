@@ -17,7 +17,8 @@ use super::deviation::Deviation;
 use super::find::{find_open_runs, Found};
 use super::online::MAX_RUN;
 use super::runs::{
-    in_angles, n_word, pure_move_line, sets_angles, write_block, Modes, Options, Summary,
+    in_angles, n_word, pure_move_line, restorable, sets_angles, tilt_of, with_angles, write_block,
+    Modes, Options, Summary,
 };
 use crate::kinematics::MachineKinematics;
 use crate::parse::{Entries, Entry, LineSource, ParseError, ReadLines, Setup};
@@ -72,6 +73,8 @@ struct Held {
     /// `G90 G21 G94` in effect at its start, and the modal motion `G01` there.
     plain: bool,
     g01: bool,
+    /// The program's tilt letter so far.
+    tilt: Option<char>,
 }
 
 /// What the window knows of each of its blocks' lines.
@@ -101,6 +104,9 @@ struct State<'a, W> {
     fit_s: f64,
     /// An error met while reading a line (the parser's source cannot return it).
     error: Option<RewriteError>,
+    /// The line after a block fitted to moves in angles, when it is a move that leaves an
+    /// angle modal: its number and the line as it is written then.
+    restore: Option<(u32, String)>,
 }
 
 impl<W: Write> State<'_, W> {
@@ -125,6 +131,7 @@ impl<W: Write> State<'_, W> {
             ending,
             plain,
             g01,
+            tilt: self.modes.tilt,
         });
         Ok(())
     }
@@ -195,6 +202,9 @@ impl<W: Write> State<'_, W> {
                         || held_line(after)
                             .or(next.filter(|n| n.0 == after).map(|n| n.1))
                             .is_some_and(sets_angles)
+                        || (k + 1 < blocks.len()
+                            && lines[k + 1].no == after
+                            && restorable(blocks.get(k + 1), lines[k + 1].plain))
                 },
             );
             self.fit_s += t0.elapsed().as_secs_f64();
@@ -219,7 +229,7 @@ impl<W: Write> State<'_, W> {
                 break;
             }
             if let Some(h) = self.pop_held() {
-                self.emit(&h.text, h.ending)?;
+                self.emit_held(&h)?;
             }
         }
         // Input blocks up to the one kept first are decided (`blocks` counts every block
@@ -244,7 +254,7 @@ impl<W: Write> State<'_, W> {
                 break;
             }
             if let Some(h) = self.pop_held() {
-                self.emit(&h.text, h.ending)?;
+                self.emit_held(&h)?;
             }
         }
         let (mut n, mut eol) = (None, "\n");
@@ -262,12 +272,41 @@ impl<W: Write> State<'_, W> {
             let body = line.trim_end_matches('\n').trim_end_matches('\r');
             self.emit(body, &line[body.len()..])?;
         }
+        // A move after it that leaves an angle modal is written with both.
+        let k = f.blocks.1;
+        let blocks = &self.window.blocks;
+        let after = self
+            .held
+            .front()
+            .filter(|h| Some(h.no) == l1.checked_add(1));
+        self.restore = after
+            .filter(|h| {
+                in_angles(&blocks[k])
+                    && !sets_angles(&h.text)
+                    && self.lines.get(k + 1).is_some_and(|l| l.no == h.no)
+                    && restorable(blocks.get(k + 1), self.lines[k + 1].plain)
+            })
+            .map(|h| {
+                let tilt = tilt_of(h.tilt, self.kin);
+                (h.no, with_angles(&h.text, &blocks[k + 1], tilt))
+            });
         let s = &mut self.summary;
         s.fitted_blocks += 1;
         s.moves_fitted += f.blocks.1 + 1 - f.blocks.0;
         s.fit_mm = s.fit_mm.max(fitted.dev_mm);
         s.fit_deg = s.fit_deg.max(fitted.dev_rad.to_degrees());
         Ok(())
+    }
+
+    /// A held line, as it was or with both angles ([`Self::restore`]).
+    fn emit_held(&mut self, h: &Held) -> Result<(), RewriteError> {
+        match self.restore.take() {
+            Some((no, text)) if no == h.no => self.emit(&text, h.ending),
+            other => {
+                self.restore = other;
+                self.emit(&h.text, h.ending)
+            }
+        }
     }
 
     fn pop_held(&mut self) -> Option<Held> {
@@ -339,6 +378,7 @@ pub fn rewrite<R: BufRead, W: Write>(
         check: Check::new(kin, limits, setup, step),
         fit_s: 0.0,
         error: None,
+        restore: None,
     }));
     let recorder = Recorder {
         lines: ReadLines::new(input),

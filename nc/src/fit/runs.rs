@@ -92,9 +92,14 @@ pub struct FitOutput {
 /// and `G94` all in effect), and whether the modal motion is `G01` (a run that begins where
 /// it is not, with a `G01` word of its own, would leave the motion mode changed once that
 /// word is gone).
-fn modes(src: &str) -> Vec<(bool, bool)> {
+fn modes(src: &str) -> Vec<(bool, bool, Option<char>)> {
     let mut modes = Modes::default();
-    src.split('\n').map(|line| modes.line(line)).collect()
+    src.split('\n')
+        .map(|line| {
+            let (plain, g01) = modes.line(line);
+            (plain, g01, modes.tilt)
+        })
+        .collect()
 }
 
 /// The modes [`modes`] follows, a line at a time.
@@ -104,6 +109,8 @@ pub(super) struct Modes {
     mm: bool,
     per_min: bool,
     motion: u32,
+    /// The letter of the program's first tilt word (`A` or `B`; the parser allows one).
+    pub(super) tilt: Option<char>,
 }
 
 impl Default for Modes {
@@ -113,6 +120,7 @@ impl Default for Modes {
             mm: true,
             per_min: true,
             motion: 0,
+            tilt: None,
         }
     }
 }
@@ -121,7 +129,11 @@ impl Modes {
     /// The modes at the start of `line` (plain modes, modal `G01`); then its G codes apply.
     pub(super) fn line(&mut self, line: &str) -> (bool, bool) {
         let at_start = (self.abs && self.mm && self.per_min, self.motion == 10);
-        for g in g_codes(&strip_comments(line)) {
+        let code = strip_comments(line);
+        if self.tilt.is_none() {
+            self.tilt = tilt_letter(&code);
+        }
+        for g in g_codes(&code) {
             match g {
                 0 | 10 | 20 | 30 => self.motion = g,
                 900 => self.abs = true,
@@ -151,6 +163,26 @@ fn g_codes(code: &str) -> impl Iterator<Item = u32> + '_ {
             let tenths = (x * 10.0).round();
             ((tenths - x * 10.0).abs() < 1e-6 && tenths < 10_000.0).then_some(tenths as u32)
         })
+}
+
+/// The letter of the first `A` or `B` word in `code`.
+fn tilt_letter(code: &str) -> Option<char> {
+    let mut chars = code.chars().peekable();
+    while let Some(c) = chars.next() {
+        let letter = c.to_ascii_uppercase();
+        if letter == 'A' || letter == 'B' {
+            while chars.peek() == Some(&' ') {
+                chars.next();
+            }
+            if chars
+                .peek()
+                .is_some_and(|n| n.is_ascii_digit() || "+-.".contains(*n))
+            {
+                return Some(letter);
+            }
+        }
+    }
+    None
 }
 
 fn strip_comments(line: &str) -> String {
@@ -220,6 +252,47 @@ pub(super) fn sets_angles(line: &str) -> bool {
     code.contains('C') && (code.contains('A') || code.contains('B'))
 }
 
+/// A block fitted to moves in angles may end before block `next` (on line `next_line`)
+/// without a line that gives both angles after it when `next` is a move in angles on a
+/// plain line of its own: kept, it is written with both angles ([`with_angles`]).
+pub(super) fn restorable(next: Option<&Block>, plain: bool) -> bool {
+    plain && next.is_some_and(in_angles)
+}
+
+/// `line` (a plain move, without its ending) with the angle words it leaves modal written
+/// out, from the values its block resolved: after a `G06.5` block the tool axis is modal
+/// as a vector, so a move there must give both angles. `tilt`: the program's tilt letter.
+pub(super) fn with_angles(line: &str, block: &Block, tilt: char) -> String {
+    let Block::Linear(m) = block else {
+        return line.to_owned();
+    };
+    let Orientation::Angles { r1_deg, r2_deg } = m.orientation else {
+        return line.to_owned();
+    };
+    let code = strip_comments(line).to_ascii_uppercase();
+    let (body, cr) = match line.strip_suffix('\r') {
+        Some(body) => (body, "\r"),
+        None => (line, ""),
+    };
+    let mut out = body.trim_end().to_owned();
+    if tilt_letter(&code).is_none() {
+        let _ = write!(out, " {tilt}{r1_deg}");
+    }
+    if !code.contains('C') {
+        let _ = write!(out, " C{r2_deg}");
+    }
+    out.push_str(cr);
+    out
+}
+
+/// The tilt letter to write: the program's, else the machine's.
+pub(super) fn tilt_of(program: Option<char>, kin: &MachineKinematics) -> char {
+    program.unwrap_or(match kin.tilt_kind() {
+        crate::kinematics::Tilt::A => 'A',
+        crate::kinematics::Tilt::B => 'B',
+    })
+}
+
 /// Fit every run of `program` (parsed from `src` without work offsets).
 pub fn fit_program(
     src: &str,
@@ -245,7 +318,11 @@ pub fn fit_program(
         |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
         // The line after block k (the next move of the run, or the line after it).
         |k, _| {
-            !in_angles(&program.blocks[k]) || lines.get(line_of(k)).is_some_and(|t| sets_angles(t))
+            !in_angles(&program.blocks[k])
+                || lines.get(line_of(k)).is_some_and(|t| sets_angles(t))
+                || (k + 1 < program.blocks.len()
+                    && line_of(k + 1) == line_of(k) + 1
+                    && restorable(program.blocks.get(k + 1), plain_line(k + 1)))
         },
     );
     let mut summary = Summary {
@@ -263,14 +340,21 @@ pub fn fit_program(
         .collect();
     let mut text = String::with_capacity(src.len() / 2);
     let mut next = 0;
+    // The line after a block fitted to moves in angles, when it is a move that leaves an
+    // angle modal: its index and the line as written then.
+    let mut restore: Option<(usize, String)> = None;
+    let line_at = |i: usize, restore: &Option<(usize, String)>| match restore {
+        Some((r, written)) if *r == i => written.clone(),
+        _ => lines[i].to_owned(),
+    };
     for run in &runs {
         let Some(f) = &run.found.fitted else {
             summary.runs_kept += 1;
             continue;
         };
         let (l0, l1) = (run.lines.0 as usize, run.lines.1 as usize);
-        for l in &lines[next..l0 - 1] {
-            text.push_str(l);
+        for i in next..l0 - 1 {
+            text.push_str(&line_at(i, &restore));
             text.push('\n');
         }
         let n_word = n_word(lines[l0 - 1]);
@@ -282,15 +366,25 @@ pub fn fit_program(
         };
         write_block(&mut text, f, run.found.feed_mm_min, n_word.as_deref(), eol);
         next = l1;
+        let k = run.found.blocks.1;
+        restore = (in_angles(&program.blocks[k])
+            && !lines.get(l1).is_some_and(|t| sets_angles(t))
+            && k + 1 < program.blocks.len()
+            && line_of(k + 1) == l1 + 1
+            && restorable(program.blocks.get(k + 1), plain_line(k + 1)))
+        .then(|| {
+            let tilt = tilt_of(modes.get(l1).and_then(|m| m.2), kin);
+            (l1, with_angles(lines[l1], &program.blocks[k + 1], tilt))
+        });
         summary.fitted_blocks += 1;
         summary.moves_fitted += l1 + 1 - l0;
         summary.fit_mm = summary.fit_mm.max(f.dev_mm);
         summary.fit_deg = summary.fit_deg.max(f.dev_rad.to_degrees());
     }
-    let rest = &lines[next.min(lines.len())..];
-    for (i, l) in rest.iter().enumerate() {
-        text.push_str(l);
-        if i + 1 < rest.len() {
+    let from = next.min(lines.len());
+    for i in from..lines.len() {
+        text.push_str(&line_at(i, &restore));
+        if i + 1 < lines.len() {
             text.push('\n');
         }
     }
