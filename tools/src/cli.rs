@@ -254,8 +254,9 @@ pub enum Command {
     /// curve on one knot vector, weights 1, with every programmed point within --tol-mm of
     /// the cutter curve and every programmed tool axis within --tol-deg of the interpolated
     /// one. Every other line passes through as it was. A run given in machine angles is
-    /// followed by a line that gives both angles (its last move is kept as written if the
-    /// line after it does not), so the angles stay modal as in the program.
+    /// followed by a line that gives both angles, so the angles stay modal as in the
+    /// program: a move after it that leaves one modal is written with it (`X1 C5` becomes
+    /// `X1 C5 A15`), else the run's last move is kept as written.
     ///
     /// The program is read as a stream, in the memory of a few thousand moves whatever its
     /// length (a run longer than 5 000 moves becomes several blocks that join on programmed

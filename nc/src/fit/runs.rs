@@ -11,9 +11,11 @@
 //!
 //! The modes after a block are those after its moves: a run begins where the modal motion
 //! is already `G01`; a block fitted to moves given in machine angles is followed by a line
-//! that gives both angles, the line after the run or else a move of its own kept as
-//! written (after a `G06.5` block the tool axis is modal as a vector, and a move that
-//! gives one angle, or a `G28` with the table tilted, would be refused). Work offsets are left out of the parse (the program's own numbers
+//! that gives both angles (after a `G06.5` block the tool axis is modal as a vector, and a
+//! move that gives one angle, or a `G28` with the table tilted, would be refused): the
+//! line after the run; or, where that line is a move of its own that leaves an angle
+//! modal, that move with the angle written out ([`with_angles`]); or else a move of the
+//! run kept as written. Work offsets are left out of the parse (the program's own numbers
 //! are written back, and the offsets apply to them at run time as they did to the moves).
 
 use super::find::{find_runs, moves_in, Found};
@@ -245,16 +247,16 @@ pub(super) fn in_angles(b: &Block) -> bool {
 /// Whether a line gives both machine angles (its tilt and its `C`). After a `G06.5` block
 /// the tool axis is modal as a vector, and a move that gives one angle alone, or a `G28`
 /// with the table tilted, is refused; so a block fitted to moves given in angles must be
-/// followed by a line that gives both (the run's next move, kept as written, or the line
-/// after the run).
+/// followed by a line that gives both (the line after the run, a move after it written
+/// with both, or the run's next move, kept as written).
 pub(super) fn sets_angles(line: &str) -> bool {
     let code = strip_comments(line).to_ascii_uppercase();
     code.contains('C') && (code.contains('A') || code.contains('B'))
 }
 
-/// A block fitted to moves in angles may end before block `next` (on line `next_line`)
-/// without a line that gives both angles after it when `next` is a move in angles on a
-/// plain line of its own: kept, it is written with both angles ([`with_angles`]).
+/// A block fitted to moves in angles may end before block `next` without a line that
+/// gives both angles after it when `next` is a move in angles on a `plain` line of its
+/// own (a pure move in plain modes): kept, it is written with both ([`with_angles`]).
 pub(super) fn restorable(next: Option<&Block>, plain: bool) -> bool {
     plain && next.is_some_and(in_angles)
 }
