@@ -350,6 +350,74 @@ fn a_post_that_writes_only_the_changing_angle_is_fitted() {
     }
 }
 
+/// A 5-axis pass in inverse time, as a post writes `G93` (each move's F is 1/minutes for
+/// its own length, rounded to 0.1, the tool's speed within 0.8 % of 900 mm/min): it is
+/// fitted into one block written in `G94` at the run's length over its time, `G93` back
+/// after it, and the programmed time of the whole program stays what it was.
+#[test]
+fn a_run_in_inverse_time_keeps_its_time() {
+    use std::fmt::Write;
+    let kin = MachineKinematics::Trt {
+        tilt: Tilt::A,
+        tilt_point: Vector3::new(0.0, 0.0, -50.0),
+        c_point: Vector3::zeros(),
+    };
+    let setup = nc::parse::Setup {
+        reference: Some([0.0, 0.0, 300.0]),
+        kinematics: Some(kin),
+        ..nc::parse::Setup::default()
+    };
+    let mut src = String::from("%\nG90 G21 G94\nG01 X20 Y0 Z5 A10 C0 F900\nG93\n");
+    let mut prev = (20.0f64, 0.0f64);
+    for k in 1..=300 {
+        let t = f64::from(k) * 0.015;
+        let (x, y) = (20.0 * t.cos(), 20.0 * t.sin());
+        let (x, y) = ((x * 1e3).round() / 1e3, (y * 1e3).round() / 1e3);
+        let len = (x - prev.0).hypot(y - prev.1);
+        prev = (x, y);
+        // The speed wanders within 0.8 % (the spread a run may have), below and above 900.
+        let speed = 900.0 * (1.0 - 0.004 * (f64::from(k) * 0.7).cos());
+        let f = (speed / len * 10.0).round() / 10.0;
+        let (a, c) = (10.0 + 5.0 * (2.0 * t).sin(), t.to_degrees());
+        let _ = writeln!(src, "G01 X{x:.3} Y{y:.3} Z5 A{a:.3} C{c:.3} F{f:.1}");
+    }
+    src.push_str("G94\nG00 Z50\nM30\n%\n");
+    let input = nc::parse::parse_with(&src, &setup).expect("input parses");
+    let opts = Options::default();
+    let whole = fit_program(&src, &input, &kin, &opts);
+    let (_, bl) = small_mill(0.002);
+    let mut out = Vec::new();
+    let done = rewrite(src.as_bytes(), &setup, &kin, &bl, &opts, 0.002, &mut out)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(text, whole.text);
+    assert_eq!(done.summary.fitted_blocks, 1, "{:?}\n{text}", done.summary);
+    assert!(done.summary.moves_fitted >= 297, "{:?}", done.summary);
+    assert!(text.contains("G93\nG94 G06.5 P3 X20 Y0 Z5 "), "{text}");
+    assert!(text.contains("K1 K1 K1 K1\nG93\n"), "{text}");
+    let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
+    let (a, b) = (
+        build(&input, &kin, &bl).expect("input builds"),
+        build(&output, &kin, &bl).expect("output builds"),
+    );
+    let dev = measure(&a, &b, &kin, 0.002);
+    assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{dev:?}");
+    assert!(
+        dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
+        "{dev:?}"
+    );
+    // The programmed time (feed moves at their feed) is the same to 1e-4.
+    let time = |p: &nc::segment::Path| -> f64 {
+        p.segments
+            .iter()
+            .filter(|s| !s.rapid)
+            .map(|s| s.length / s.feed)
+            .sum()
+    };
+    let (ta, tb) = (time(&a), time(&b));
+    assert!((ta - tb).abs() < 1e-4 * ta, "{ta} s posted, {tb} s fitted");
+}
+
 /// A finishing raster as `tests/data/fit/raster.py` writes it (rows of 0.1 mm moves over a
 /// wavy surface, step-overs of 10 moves, 90-degree corners), `rows` rows of `steps` moves.
 fn raster(rows: usize, steps: usize) -> String {

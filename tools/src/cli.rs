@@ -249,8 +249,10 @@ pub enum Command {
     /// Fit runs of G01 moves into G06.5 double-NURBS blocks (the paper's section 4).
     ///
     /// Each run of G01 moves (consecutive lines holding only the move, one feed, absolute
-    /// millimetres per minute, no corner above --corner-deg, each move turning the tool by at
-    /// most 10 degrees) becomes one G06.5 block: a cubic cutter curve and an orientation
+    /// millimetres, feed per minute or in inverse time (G93: the moves' speeds within 1 %;
+    /// the block is written in G94 at the run's length over its time, G93 after it), no
+    /// corner above --corner-deg, each move turning the tool by at most 10 degrees) becomes
+    /// one G06.5 block: a cubic cutter curve and an orientation
     /// curve on one knot vector, weights 1, with every programmed point within --tol-mm of
     /// the cutter curve and every programmed tool axis within --tol-deg of the interpolated
     /// one. Every other line passes through as it was. A run given in machine angles is

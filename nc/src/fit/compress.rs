@@ -49,6 +49,7 @@ pub fn compress(
         |_| true,
         |k| !word_before[k],
         |_, _| true,
+        |_| false,
     );
     let mut out = Compressed {
         moves_in: moves_in(program),

@@ -4,7 +4,8 @@
 //!
 //! Blocks b..=e form a run when each is a feed move (`G01`, not rapid) that follows a
 //! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`], has the
-//! run's feed and tool length and no wait before it (but the first), and no two of them
+//! run's feed (within [`INVERSE_FEED_SPREAD`] under `G93`) and tool length and no wait
+//! before it (but the first), and no two of them
 //! meet at a corner sharper than the corner angle; the caller adds its own conditions for
 //! a run's first move and for each move that joins it.
 
@@ -19,6 +20,11 @@ use nalgebra::Vector3;
 /// revolution, which leaves the axis where it was, is never fitted away).
 pub const MAX_TURN_DEG: f64 = 10.0;
 
+/// How far the feeds (mm/min) of a run's moves under `G93` may spread, relative to its
+/// first's: a post writes each move's 1/minutes for its own rounded length, so a constant
+/// speed of the tool comes out a little different on every move.
+pub const INVERSE_FEED_SPREAD: f64 = 0.01;
+
 /// A run and its fit.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Found {
@@ -28,8 +34,11 @@ pub struct Found {
     pub reach: usize,
     /// The programmed points: where the run starts, then each move's end.
     pub points: Vec<Point>,
-    /// Programmed feed, mm/min.
+    /// Programmed feed, mm/min: for a run under `G93`, its length over its time.
     pub feed_mm_min: f64,
+    /// The run was programmed in inverse time (`G93`); its time, minutes, is the sum of
+    /// its moves'.
+    pub inverse_minutes: Option<f64>,
     /// The fitted curve, or `None` when no curve meets the tolerances.
     pub fitted: Option<Fitted>,
 }
@@ -93,7 +102,9 @@ pub fn is_corner(a: &LinearMove, m: &LinearMove, c: &LinearMove, corner_deg: f64
 /// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
 /// run; `may_join(k)`: block k may follow block k - 1 in one; `may_end(k, e)`: a fitted
 /// block may end at block k of a run that could go on to block e (the run is cut back to
-/// the last such block, and the moves after it stay as they are).
+/// the last such block, and the moves after it stay as they are); `inverse(k)`: block k's
+/// feed was programmed in inverse time (`G93`), so the run's feeds may spread by
+/// [`INVERSE_FEED_SPREAD`].
 pub fn find_runs(
     program: &Program,
     kin: &MachineKinematics,
@@ -101,8 +112,9 @@ pub fn find_runs(
     may_start: impl Fn(usize) -> bool,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
+    inverse: impl Fn(usize) -> bool,
 ) -> Vec<Found> {
-    find_open_runs(program, kin, opts, may_start, may_join, may_end).0
+    find_open_runs(program, kin, opts, may_start, may_join, may_end, inverse).0
 }
 
 /// [`find_runs`], and the first block of the run that reaches the program's last block,
@@ -115,6 +127,7 @@ pub fn find_open_runs(
     may_start: impl Fn(usize) -> bool,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
+    inverse: impl Fn(usize) -> bool,
 ) -> (Vec<Found>, Option<usize>) {
     let linear = |b: usize| match program.blocks.get(b) {
         Some(Block::Linear(m)) => Some(m),
@@ -132,7 +145,17 @@ pub fn find_open_runs(
         };
         is_corner(a, m, c, opts.corner_deg)
     };
-    let key = run_key;
+    // A move joins a run at its feed (within the spread under G93), tool length and mode.
+    let same = |b: usize, first: &LinearMove, k: usize, m: &LinearMove| {
+        let feed = if inverse(b) {
+            inverse(k)
+                && (m.feed_mm_min - first.feed_mm_min).abs()
+                    <= INVERSE_FEED_SPREAD * first.feed_mm_min
+        } else {
+            !inverse(k) && m.feed_mm_min == first.feed_mm_min
+        };
+        feed && run_key(m).1 == run_key(first).1 && run_key(m).2 == run_key(first).2
+    };
     let mut runs = Vec::new();
     let mut open = None;
     let mut b = 1;
@@ -145,7 +168,7 @@ pub fn find_open_runs(
         while e + 1 < program.blocks.len()
             && eligible(e + 1)
             && may_join(e + 1)
-            && linear(e + 1).is_some_and(|m| key(m) == key(first) && !m.tooling.wait.is_some())
+            && linear(e + 1).is_some_and(|m| same(b, first, e + 1, m) && !m.tooling.wait.is_some())
             && !corner(e)
         {
             e += 1;
@@ -161,12 +184,23 @@ pub fn find_open_runs(
             let points: Vec<Point> = (b - 1..=end)
                 .filter_map(|k| linear(k).map(|m| point(m, kin)))
                 .collect();
+            // Under G93 each move took its length over its feed (the parser's own measure).
+            let inverse_minutes = inverse(b).then(|| {
+                (b..=end)
+                    .zip(points.windows(2))
+                    .filter_map(|(k, w)| {
+                        linear(k).map(|m| (w[1].p - w[0].p).norm() / m.feed_mm_min)
+                    })
+                    .sum::<f64>()
+            });
+            let length: f64 = points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
             runs.push(Found {
                 blocks: (b, end),
                 reach: e,
                 fitted: fit(&points, opts.tol, opts.degree),
                 points,
-                feed_mm_min: first.feed_mm_min,
+                feed_mm_min: inverse_minutes.map_or(first.feed_mm_min, |t| length / t),
+                inverse_minutes,
             });
         }
         b = e + 1;

@@ -73,6 +73,8 @@ struct Held {
     /// `G90 G21 G94` in effect at its start, and the modal motion `G01` there.
     plain: bool,
     g01: bool,
+    /// `G93` in effect: its feed is inverse time.
+    inverse: bool,
     /// The program's tilt letter so far.
     tilt: Option<char>,
 }
@@ -83,6 +85,7 @@ struct Line {
     no: u32,
     plain: bool,
     g01: bool,
+    inverse: bool,
 }
 
 struct State<'a, W> {
@@ -112,7 +115,7 @@ struct State<'a, W> {
 impl<W: Write> State<'_, W> {
     /// A line is read (before its block is parsed).
     fn on_line(&mut self, no: u32, text: &str, ending: &'static str) -> Result<(), RewriteError> {
-        let (plain, g01) = self.modes.line(text);
+        let at = self.modes.line(text);
         self.summary.bytes_in += text.len() + ending.len();
         self.lines_read = no;
         if !pure_move_line(text) {
@@ -129,8 +132,9 @@ impl<W: Write> State<'_, W> {
             no,
             text: text.to_owned(),
             ending,
-            plain,
-            g01,
+            plain: at.plain,
+            g01: at.g01,
+            inverse: at.inverse,
             tilt: self.modes.tilt,
         });
         Ok(())
@@ -139,12 +143,12 @@ impl<W: Write> State<'_, W> {
     /// Input block `i` is read.
     fn on_block(&mut self, i: usize, block: Block) -> Result<(), RewriteError> {
         let no = block.pos().line;
-        let (plain, g01) = self
+        let (plain, g01, inverse) = self
             .held
             .iter()
             .rev()
             .find(|h| h.no == no)
-            .map_or((false, false), |h| (h.plain, h.g01));
+            .map_or((false, false, false), |h| (h.plain, h.g01, h.inverse));
         let joins = matches!(block, Block::Linear(_))
             && plain
             && self
@@ -161,7 +165,12 @@ impl<W: Write> State<'_, W> {
         self.blocks += 1;
         self.check.block(i, &block).map_err(RewriteError::Build)?;
         self.window.blocks.push(block);
-        self.lines.push(Line { no, plain, g01 });
+        self.lines.push(Line {
+            no,
+            plain,
+            g01,
+            inverse,
+        });
         Ok(())
     }
 
@@ -206,6 +215,7 @@ impl<W: Write> State<'_, W> {
                             && lines[k + 1].no == after
                             && restorable(blocks.get(k + 1), lines[k + 1].plain))
                 },
+                |k| lines[k].inverse,
             );
             self.fit_s += t0.elapsed().as_secs_f64();
             // A window cut for its size keeps the run that reaches its end (it is fitted
@@ -267,7 +277,7 @@ impl<W: Write> State<'_, W> {
             }
         }
         let mut text = String::new();
-        write_block(&mut text, fitted, f.feed_mm_min, n.as_deref(), eol);
+        write_block(&mut text, fitted, f, n.as_deref(), eol);
         for line in text.split_inclusive('\n') {
             let body = line.trim_end_matches('\n').trim_end_matches('\r');
             self.emit(body, &line[body.len()..])?;

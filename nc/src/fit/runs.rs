@@ -3,9 +3,11 @@
 //!
 //! A run is a sequence of `G01` moves on consecutive lines that hold nothing else (no
 //! comment, no other word), all at one feed and tool length, in absolute millimetres with
-//! a feed per minute (`G90 G21 G94`), each moving the cutter and turning the tool by at
-//! most [`super::find::MAX_TURN_DEG`], with no corner sharper than the corner angle
-//! between two moves. It starts where the move before it ends (that move must be a
+//! a feed per minute (`G90 G21 G94`) or in inverse time (`G93`: the moves' speeds within
+//! [`super::find::INVERSE_FEED_SPREAD`]; the block is written in `G94` at the run's length
+//! over its time, and `G93` is restored on a line after it), each moving the cutter and
+//! turning the tool by at most [`super::find::MAX_TURN_DEG`], with no corner sharper than
+//! the corner angle between two moves. It starts where the move before it ends (that move must be a
 //! `G00`/`G01`). Every other line is written as it was; so is a run the fit cannot bring
 //! within the tolerances (it is counted).
 //!
@@ -91,17 +93,28 @@ pub struct FitOutput {
 }
 
 /// Modal state at the start of each line: whether a run may be written there (`G90`, `G21`
-/// and `G94` all in effect), and whether the modal motion is `G01` (a run that begins where
-/// it is not, with a `G01` word of its own, would leave the motion mode changed once that
-/// word is gone).
-fn modes(src: &str) -> Vec<(bool, bool, Option<char>)> {
+/// and `G94` or `G93` in effect), whether the modal motion is `G01` (a run that begins
+/// where it is not, with a `G01` word of its own, would leave the motion mode changed once
+/// that word is gone), whether feeds are inverse time, and the program's tilt letter.
+fn modes(src: &str) -> Vec<(LineModes, Option<char>)> {
     let mut modes = Modes::default();
     src.split('\n')
         .map(|line| {
-            let (plain, g01) = modes.line(line);
-            (plain, g01, modes.tilt)
+            let at = modes.line(line);
+            (at, modes.tilt)
         })
         .collect()
+}
+
+/// The modes in effect at the start of a line.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LineModes {
+    /// `G90`, `G21`, and `G94` or `G93`: a run may be written there.
+    pub plain: bool,
+    /// The modal motion is `G01`.
+    pub g01: bool,
+    /// `G93`: its moves' feeds are inverse time.
+    pub inverse: bool,
 }
 
 /// The modes [`modes`] follows, a line at a time.
@@ -109,7 +122,8 @@ fn modes(src: &str) -> Vec<(bool, bool, Option<char>)> {
 pub(super) struct Modes {
     abs: bool,
     mm: bool,
-    per_min: bool,
+    /// The feed mode, in tenths: 940 (`G94`, per minute), 930 (`G93`, inverse time), 950.
+    feed: u32,
     motion: u32,
     /// The letter of the program's first tilt word (`A` or `B`; the parser allows one).
     pub(super) tilt: Option<char>,
@@ -120,7 +134,7 @@ impl Default for Modes {
         Modes {
             abs: true,
             mm: true,
-            per_min: true,
+            feed: 940,
             motion: 0,
             tilt: None,
         }
@@ -128,9 +142,13 @@ impl Default for Modes {
 }
 
 impl Modes {
-    /// The modes at the start of `line` (plain modes, modal `G01`); then its G codes apply.
-    pub(super) fn line(&mut self, line: &str) -> (bool, bool) {
-        let at_start = (self.abs && self.mm && self.per_min, self.motion == 10);
+    /// The modes at the start of `line`; then its G codes apply.
+    pub(super) fn line(&mut self, line: &str) -> LineModes {
+        let at_start = LineModes {
+            plain: self.abs && self.mm && (self.feed == 940 || self.feed == 930),
+            g01: self.motion == 10,
+            inverse: self.feed == 930,
+        };
         let code = strip_comments(line);
         if self.tilt.is_none() {
             self.tilt = tilt_letter(&code);
@@ -142,8 +160,7 @@ impl Modes {
                 910 => self.abs = false,
                 210 => self.mm = true,
                 200 => self.mm = false,
-                940 => self.per_min = true,
-                930 | 950 => self.per_min = false,
+                930 | 940 | 950 => self.feed = g,
                 _ => {}
             }
         }
@@ -310,13 +327,15 @@ pub fn fit_program(
         let l = line_of(b);
         l >= 1
             && lines.get(l - 1).is_some_and(|t| pure_move_line(t))
-            && modes.get(l - 1).is_some_and(|m| m.0)
+            && modes.get(l - 1).is_some_and(|m| m.0.plain)
     };
+    let inverse =
+        |b: usize| line_of(b) >= 1 && modes.get(line_of(b) - 1).is_some_and(|m| m.0.inverse);
     let found = find_runs(
         program,
         kin,
         opts,
-        |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.1),
+        |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.0.g01),
         |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
         // The line after block k (the next move of the run, or the line after it).
         |k, _| {
@@ -326,6 +345,7 @@ pub fn fit_program(
                     && line_of(k + 1) == line_of(k) + 1
                     && restorable(program.blocks.get(k + 1), plain_line(k + 1)))
         },
+        inverse,
     );
     let mut summary = Summary {
         blocks_in: program.blocks.len(),
@@ -366,7 +386,7 @@ pub fn fit_program(
         } else {
             "\n"
         };
-        write_block(&mut text, f, run.found.feed_mm_min, n_word.as_deref(), eol);
+        write_block(&mut text, f, &run.found, n_word.as_deref(), eol);
         next = l1;
         let k = run.found.blocks.1;
         restore = (in_angles(&program.blocks[k])
@@ -375,7 +395,7 @@ pub fn fit_program(
             && line_of(k + 1) == l1 + 1
             && restorable(program.blocks.get(k + 1), plain_line(k + 1)))
         .then(|| {
-            let tilt = tilt_of(modes.get(l1).and_then(|m| m.2), kin);
+            let tilt = tilt_of(modes.get(l1).and_then(|m| m.1), kin);
             (l1, with_angles(lines[l1], &program.blocks[k + 1], tilt))
         });
         summary.fitted_blocks += 1;
@@ -418,12 +438,18 @@ fn num(x: f64) -> String {
     }
 }
 
-pub(super) fn write_block(out: &mut String, f: &Fitted, feed: f64, n: Option<&str>, eol: &str) {
-    let p = f.degree;
+/// Run `found`'s block, fitted as `f`. A run programmed in inverse time (`G93`) is written
+/// at its length over its time in `G94`, and `G93` is restored on a line after it.
+pub(super) fn write_block(out: &mut String, f: &Fitted, found: &Found, n: Option<&str>, eol: &str) {
+    let (p, feed) = (f.degree, found.feed_mm_min);
+    let inverse = found.inverse_minutes.is_some();
     for (i, (c, t)) in f.ctrl.iter().zip(&f.tool).enumerate() {
         if i == 0 {
             if let Some(n) = n {
                 let _ = write!(out, "{n} ");
+            }
+            if inverse {
+                out.push_str("G94 ");
             }
             let _ = write!(out, "G06.5 P{p} ");
         }
@@ -445,6 +471,9 @@ pub(super) fn write_block(out: &mut String, f: &Fitted, feed: f64, n: Option<&st
     }
     let tail: Vec<String> = f.knots[f.ctrl.len()..].iter().map(|&k| knot(k)).collect();
     let _ = write!(out, "K{}{eol}", tail.join(" K"));
+    if inverse {
+        let _ = write!(out, "G93{eol}");
+    }
 }
 
 /// Knots with twelve significant decimals: the fit's parameters, not lengths.
