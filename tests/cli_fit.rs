@@ -198,6 +198,50 @@ fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A post in inverse time (hyperMILL's 5-axis pass in `G93`, F on every move): its run
+/// becomes one block written in `G94` with `G93` back after it, and `simulate` runs the
+/// result within the limits, faster than the posted moves.
+#[test]
+fn fit_writes_a_g93_posts_program_that_simulate_runs() {
+    let posts = root().join("tests/data/posts");
+    let (mach, tools) = (posts.join("machine.toml"), posts.join("tool.tbl"));
+    let out = temp("hm-fitted.nc");
+    let with_post = |cmd: &str, file: &std::path::Path, extra: &[&str]| {
+        let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
+        args.extend_from_slice(&["--tools", tools.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        dnurbs(&args)
+    };
+    let hm = posts.join("hypermill-5axis-g93.nc");
+    let r = with_post("fit", &hm, &["-o", out.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr).to_string();
+    assert_eq!(r.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("62 in, 59 fitted into 1 G06.5 blocks"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    assert!(text.contains("N11 G93\nN12 G94 G06.5 P3 "), "{text}");
+    assert!(text.contains("K1 K1 K1 K1\nG93\nN71 G1 "), "{text}");
+    let time = |file: &std::path::Path| {
+        let sim = with_post("simulate", file, &["--json"]);
+        assert_eq!(
+            sim.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&sim.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&sim.stdout).unwrap();
+        let exceeded = v["limits_exceeded"].as_array().expect("limits_exceeded");
+        assert!(exceeded.is_empty(), "{v}");
+        assert_eq!(v["axis_travel_ok"], serde_json::Value::Bool(true), "{v}");
+        v["machining_time_s"].as_f64().unwrap()
+    };
+    let (posted, fitted) = (time(&hm), time(&out));
+    assert!(fitted < posted, "{fitted} s fitted, {posted} s posted");
+    let _ = std::fs::remove_file(&out);
+}
+
 /// A program that can be read once (a pipe: `dnurbs fit /dev/stdin`, or `<(...)`) is read
 /// into memory and fitted as a file is; it is never taken for an empty program.
 #[test]
