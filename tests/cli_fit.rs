@@ -222,7 +222,7 @@ fn fit_writes_a_g93_posts_program_that_simulate_runs() {
     );
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.contains("N11 G93\nN12 G94 G06.5 P3 "), "{text}");
-    assert!(text.contains("K1 K1 K1 K1\nG93\nN71 G1 "), "{text}");
+    assert!(text.contains("K1 K1 K1 K1\nF800\nG93\nN71 G1 "), "{text}");
     let time = |file: &std::path::Path| {
         let sim = with_post("simulate", file, &["--json"]);
         assert_eq!(

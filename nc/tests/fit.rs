@@ -227,7 +227,11 @@ fn lines_that_are_not_plain_moves_pass_through_and_end_runs() {
     // the G91 moves.
     assert_eq!(out.summary.fitted_blocks, 4, "{}", out.text);
     assert!(out.text.contains("G94 G06.5 P3"), "{}", out.text);
-    assert!(out.text.contains("K1 K1 K1 K1\nG93\nX"), "{}", out.text);
+    assert!(
+        out.text.contains("K1 K1 K1 K1\nF2000\nG93\nX"),
+        "{}",
+        out.text
+    );
     // Every line that is not a fitted move is there, in order: the fitted ones are the
     // G01 lines of the first run and the bare wave lines (ending in Z1) of the others.
     let fitted = |l: &str| {

@@ -352,8 +352,9 @@ fn a_post_that_writes_only_the_changing_angle_is_fitted() {
 
 /// A 5-axis pass in inverse time, as a post writes `G93` (each move's F is 1/minutes for
 /// its own length, rounded to 0.1, the tool's speed within 0.8 % of 900 mm/min): it is
-/// fitted into one block written in `G94` at the run's length over its time, `G93` back
-/// after it, and the programmed time of the whole program stays what it was.
+/// fitted into one block written in `G94` at the run's length over its time, the feed per
+/// minute and `G93` back after it, and the programmed time of the whole program (a move
+/// at the feed per minute after the section included) stays what it was.
 #[test]
 fn a_run_in_inverse_time_keeps_its_time() {
     use std::fmt::Write;
@@ -367,7 +368,7 @@ fn a_run_in_inverse_time_keeps_its_time() {
         kinematics: Some(kin),
         ..nc::parse::Setup::default()
     };
-    let mut src = String::from("%\nG90 G21 G94\nG01 X20 Y0 Z5 A10 C0 F900\nG93\n");
+    let mut src = String::from("%\nG90 G21 G94\nG01 X20 Y0 Z5 A10 C0 F600\nG93\n");
     let mut prev = (20.0f64, 0.0f64);
     for k in 1..=300 {
         let t = f64::from(k) * 0.015;
@@ -381,7 +382,8 @@ fn a_run_in_inverse_time_keeps_its_time() {
         let (a, c) = (10.0 + 5.0 * (2.0 * t).sin(), t.to_degrees());
         let _ = writeln!(src, "G01 X{x:.3} Y{y:.3} Z5 A{a:.3} C{c:.3} F{f:.1}");
     }
-    src.push_str("G94\nG00 Z50\nM30\n%\n");
+    // Back in G94, a move at the feed per minute given before the G93 section.
+    src.push_str("G94\nG00 Z50\nG01 X0 Y-20\nM30\n%\n");
     let input = nc::parse::parse_with(&src, &setup).expect("input parses");
     let opts = Options::default();
     let whole = fit_program(&src, &input, &kin, &opts);
@@ -394,7 +396,8 @@ fn a_run_in_inverse_time_keeps_its_time() {
     assert_eq!(done.summary.fitted_blocks, 1, "{:?}\n{text}", done.summary);
     assert!(done.summary.moves_fitted >= 297, "{:?}", done.summary);
     assert!(text.contains("G93\nG94 G06.5 P3 X20 Y0 Z5 "), "{text}");
-    assert!(text.contains("K1 K1 K1 K1\nG93\n"), "{text}");
+    // The block's F replaced the feed per minute: it is given back before G93.
+    assert!(text.contains("K1 K1 K1 K1\nF600\nG93\n"), "{text}");
     let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
     let (a, b) = (
         build(&input, &kin, &bl).expect("input builds"),

@@ -107,8 +107,9 @@ impl Near {
     };
 }
 
-/// Nearest chord (samples j, j + 1) to `q`, searched from `from` (two chords back) to
-/// `reach` of track beyond `from`'s foot (a straight move is one chord however long).
+/// Nearest chord (samples j, j + 1) to `q`, searched along the track from `back` behind
+/// `from`'s foot (the chord there from that point on: a straight move is one chord however
+/// long, and what lies farther behind is not looked at) to `reach` beyond it.
 ///
 /// Chords that cannot be nearer are skipped, not measured: a point of the track `a` mm
 /// along from sample `j + 1` is at least `|q - p[j + 1]| - a` from `q` (the track between
@@ -116,17 +117,18 @@ impl Near {
 /// distance found, no chord there can beat it. The answer is the scan's over every chord
 /// of the reach ([`nearest_scan`], which the tests compare it with), found in a few chord
 /// measurements where the track runs away from `q` instead of one for every sample.
-fn nearest(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
+fn nearest(t: &Track, q: &Vector3<f64>, from: Near, back: f64, reach: f64) -> Near {
     let n = t.p.len();
     if n == 1 {
         return near(t, q, 0);
     }
-    let start = from.j.saturating_sub(2);
+    let (start, first, first_along) = behind(t, from, back);
     let limit = from.along + reach;
     let mut best = (start, f64::INFINITY);
     let mut j = start;
     while j + 1 < n {
-        let d = to_segment(q, &t.p[j], &t.p[j + 1]);
+        let a = if j == start { &first } else { &t.p[j] };
+        let d = to_segment(q, a, &t.p[j + 1]);
         if d < best.1 {
             best = (j, d);
         }
@@ -148,19 +150,46 @@ fn nearest(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
         }
         j = next;
     }
-    near(t, q, best.0)
+    if best.0 == start {
+        near_on(t, q, start, &first, first_along)
+    } else {
+        near(t, q, best.0)
+    }
+}
+
+/// Where a search `back` behind `from`'s foot starts: the chord there, the point on it and
+/// its distance along the track.
+fn behind(t: &Track, from: Near, back: f64) -> (usize, Vector3<f64>, f64) {
+    let last = from.j.min(t.p.len() - 1);
+    let at = (from.along - back).max(0.0);
+    let k = t.along[..=last]
+        .partition_point(|&a| a <= at)
+        .saturating_sub(1)
+        .min(t.p.len().saturating_sub(2));
+    let span = t.along.get(k + 1).map_or(0.0, |b| b - t.along[k]);
+    if span > 0.0 && at > t.along[k] {
+        let f = ((at - t.along[k]) / span).min(1.0);
+        (k, t.p[k] + (t.p[k + 1] - t.p[k]) * f, t.along[k] + f * span)
+    } else {
+        (k, t.p[k], t.along[k])
+    }
 }
 
 /// `q`'s foot on chord `j` of the track (the one sample, on a track of one).
 fn near(t: &Track, q: &Vector3<f64>, j: usize) -> Near {
+    near_on(t, q, j, &t.p[j], t.along[j])
+}
+
+/// `q`'s foot on chord `j` from point `a` on it (`a_along` along the track) to its end.
+fn near_on(t: &Track, q: &Vector3<f64>, j: usize, a: &Vector3<f64>, a_along: f64) -> Near {
     let Some(b) = t.p.get(j + 1) else {
         return Near {
             j,
-            d: (q - t.p[j]).norm(),
-            along: t.along[j],
+            d: (q - a).norm(),
+            along: a_along,
         };
     };
-    let (a, ab) = (&t.p[j], t.p[j + 1] - t.p[j]);
+    let ab = b - a;
     let l2 = ab.norm_squared();
     let f = if l2 > 0.0 {
         ((q - a).dot(&ab) / l2).clamp(0.0, 1.0)
@@ -170,7 +199,7 @@ fn near(t: &Track, q: &Vector3<f64>, j: usize) -> Near {
     Near {
         j,
         d: to_segment(q, a, b),
-        along: t.along[j] + f * (t.along[j + 1] - t.along[j]),
+        along: a_along + f * (t.along[j + 1] - a_along),
     }
 }
 
@@ -191,13 +220,17 @@ fn first_at_least(v: &[f64], from: usize, x: f64) -> usize {
 
 /// [`nearest`] by measuring every chord of the reach (the tests' reference).
 #[cfg(test)]
-fn nearest_scan(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
-    let start = from.j.saturating_sub(2);
+fn nearest_scan(t: &Track, q: &Vector3<f64>, from: Near, back: f64, reach: f64) -> Near {
+    if t.p.len() == 1 {
+        return near(t, q, 0);
+    }
+    let (start, first, first_along) = behind(t, from, back);
     let limit = from.along + reach;
     let mut best = (start, f64::INFINITY);
     let mut j = start;
     while j + 1 < t.p.len() {
-        let d = to_segment(q, &t.p[j], &t.p[j + 1]);
+        let a = if j == start { &first } else { &t.p[j] };
+        let d = to_segment(q, a, &t.p[j + 1]);
         if d < best.1 {
             best = (j, d);
         }
@@ -206,7 +239,11 @@ fn nearest_scan(t: &Track, q: &Vector3<f64>, from: Near, reach: f64) -> Near {
         }
         j += 1;
     }
-    near(t, q, if t.p.len() == 1 { 0 } else { best.0 })
+    if best.0 == start {
+        near_on(t, q, start, &first, first_along)
+    } else {
+        near(t, q, best.0)
+    }
 }
 
 /// The parameter in `a..=b` where the cutter is nearest `q`, where its distance has one
@@ -337,7 +374,7 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
     for (pose, line) in points {
         let step = (pose.p - prev).norm();
         prev = pose.p;
-        cursor = nearest(&out, &pose.p, cursor, 2.0 * step + 0.5);
+        cursor = nearest(&out, &pose.p, cursor, 2.0 * h, 2.0 * step + 0.5);
         let j = cursor.j;
         // The exact nearest position around samples j - 1 .. j + 2, on their segments.
         let (mut best_d, mut best_at) = (f64::INFINITY, None);
@@ -397,7 +434,7 @@ pub fn measure(input: &Path, output: &Path, kin: &MachineKinematics, h: f64) -> 
         } else {
             0.0
         };
-        cursor = nearest(&inp, &out.p[j], cursor, 2.0 * step + 0.5);
+        cursor = nearest(&inp, &out.p[j], cursor, 2.0 * h, 2.0 * step + 0.5);
         dev.path_mm = dev.path_mm.max(cursor.d);
     }
     dev
@@ -456,17 +493,20 @@ mod tests {
         #[test]
         fn nearest_skips_only_what_cannot_be_nearer(
             p in walks(),
-            queries in prop::collection::vec((0.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, 0.0f64..1.0), 1..20),
+            queries in prop::collection::vec((0.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0, 0.0f64..1.0, 0.0f64..0.5), 1..20),
             spread in prop::sample::select(vec![0.0, 1e-6, 1e-3, 0.1, 1.0, 10.0]),
         ) {
             let t = track(p);
             let n = t.p.len();
-            for (at, x, y, z, reach) in queries {
+            for (at, x, y, z, reach, back) in queries {
                 let j = ((at * n as f64) as usize).min(n - 1);
                 let q = t.p[j] + Vector3::new(x, y, z) * spread;
                 let from = near(&t, &(q + Vector3::new(z, x, y) * spread), j);
                 let reach = reach * t.along[n - 1] * 1.2;
-                prop_assert_eq!(nearest(&t, &q, from, reach), nearest_scan(&t, &q, from, reach));
+                prop_assert_eq!(
+                    nearest(&t, &q, from, back, reach),
+                    nearest_scan(&t, &q, from, back, reach)
+                );
             }
         }
     }
@@ -521,6 +561,24 @@ mod tests {
                 Ok(())
             })
             .unwrap();
+    }
+
+    /// A long straight move, a 0.05 mm step-over and the way back in short samples: a
+    /// point that sags from the way back toward the long move is measured against the way
+    /// back, where the search starts, not against the long move behind it (which is one
+    /// chord, two chords back).
+    #[test]
+    fn the_search_does_not_reach_back_along_a_long_chord() {
+        let mut p = vec![Vector3::zeros(), Vector3::new(100.0, 0.0, 0.0)];
+        p.extend((0..=200).map(|k| Vector3::new(100.0 - f64::from(k) * 0.005, 0.05, 0.0)));
+        let t = track(p);
+        // The last query stood on the first chord of the way back.
+        let from = near(&t, &Vector3::new(99.998, 0.05, 0.0), 2);
+        assert_eq!(from.j, 2);
+        let q = Vector3::new(99.99, 0.0, 0.0);
+        let found = nearest(&t, &q, from, 0.01, 0.51);
+        assert!(found.d > 0.04, "{found:?}");
+        assert_eq!(found, nearest_scan(&t, &q, from, 0.01, 0.51));
     }
 
     #[test]

@@ -12,6 +12,7 @@
 use super::runs::Options;
 use super::{fit, Fitted, Point};
 use crate::kinematics::{Kinematics, MachineKinematics};
+use crate::parse::MIN_FEED_MM_MIN;
 use crate::program::{Block, LengthMode, LinearMove, Orientation, Program};
 use nalgebra::Vector3;
 
@@ -24,6 +25,9 @@ pub const MAX_TURN_DEG: f64 = 10.0;
 /// first's: a post writes each move's 1/minutes for its own rounded length, so a constant
 /// speed of the tool comes out a little different on every move.
 pub const INVERSE_FEED_SPREAD: f64 = 0.01;
+
+/// The largest feed a program can give (the domain of an `F` word), mm/min.
+const MAX_FEED_MM_MIN: f64 = 1e6;
 
 /// A run and its fit.
 #[derive(Clone, Debug, PartialEq)]
@@ -194,14 +198,18 @@ pub fn find_open_runs(
                     .sum::<f64>()
             });
             let length: f64 = points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
-            runs.push(Found {
-                blocks: (b, end),
-                reach: e,
-                fitted: fit(&points, opts.tol, opts.degree),
-                points,
-                feed_mm_min: inverse_minutes.map_or(first.feed_mm_min, |t| length / t),
-                inverse_minutes,
-            });
+            let feed_mm_min = inverse_minutes.map_or(first.feed_mm_min, |t| length / t);
+            // (A run in inverse time at a speed no feed per minute can give stays as it is.)
+            if (MIN_FEED_MM_MIN..=MAX_FEED_MM_MIN).contains(&feed_mm_min) {
+                runs.push(Found {
+                    blocks: (b, end),
+                    reach: e,
+                    fitted: fit(&points, opts.tol, opts.degree),
+                    points,
+                    feed_mm_min,
+                    inverse_minutes,
+                });
+            }
         }
         b = e + 1;
     }

@@ -75,6 +75,8 @@ struct Held {
     g01: bool,
     /// `G93` in effect: its feed is inverse time.
     inverse: bool,
+    /// The feed per minute in effect (mm/min).
+    g94_feed: Option<f64>,
     /// The program's tilt letter so far.
     tilt: Option<char>,
 }
@@ -135,6 +137,7 @@ impl<W: Write> State<'_, W> {
             plain: at.plain,
             g01: at.g01,
             inverse: at.inverse,
+            g94_feed: at.g94_feed,
             tilt: self.modes.tilt,
         });
         Ok(())
@@ -267,17 +270,18 @@ impl<W: Write> State<'_, W> {
                 self.emit_held(&h)?;
             }
         }
-        let (mut n, mut eol) = (None, "\n");
+        let (mut n, mut eol, mut g94_feed) = (None, "\n", None);
         while self.held.front().is_some_and(|h| h.no <= l1) {
             if let Some(h) = self.pop_held().filter(|h| h.no == l0) {
                 n = n_word(&h.text);
                 if h.ending == "\r\n" {
                     eol = "\r\n";
                 }
+                g94_feed = h.g94_feed;
             }
         }
         let mut text = String::new();
-        write_block(&mut text, fitted, f, n.as_deref(), eol);
+        write_block(&mut text, fitted, f, n.as_deref(), eol, g94_feed);
         for line in text.split_inclusive('\n') {
             let body = line.trim_end_matches('\n').trim_end_matches('\r');
             self.emit(body, &line[body.len()..])?;

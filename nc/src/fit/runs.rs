@@ -23,6 +23,7 @@
 use super::find::{find_runs, moves_in, Found};
 use super::{Fitted, Tolerance};
 use crate::kinematics::MachineKinematics;
+use crate::parse::MM_PER_INCH;
 use crate::program::{Block, Orientation, Program};
 use std::fmt::Write;
 
@@ -115,6 +116,8 @@ pub(super) struct LineModes {
     pub g01: bool,
     /// `G93`: its moves' feeds are inverse time.
     pub inverse: bool,
+    /// The modal feed per minute, mm/min (see [`Modes`]).
+    pub g94_feed: Option<f64>,
 }
 
 /// The modes [`modes`] follows, a line at a time.
@@ -127,6 +130,9 @@ pub(super) struct Modes {
     motion: u32,
     /// The letter of the program's first tilt word (`A` or `B`; the parser allows one).
     pub(super) tilt: Option<char>,
+    /// The modal feed per minute (mm/min), the last `F` given under `G94`: under `G93` an
+    /// `F` is its line's own and leaves it as it was.
+    g94_feed: Option<f64>,
 }
 
 impl Default for Modes {
@@ -137,6 +143,7 @@ impl Default for Modes {
             feed: 940,
             motion: 0,
             tilt: None,
+            g94_feed: None,
         }
     }
 }
@@ -148,6 +155,7 @@ impl Modes {
             plain: self.abs && self.mm && (self.feed == 940 || self.feed == 930),
             g01: self.motion == 10,
             inverse: self.feed == 930,
+            g94_feed: self.g94_feed,
         };
         let code = strip_comments(line);
         if self.tilt.is_none() {
@@ -162,6 +170,12 @@ impl Modes {
                 200 => self.mm = false,
                 930 | 940 | 950 => self.feed = g,
                 _ => {}
+            }
+        }
+        // The line's G codes apply before its F, as the parser reads them.
+        if self.feed == 940 {
+            if let Some(f) = word_value(&code, 'F') {
+                self.g94_feed = Some(if self.mm { f } else { f * MM_PER_INCH });
             }
         }
         at_start
@@ -182,6 +196,18 @@ fn g_codes(code: &str) -> impl Iterator<Item = u32> + '_ {
             let tenths = (x * 10.0).round();
             ((tenths - x * 10.0).abs() < 1e-6 && tenths < 10_000.0).then_some(tenths as u32)
         })
+}
+
+/// The value of the first `letter` word in `code`.
+fn word_value(code: &str, letter: char) -> Option<f64> {
+    let upper = code.to_ascii_uppercase();
+    let at = upper.find(letter)?;
+    let num: String = upper[at + 1..]
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || "+-.".contains(*c))
+        .collect();
+    num.parse().ok()
 }
 
 /// The letter of the first `A` or `B` word in `code`.
@@ -386,7 +412,8 @@ pub fn fit_program(
         } else {
             "\n"
         };
-        write_block(&mut text, f, &run.found, n_word.as_deref(), eol);
+        let g94_feed = modes.get(l0 - 1).and_then(|m| m.0.g94_feed);
+        write_block(&mut text, f, &run.found, n_word.as_deref(), eol, g94_feed);
         next = l1;
         let k = run.found.blocks.1;
         restore = (in_angles(&program.blocks[k])
@@ -439,8 +466,16 @@ fn num(x: f64) -> String {
 }
 
 /// Run `found`'s block, fitted as `f`. A run programmed in inverse time (`G93`) is written
-/// at its length over its time in `G94`, and `G93` is restored on a line after it.
-pub(super) fn write_block(out: &mut String, f: &Fitted, found: &Found, n: Option<&str>, eol: &str) {
+/// at its length over its time in `G94`; after it, the feed per minute in effect before
+/// it (`g94_feed`, which its `F` replaced) and then `G93` are restored, each on a line.
+pub(super) fn write_block(
+    out: &mut String,
+    f: &Fitted,
+    found: &Found,
+    n: Option<&str>,
+    eol: &str,
+    g94_feed: Option<f64>,
+) {
     let (p, feed) = (f.degree, found.feed_mm_min);
     let inverse = found.inverse_minutes.is_some();
     for (i, (c, t)) in f.ctrl.iter().zip(&f.tool).enumerate() {
@@ -472,6 +507,9 @@ pub(super) fn write_block(out: &mut String, f: &Fitted, found: &Found, n: Option
     let tail: Vec<String> = f.knots[f.ctrl.len()..].iter().map(|&k| knot(k)).collect();
     let _ = write!(out, "K{}{eol}", tail.join(" K"));
     if inverse {
+        if let Some(feed) = g94_feed {
+            let _ = write!(out, "F{feed}{eol}");
+        }
         let _ = write!(out, "G93{eol}");
     }
 }
