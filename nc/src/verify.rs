@@ -543,6 +543,12 @@ fn branch_change(w: &[Sample; 4]) -> Option<Violation> {
 
 /// Distance from `p` to the segment a..b.
 pub fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    chord_foot(p, a, b).1
+}
+
+/// The foot of `p` on the segment a..b, as the fraction of the way from `a`, and the
+/// distance from `p` to it.
+pub fn chord_foot(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64) {
     let ab = b - a;
     let l2 = ab.norm_squared();
     let f = if l2 > 0.0 {
@@ -550,7 +556,7 @@ pub fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f6
     } else {
         0.0
     };
-    (p - (a + ab * f)).norm()
+    (f, (p - (a + ab * f)).norm())
 }
 
 /// Largest distance of the cutter path between setpoints `a` and `b` from their chord.

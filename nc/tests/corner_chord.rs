@@ -47,17 +47,6 @@ fn point_at(path: &Path, seg_start: &[f64], s: f64) -> (usize, Vector3<f64>) {
     (i, seg.pose((s - seg_start[i]).clamp(0.0, seg.length)).p)
 }
 
-fn dist_to_segment(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
-}
-
 /// The largest distance of a corner from a chord straddling it, sampling the plan at
 /// `k Ts + phase`.
 fn worst_corner_chord(path: &Path, profile: &nc::plan::FeedProfile, phase: f64) -> f64 {
@@ -72,7 +61,7 @@ fn worst_corner_chord(path: &Path, profile: &nc::plan::FeedProfile, phase: f64) 
         if let Some((i0, p0)) = prev {
             for seg in &path.segments[i0..i] {
                 let corner = seg.pose(seg.length).p;
-                worst = worst.max(dist_to_segment(&corner, &p0, &p));
+                worst = worst.max(nc::verify::dist_to_chord(&corner, &p0, &p));
             }
         }
         prev = Some((i, p));

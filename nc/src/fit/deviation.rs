@@ -17,6 +17,7 @@ use crate::nurbs::DoubleNurbs;
 use crate::segment::{Geometry, Path, Pose, Segment};
 use nalgebra::Vector3;
 
+use crate::verify::chord_foot;
 pub use crate::verify::dist_to_chord as to_segment;
 
 /// The largest deviations found.
@@ -189,16 +190,10 @@ fn near_on(t: &Track, q: &Vector3<f64>, j: usize, a: &Vector3<f64>, a_along: f64
             along: a_along,
         };
     };
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let f = if l2 > 0.0 {
-        ((q - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let (f, d) = chord_foot(q, a, b);
     Near {
         j,
-        d: to_segment(q, a, b),
+        d,
         along: a_along + f * (t.along[j + 1] - a_along),
     }
 }
