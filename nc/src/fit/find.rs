@@ -151,14 +151,13 @@ pub fn find_open_runs(
     };
     // A move joins a run at its feed (within the spread under G93), tool length and mode.
     let same = |b: usize, first: &LinearMove, k: usize, m: &LinearMove| {
-        let feed = if inverse(b) {
-            inverse(k)
-                && (m.feed_mm_min - first.feed_mm_min).abs()
-                    <= INVERSE_FEED_SPREAD * first.feed_mm_min
-        } else {
-            !inverse(k) && m.feed_mm_min == first.feed_mm_min
+        let ((feed, length, mode), (feed0, length0, mode0)) = (run_key(m), run_key(first));
+        let feeds = match (inverse(b), inverse(k)) {
+            (true, true) => (feed - feed0).abs() <= INVERSE_FEED_SPREAD * feed0,
+            (false, false) => feed == feed0,
+            _ => false,
         };
-        feed && run_key(m).1 == run_key(first).1 && run_key(m).2 == run_key(first).2
+        feeds && length == length0 && mode == mode0
     };
     let mut runs = Vec::new();
     let mut open = None;
