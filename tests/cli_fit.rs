@@ -21,6 +21,16 @@ fn helix(n: usize) -> String {
     s
 }
 
+/// `dnurbs CMD FILE` on the posts' machine and tool table (`tests/data/posts`), `EXTRA...`.
+fn on_posts_machine(cmd: &str, file: &std::path::Path, extra: &[&str]) -> std::process::Output {
+    let posts = root().join("tests/data/posts");
+    let (mach, tools) = (posts.join("machine.toml"), posts.join("tool.tbl"));
+    let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
+    args.extend_from_slice(&["--tools", tools.to_str().unwrap()]);
+    args.extend_from_slice(extra);
+    dnurbs(&args)
+}
+
 /// `dnurbs CMD FILE -m paper-ac-table.toml EXTRA...`.
 fn on_paper_machine(cmd: &str, file: &std::path::Path, extra: &[&str]) -> std::process::Output {
     let mach = machine("paper-ac-table.toml");
@@ -151,17 +161,10 @@ fn simulate_compresses_on_request_and_says_so() {
 #[test]
 fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
     let posts = root().join("tests/data/posts");
-    let (mach, tools) = (posts.join("machine.toml"), posts.join("tool.tbl"));
     let dir = temp("fit-posts");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("nx-fitted.nc");
-    let on_posts_machine = |cmd: &str, file: &std::path::Path, extra: &[&str]| {
-        let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
-        args.extend_from_slice(&["--tools", tools.to_str().unwrap()]);
-        args.extend_from_slice(extra);
-        dnurbs(&args)
-    };
     let nx = posts.join("nx-5axis-g43-4.nc");
     let r = on_posts_machine("fit", &nx, &["-o", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&r.stderr).to_string();
@@ -204,16 +207,9 @@ fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
 #[test]
 fn fit_writes_a_g93_posts_program_that_simulate_runs() {
     let posts = root().join("tests/data/posts");
-    let (mach, tools) = (posts.join("machine.toml"), posts.join("tool.tbl"));
     let out = temp("hm-fitted.nc");
-    let with_post = |cmd: &str, file: &std::path::Path, extra: &[&str]| {
-        let mut args = vec![cmd, file.to_str().unwrap(), "-m", mach.to_str().unwrap()];
-        args.extend_from_slice(&["--tools", tools.to_str().unwrap()]);
-        args.extend_from_slice(extra);
-        dnurbs(&args)
-    };
     let hm = posts.join("hypermill-5axis-g93.nc");
-    let r = with_post("fit", &hm, &["-o", out.to_str().unwrap()]);
+    let r = on_posts_machine("fit", &hm, &["-o", out.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&r.stderr).to_string();
     assert_eq!(r.status.code(), Some(0), "{err}");
     assert!(
@@ -224,7 +220,7 @@ fn fit_writes_a_g93_posts_program_that_simulate_runs() {
     assert!(text.contains("N11 G93\nN12 G94 G06.5 P3 "), "{text}");
     assert!(text.contains("K1 K1 K1 K1\nF800\nG93\nN71 G1 "), "{text}");
     let time = |file: &std::path::Path| {
-        let sim = with_post("simulate", file, &["--json"]);
+        let sim = on_posts_machine("simulate", file, &["--json"]);
         assert_eq!(
             sim.status.code(),
             Some(0),

@@ -181,6 +181,54 @@ fn line_endings_continued_lines_and_lines_that_move_nothing_are_kept() {
     assert!(text.contains("G01 X30 \\\n Y-10 Z12\n"), "{text}");
 }
 
+/// A trunnion table tilting about `tilt` 50 mm below the C table, and the parse setup
+/// that reads angle words for it.
+fn trunnion(tilt: Tilt) -> (MachineKinematics, nc::parse::Setup) {
+    let kin = MachineKinematics::Trt {
+        tilt,
+        tilt_point: Vector3::new(0.0, 0.0, -50.0),
+        c_point: Vector3::zeros(),
+    };
+    let setup = nc::parse::Setup {
+        reference: Some([0.0, 0.0, 300.0]),
+        kinematics: Some(kin),
+        ..nc::parse::Setup::default()
+    };
+    (kin, setup)
+}
+
+/// `src` fitted as a stream with the default options: it must write what the whole-text
+/// fit writes and read back within both tolerances by the independent measurement. The
+/// text written, what the stream did, and the input's and the output's paths.
+fn fit_checked(
+    src: &str,
+    kin: &MachineKinematics,
+    setup: &nc::parse::Setup,
+    what: &str,
+) -> (String, Rewritten, nc::segment::Path, nc::segment::Path) {
+    let opts = Options::default();
+    let input = nc::parse::parse_with(src, setup).expect("input parses");
+    let whole = fit_program(src, &input, kin, &opts);
+    let (_, bl) = small_mill(0.002);
+    let mut out = Vec::new();
+    let done = rewrite(src.as_bytes(), setup, kin, &bl, &opts, 0.002, &mut out)
+        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    let text = String::from_utf8(out).unwrap();
+    assert_eq!(text, whole.text, "{what}");
+    let output = nc::parse::parse_with(&text, setup).expect("the output parses");
+    let (a, b) = (
+        build(&input, kin, &bl).expect("input builds"),
+        build(&output, kin, &bl).expect("output builds"),
+    );
+    let dev = measure(&a, &b, kin, 0.002);
+    assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{what}: {dev:?}");
+    assert!(
+        dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
+        "{what}: {dev:?}"
+    );
+    (text, done, a, b)
+}
+
 /// A run given in machine angles, followed by `after`: 400 moves of about 0.1 mm along an
 /// arc, A and C turning a little on every move, as an A/C post writes them.
 fn in_angles(after: &str) -> String {
@@ -206,18 +254,7 @@ fn in_angles(after: &str) -> String {
 /// gives one angle, or a `G28` under the tilted table, still reads as it did.
 #[test]
 fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
-    let trt = MachineKinematics::Trt {
-        tilt: Tilt::A,
-        tilt_point: Vector3::new(0.0, 0.0, -50.0),
-        c_point: Vector3::zeros(),
-    };
-    let setup = nc::parse::Setup {
-        reference: Some([0.0, 0.0, 300.0]),
-        kinematics: Some(trt),
-        ..nc::parse::Setup::default()
-    };
-    let (_, bl) = small_mill(0.002);
-    let opts = Options::default();
+    let (trt, setup) = trunnion(Tilt::A);
     for (after, fitted, written) in [
         // The next move gives both angles: the whole run is one block.
         (
@@ -246,13 +283,7 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
         ),
     ] {
         let src = in_angles(after);
-        let input = nc::parse::parse_with(&src, &setup).expect("input parses");
-        let whole = fit_program(&src, &input, &trt, &opts);
-        let mut out = Vec::new();
-        let done = rewrite(src.as_bytes(), &setup, &trt, &bl, &opts, 0.002, &mut out)
-            .unwrap_or_else(|e| panic!("{after}: {e}"));
-        let text = String::from_utf8(out).unwrap();
-        assert_eq!(text, whole.text, "{after}");
+        let (text, done, _, _) = fit_checked(&src, &trt, &setup, after);
         assert!(text.contains(written), "{after}: {text}");
         assert_eq!(
             done.summary.moves_fitted, fitted,
@@ -260,17 +291,6 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
             done.summary
         );
         assert_eq!(done.summary.fitted_blocks, 1, "{after}");
-        let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
-        let (a, b) = (
-            build(&input, &trt, &bl).expect("input builds"),
-            build(&output, &trt, &bl).expect("output builds"),
-        );
-        let dev = measure(&a, &b, &trt, 0.002);
-        assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{after}: {dev:?}");
-        assert!(
-            dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
-            "{after}: {dev:?}"
-        );
     }
 }
 
@@ -282,16 +302,7 @@ fn a_run_in_angles_leaves_the_angles_modal_after_its_block() {
 fn a_post_that_writes_only_the_changing_angle_is_fitted() {
     use std::fmt::Write;
     for (tilt, letter) in [(Tilt::A, 'A'), (Tilt::B, 'B')] {
-        let kin = MachineKinematics::Trt {
-            tilt,
-            tilt_point: Vector3::new(0.0, 0.0, -50.0),
-            c_point: Vector3::zeros(),
-        };
-        let setup = nc::parse::Setup {
-            reference: Some([0.0, 0.0, 300.0]),
-            kinematics: Some(kin),
-            ..nc::parse::Setup::default()
-        };
+        let (kin, setup) = trunnion(tilt);
         let mut src = format!("%\nG90 G21 G94\nG01 X0 Y0 Z5 {letter}15 C0 F2000\n");
         for k in 1..=150 {
             let x = f64::from(k) * 0.1;
@@ -313,15 +324,7 @@ fn a_post_that_writes_only_the_changing_angle_is_fitted() {
             );
         }
         src.push_str("Y20 C0.5 F1000\nM30\n%\n");
-        let input = nc::parse::parse_with(&src, &setup).expect("input parses");
-        let opts = Options::default();
-        let whole = fit_program(&src, &input, &kin, &opts);
-        let (_, bl) = small_mill(0.002);
-        let mut out = Vec::new();
-        let done = rewrite(src.as_bytes(), &setup, &kin, &bl, &opts, 0.002, &mut out)
-            .unwrap_or_else(|e| panic!("{letter}: {e}"));
-        let text = String::from_utf8(out).unwrap();
-        assert_eq!(text, whole.text, "{letter}");
+        let (text, done, _, _) = fit_checked(&src, &kin, &setup, &letter.to_string());
         assert_eq!(
             done.summary.fitted_blocks, 2,
             "{letter}: {:?}\n{text}",
@@ -336,17 +339,6 @@ fn a_post_that_writes_only_the_changing_angle_is_fitted() {
             text.contains(&format!("Y20 C0.5 F1000 {letter}15\n")),
             "{text}"
         );
-        let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
-        let (a, b) = (
-            build(&input, &kin, &bl).expect("input builds"),
-            build(&output, &kin, &bl).expect("output builds"),
-        );
-        let dev = measure(&a, &b, &kin, 0.002);
-        assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{letter}: {dev:?}");
-        assert!(
-            dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
-            "{letter}: {dev:?}"
-        );
     }
 }
 
@@ -358,16 +350,7 @@ fn a_post_that_writes_only_the_changing_angle_is_fitted() {
 #[test]
 fn a_run_in_inverse_time_keeps_its_time() {
     use std::fmt::Write;
-    let kin = MachineKinematics::Trt {
-        tilt: Tilt::A,
-        tilt_point: Vector3::new(0.0, 0.0, -50.0),
-        c_point: Vector3::zeros(),
-    };
-    let setup = nc::parse::Setup {
-        reference: Some([0.0, 0.0, 300.0]),
-        kinematics: Some(kin),
-        ..nc::parse::Setup::default()
-    };
+    let (kin, setup) = trunnion(Tilt::A);
     let mut src = String::from("%\nG90 G21 G94\nG01 X20 Y0 Z5 A10 C0 F600\nG93\n");
     let mut prev = (20.0f64, 0.0f64);
     for k in 1..=300 {
@@ -384,31 +367,12 @@ fn a_run_in_inverse_time_keeps_its_time() {
     }
     // Back in G94, a move at the feed per minute given before the G93 section.
     src.push_str("G94\nG00 Z50\nG01 X0 Y-20\nM30\n%\n");
-    let input = nc::parse::parse_with(&src, &setup).expect("input parses");
-    let opts = Options::default();
-    let whole = fit_program(&src, &input, &kin, &opts);
-    let (_, bl) = small_mill(0.002);
-    let mut out = Vec::new();
-    let done = rewrite(src.as_bytes(), &setup, &kin, &bl, &opts, 0.002, &mut out)
-        .unwrap_or_else(|e| panic!("{e}"));
-    let text = String::from_utf8(out).unwrap();
-    assert_eq!(text, whole.text);
+    let (text, done, a, b) = fit_checked(&src, &kin, &setup, "G93");
     assert_eq!(done.summary.fitted_blocks, 1, "{:?}\n{text}", done.summary);
     assert!(done.summary.moves_fitted >= 297, "{:?}", done.summary);
     assert!(text.contains("G93\nG94 G06.5 P3 X20 Y0 Z5 "), "{text}");
     // The block's F replaced the feed per minute: it is given back before G93.
     assert!(text.contains("K1 K1 K1 K1\nF600\nG93\n"), "{text}");
-    let output = nc::parse::parse_with(&text, &setup).expect("the output parses");
-    let (a, b) = (
-        build(&input, &kin, &bl).expect("input builds"),
-        build(&output, &kin, &bl).expect("output builds"),
-    );
-    let dev = measure(&a, &b, &kin, 0.002);
-    assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{dev:?}");
-    assert!(
-        dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
-        "{dev:?}"
-    );
     // The programmed time (feed moves at their feed) is the same to 1e-4.
     let time = |p: &nc::segment::Path| -> f64 {
         p.segments
