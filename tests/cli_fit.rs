@@ -203,7 +203,9 @@ fn fit_writes_a_posts_program_that_simulate_runs_and_nothing_when_refused() {
 
 /// A post in inverse time (hyperMILL's 5-axis pass in `G93`, F on every move): its run
 /// becomes one block written in `G94` with `G93` back after it, and `simulate` runs the
-/// result within the limits, faster than the posted moves.
+/// result within the limits, faster than the posted moves; `simulate --compress` fits the
+/// same run of the posted program on line (and one move more: the parsed program has no
+/// line to keep the run's last move on) and takes the fitted program's time.
 #[test]
 fn fit_writes_a_g93_posts_program_that_simulate_runs() {
     let posts = root().join("tests/data/posts");
@@ -219,8 +221,8 @@ fn fit_writes_a_g93_posts_program_that_simulate_runs() {
     let text = std::fs::read_to_string(&out).unwrap();
     assert!(text.contains("N11 G93\nN12 G94 G06.5 P3 "), "{text}");
     assert!(text.contains("K1 K1 K1 K1\nF800\nG93\nN71 G1 "), "{text}");
-    let time = |file: &std::path::Path| {
-        let sim = on_posts_machine("simulate", file, &["--json"]);
+    let time = |file: &std::path::Path, extra: &[&str]| {
+        let sim = on_posts_machine("simulate", file, &[&["--json"], extra].concat());
         assert_eq!(
             sim.status.code(),
             Some(0),
@@ -231,10 +233,23 @@ fn fit_writes_a_g93_posts_program_that_simulate_runs() {
         let exceeded = v["limits_exceeded"].as_array().expect("limits_exceeded");
         assert!(exceeded.is_empty(), "{v}");
         assert_eq!(v["axis_travel_ok"], serde_json::Value::Bool(true), "{v}");
+        if extra.contains(&"--compress") {
+            let c = &v["compressed"];
+            assert_eq!(
+                (&c["moves_fitted"], &c["fitted_blocks"]),
+                (&60.into(), &1.into()),
+                "{c}"
+            );
+        }
         v["machining_time_s"].as_f64().unwrap()
     };
-    let (posted, fitted) = (time(&hm), time(&out));
+    let (posted, fitted) = (time(&hm, &[]), time(&out, &[]));
     assert!(fitted < posted, "{fitted} s fitted, {posted} s posted");
+    let online = time(&hm, &["--compress"]);
+    assert!(
+        (online - fitted).abs() <= 0.01 * fitted,
+        "{online} s compressed on line, {fitted} s fitted"
+    );
     let _ = std::fs::remove_file(&out);
 }
 

@@ -278,29 +278,30 @@ fn check_run(
     rep
 }
 
-/// `run --compress` end to end: the NX post's swarf pass (63 G01 moves with A and C) runs
-/// fitted into a G06.5 block, and every check of the posts holds on what the drives
-/// received: the targets follow the compressed path `simulate --compress` interpolates,
-/// within the limits at the period, to the program's end; spindle, coolant and the operator
-/// stops as programmed. The report says what compression did.
+/// `run --compress` end to end: the NX post's swarf pass (63 G01 moves with A and C) and the
+/// hyperMILL post's pass in inverse time (`G93`, 62 moves) each run fitted into a G06.5
+/// block, and every check of the posts holds on what the drives received: the targets
+/// follow the compressed path `simulate --compress` interpolates, within the limits at the
+/// period, to the program's end; spindle, coolant and the operator stops as programmed. The
+/// report says what compression did.
 #[test]
-fn the_nx_post_runs_compressed_as_simulate_compresses_it() {
-    let name = "nx-5axis-g43-4.nc";
+fn the_nx_and_g93_posts_run_compressed_as_simulate_compresses_them() {
     let m = slow_spindle_machine();
-    let rep = check_run(name, &m, Some(true));
-    let c = rep
-        .compressed
-        .expect("the report says what compression did");
-    assert_eq!(
-        (c.moves_in, c.moves_fitted, c.fitted_blocks),
-        (63, 60, 1),
-        "{c:?}"
-    );
-    assert!(rep
-        .text()
-        .contains("compressed         60 of 63 G01 moves into 1 G06.5 blocks"));
+    for (name, moves_in) in [("nx-5axis-g43-4.nc", 63), ("hypermill-5axis-g93.nc", 62)] {
+        let rep = check_run(name, &m, Some(true));
+        let c = rep
+            .compressed
+            .expect("the report says what compression did");
+        assert_eq!(
+            (c.moves_in, c.moves_fitted, c.fitted_blocks),
+            (moves_in, 60, 1),
+            "{name}: {c:?}"
+        );
+        let line = format!("compressed         60 of {moves_in} G01 moves into 1 G06.5 blocks");
+        assert!(rep.text().contains(&line), "{name}: {}", rep.text());
+    }
     // Off, the report has no such line.
-    let plain = check_run(name, &m, Some(false));
+    let plain = check_run("nx-5axis-g43-4.nc", &m, Some(false));
     assert!(plain.compressed.is_none());
 }
 

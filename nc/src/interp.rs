@@ -380,6 +380,7 @@ pub(crate) mod tests {
                     end: c[0],
                     orientation: Orientation::Vector([dir[0] / n, dir[1] / n, dir[2] / n]),
                     feed_mm_min: 400.0,
+                    inverse_time: false,
                     tooling: Default::default(),
                 }),
                 Block::Nurbs(b),

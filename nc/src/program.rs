@@ -54,6 +54,9 @@ pub struct LinearMove {
     pub orientation: Orientation,
     /// Programmed feed, mm/min (ignored for rapid moves; may then be 0).
     pub feed_mm_min: f64,
+    /// The feed was programmed in inverse time (`G93`): `feed_mm_min` is the move's length
+    /// over the time its `F` gave it.
+    pub inverse_time: bool,
     /// Tool length and stops in effect for this move (see [`MoveTooling`]).
     pub tooling: MoveTooling,
 }

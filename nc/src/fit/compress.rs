@@ -49,7 +49,6 @@ pub fn compress(
         |_| true,
         |k| !word_before[k],
         |_, _| true,
-        |_| false,
     );
     let mut out = Compressed {
         moves_in: moves_in(program),
@@ -73,7 +72,7 @@ pub fn compress(
         for slot in &mut index[b..=e] {
             *slot = blocks.len();
         }
-        blocks.push(Block::Nurbs(fitted_block(first, f)));
+        blocks.push(Block::Nurbs(fitted_block(first, f, run.feed_mm_min)));
         next = e + 1;
         out.fitted_blocks += 1;
         out.moves_fitted += e + 1 - b;
@@ -98,9 +97,9 @@ pub fn compress(
     )
 }
 
-/// The G06.5 block of a run fitted as `f`, whose first move is `first` (its position, `N`,
-/// feed and tooling).
-pub fn fitted_block(first: &LinearMove, f: &Fitted) -> NurbsBlock {
+/// The G06.5 block of a run fitted as `f`, whose first move is `first` (its position, `N`
+/// and tooling), at the run's feed (mm/min, [`super::find::run_feed`]).
+pub fn fitted_block(first: &LinearMove, f: &Fitted, feed_mm_min: f64) -> NurbsBlock {
     let tool_ctrl = f
         .ctrl
         .iter()
@@ -117,7 +116,7 @@ pub fn fitted_block(first: &LinearMove, f: &Fitted) -> NurbsBlock {
         ctrl_pos: vec![first.pos; f.ctrl.len()],
         weights: vec![1.0; f.ctrl.len()],
         knots: f.knots.clone(),
-        feed_mm_min: first.feed_mm_min,
+        feed_mm_min,
         tooling: first.tooling,
         turn_to: None,
     }

@@ -13,7 +13,7 @@ use super::runs::Options;
 use super::{fit, Fitted, Point};
 use crate::kinematics::{Kinematics, MachineKinematics};
 use crate::parse::MIN_FEED_MM_MIN;
-use crate::program::{Block, LengthMode, LinearMove, Orientation, Program};
+use crate::program::{Block, LinearMove, Orientation, Program};
 use nalgebra::Vector3;
 
 /// Largest tool turn (degrees) of one move in a run: the fit follows the tool axis at the
@@ -89,9 +89,44 @@ pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) ->
     !m.rapid && (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
 }
 
-/// What every move of a run shares: its feed and tool length and mode.
-pub fn run_key(m: &LinearMove) -> (f64, f64, LengthMode) {
-    (m.feed_mm_min, m.tooling.tool_length, m.tooling.mode)
+/// Move `m` has the feed, tool length and mode of the run `first` begins: the same feed
+/// per minute, or both in inverse time (`G93`) at speeds within [`INVERSE_FEED_SPREAD`].
+pub fn same_run(first: &LinearMove, m: &LinearMove) -> bool {
+    let feeds = match (first.inverse_time, m.inverse_time) {
+        (true, true) => {
+            (m.feed_mm_min - first.feed_mm_min).abs() <= INVERSE_FEED_SPREAD * first.feed_mm_min
+        }
+        (false, false) => m.feed_mm_min == first.feed_mm_min,
+        _ => false,
+    };
+    feeds
+        && m.tooling.tool_length == first.tooling.tool_length
+        && m.tooling.mode == first.tooling.mode
+}
+
+/// The feed (mm/min) a fitted block of `moves` is given, and under `G93` the run's time
+/// (minutes, the sum of its moves': each took its length over its feed, the parser's own
+/// measure); `points`: the run's start, then each move's end. None for a run in inverse
+/// time at a speed no feed per minute can give, which stays as it is.
+pub fn run_feed<'m>(
+    mut moves: impl Iterator<Item = &'m LinearMove>,
+    points: &[Point],
+) -> Option<(f64, Option<f64>)> {
+    let first = moves.next()?;
+    if !first.inverse_time {
+        return Some((first.feed_mm_min, None));
+    }
+    let chord = |w: &[Point]| (w[1].p - w[0].p).norm();
+    let minutes: f64 = core::iter::once(first)
+        .chain(moves)
+        .zip(points.windows(2))
+        .map(|(m, w)| chord(w) / m.feed_mm_min)
+        .sum();
+    let length: f64 = points.windows(2).map(chord).sum();
+    let feed = length / minutes;
+    (MIN_FEED_MM_MIN..=MAX_FEED_MM_MIN)
+        .contains(&feed)
+        .then_some((feed, Some(minutes)))
 }
 
 /// The path turns at the end of `m` (from `a`'s end, to `c`'s) by more than `corner_deg`.
@@ -106,9 +141,7 @@ pub fn is_corner(a: &LinearMove, m: &LinearMove, c: &LinearMove, corner_deg: f64
 /// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
 /// run; `may_join(k)`: block k may follow block k - 1 in one; `may_end(k, e)`: a fitted
 /// block may end at block k of a run that could go on to block e (the run is cut back to
-/// the last such block, and the moves after it stay as they are); `inverse(k)`: block k's
-/// feed was programmed in inverse time (`G93`), so the run's feeds may spread by
-/// [`INVERSE_FEED_SPREAD`].
+/// the last such block, and the moves after it stay as they are).
 pub fn find_runs(
     program: &Program,
     kin: &MachineKinematics,
@@ -116,9 +149,8 @@ pub fn find_runs(
     may_start: impl Fn(usize) -> bool,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
-    inverse: impl Fn(usize) -> bool,
 ) -> Vec<Found> {
-    find_open_runs(program, kin, opts, may_start, may_join, may_end, inverse).0
+    find_open_runs(program, kin, opts, may_start, may_join, may_end).0
 }
 
 /// [`find_runs`], and the first block of the run that reaches the program's last block,
@@ -131,7 +163,6 @@ pub fn find_open_runs(
     may_start: impl Fn(usize) -> bool,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
-    inverse: impl Fn(usize) -> bool,
 ) -> (Vec<Found>, Option<usize>) {
     let linear = |b: usize| match program.blocks.get(b) {
         Some(Block::Linear(m)) => Some(m),
@@ -149,16 +180,6 @@ pub fn find_open_runs(
         };
         is_corner(a, m, c, opts.corner_deg)
     };
-    // A move joins a run at its feed (within the spread under G93), tool length and mode.
-    let same = |b: usize, first: &LinearMove, k: usize, m: &LinearMove| {
-        let ((feed, length, mode), (feed0, length0, mode0)) = (run_key(m), run_key(first));
-        let feeds = match (inverse(b), inverse(k)) {
-            (true, true) => (feed - feed0).abs() <= INVERSE_FEED_SPREAD * feed0,
-            (false, false) => feed == feed0,
-            _ => false,
-        };
-        feeds && length == length0 && mode == mode0
-    };
     let mut runs = Vec::new();
     let mut open = None;
     let mut b = 1;
@@ -171,7 +192,7 @@ pub fn find_open_runs(
         while e + 1 < program.blocks.len()
             && eligible(e + 1)
             && may_join(e + 1)
-            && linear(e + 1).is_some_and(|m| same(b, first, e + 1, m) && !m.tooling.wait.is_some())
+            && linear(e + 1).is_some_and(|m| same_run(first, m) && !m.tooling.wait.is_some())
             && !corner(e)
         {
             e += 1;
@@ -187,19 +208,9 @@ pub fn find_open_runs(
             let points: Vec<Point> = (b - 1..=end)
                 .filter_map(|k| linear(k).map(|m| point(m, kin)))
                 .collect();
-            // Under G93 each move took its length over its feed (the parser's own measure).
-            let inverse_minutes = inverse(b).then(|| {
-                (b..=end)
-                    .zip(points.windows(2))
-                    .filter_map(|(k, w)| {
-                        linear(k).map(|m| (w[1].p - w[0].p).norm() / m.feed_mm_min)
-                    })
-                    .sum::<f64>()
-            });
-            let length: f64 = points.windows(2).map(|w| (w[1].p - w[0].p).norm()).sum();
-            let feed_mm_min = inverse_minutes.map_or(first.feed_mm_min, |t| length / t);
-            // (A run in inverse time at a speed no feed per minute can give stays as it is.)
-            if (MIN_FEED_MM_MIN..=MAX_FEED_MM_MIN).contains(&feed_mm_min) {
+            if let Some((feed_mm_min, inverse_minutes)) =
+                run_feed((b..=end).filter_map(linear), &points)
+            {
                 runs.push(Found {
                     blocks: (b, end),
                     reach: e,

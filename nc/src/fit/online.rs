@@ -7,7 +7,7 @@
 //! those [`super::compress::compress`] makes of the whole program (tested).
 
 use super::compress::{fitted_block, Compressed};
-use super::find::{is_corner, may_follow, point, run_key};
+use super::find::{is_corner, may_follow, point, run_feed, same_run};
 use super::runs::Options;
 use super::{fit, Point};
 use crate::kinematics::MachineKinematics;
@@ -89,31 +89,35 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
         if moves.is_empty() {
             return;
         }
-        let min_moves = opts.min_moves;
-        let fitted = (moves.len() >= min_moves)
-            .then(|| fit(&self.points, opts.tol, opts.degree))
+        // As `find_runs`: a run too short, or in inverse time at a speed no feed per minute
+        // can give, is no run; one the fit cannot bring within the tolerances is kept.
+        let feed = (moves.len() >= opts.min_moves)
+            .then(|| run_feed(moves.iter(), &self.points))
             .flatten();
+        let fitted = feed.and_then(|(feed, _)| {
+            let f = fit(&self.points, opts.tol, opts.degree);
+            self.done.runs_kept += usize::from(f.is_none());
+            f.map(|f| (f, feed))
+        });
         match (fitted, moves.first()) {
-            (Some(f), Some(first)) => {
+            (Some((f, feed)), Some(first)) => {
                 self.done.fitted_blocks += 1;
                 self.done.moves_fitted += moves.len();
                 self.done.fit_mm = self.done.fit_mm.max(f.dev_mm);
                 self.done.fit_deg = self.done.fit_deg.max(f.dev_rad.to_degrees());
-                self.give(Block::Nurbs(fitted_block(first, &f)));
+                self.give(Block::Nurbs(fitted_block(first, &f, feed)));
             }
-            (None, _) => {
-                self.done.runs_kept += usize::from(moves.len() >= min_moves);
+            _ => {
                 for m in moves {
                     self.give(Block::Linear(m));
                 }
             }
-            (Some(_), None) => {}
         }
         self.points.clear();
     }
 
-    /// Move `m` joins the run being gathered: it follows the run's last move, shares its
-    /// key, does not wait, and the run's last move is no corner.
+    /// Move `m` joins the run being gathered: it follows the run's last move, has its feed
+    /// and tool length ([`same_run`]), does not wait, and the run's last move is no corner.
     fn joins(&self, m: &LinearMove) -> bool {
         let (Some(last), Some(first), Some(opts)) = (self.run.last(), self.run.first(), &self.opts)
         else {
@@ -126,7 +130,7 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
         };
         self.run.len() < MAX_RUN
             && may_follow(last, m, self.kin)
-            && run_key(m) == run_key(first)
+            && same_run(first, m)
             && !m.tooling.wait.is_some()
             && before.is_some_and(|b| !is_corner(b, last, m, opts.corner_deg))
     }

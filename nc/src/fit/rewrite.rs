@@ -73,8 +73,6 @@ struct Held {
     /// `G90 G21 G94` in effect at its start, and the modal motion `G01` there.
     plain: bool,
     g01: bool,
-    /// `G93` in effect: its feed is inverse time.
-    inverse: bool,
     /// The feed per minute in effect (mm/min).
     g94_feed: Option<f64>,
     /// The program's tilt letter so far.
@@ -87,7 +85,6 @@ struct Line {
     no: u32,
     plain: bool,
     g01: bool,
-    inverse: bool,
 }
 
 struct State<'a, W> {
@@ -136,7 +133,6 @@ impl<W: Write> State<'_, W> {
             ending,
             plain: at.plain,
             g01: at.g01,
-            inverse: at.inverse,
             g94_feed: at.g94_feed,
             tilt: self.modes.tilt,
         });
@@ -146,12 +142,12 @@ impl<W: Write> State<'_, W> {
     /// Input block `i` is read.
     fn on_block(&mut self, i: usize, block: Block) -> Result<(), RewriteError> {
         let no = block.pos().line;
-        let (plain, g01, inverse) = self
+        let (plain, g01) = self
             .held
             .iter()
             .rev()
             .find(|h| h.no == no)
-            .map_or((false, false, false), |h| (h.plain, h.g01, h.inverse));
+            .map_or((false, false), |h| (h.plain, h.g01));
         let joins = matches!(block, Block::Linear(_))
             && plain
             && self
@@ -168,12 +164,7 @@ impl<W: Write> State<'_, W> {
         self.blocks += 1;
         self.check.block(i, &block).map_err(RewriteError::Build)?;
         self.window.blocks.push(block);
-        self.lines.push(Line {
-            no,
-            plain,
-            g01,
-            inverse,
-        });
+        self.lines.push(Line { no, plain, g01 });
         Ok(())
     }
 
@@ -218,7 +209,6 @@ impl<W: Write> State<'_, W> {
                             && lines[k + 1].no == after
                             && restorable(blocks.get(k + 1), lines[k + 1].plain))
                 },
-                |k| lines[k].inverse,
             );
             self.fit_s += t0.elapsed().as_secs_f64();
             // A window cut for its size keeps the run that reaches its end (it is fitted

@@ -114,8 +114,6 @@ pub(super) struct LineModes {
     pub plain: bool,
     /// The modal motion is `G01`.
     pub g01: bool,
-    /// `G93`: its moves' feeds are inverse time.
-    pub inverse: bool,
     /// The modal feed per minute, mm/min (see [`Modes`]).
     pub g94_feed: Option<f64>,
 }
@@ -154,7 +152,6 @@ impl Modes {
         let at_start = LineModes {
             plain: self.abs && self.mm && (self.feed == 940 || self.feed == 930),
             g01: self.motion == 10,
-            inverse: self.feed == 930,
             g94_feed: self.g94_feed,
         };
         let code = strip_comments(line);
@@ -355,8 +352,6 @@ pub fn fit_program(
             && lines.get(l - 1).is_some_and(|t| pure_move_line(t))
             && modes.get(l - 1).is_some_and(|m| m.0.plain)
     };
-    let inverse =
-        |b: usize| line_of(b) >= 1 && modes.get(line_of(b) - 1).is_some_and(|m| m.0.inverse);
     let found = find_runs(
         program,
         kin,
@@ -371,7 +366,6 @@ pub fn fit_program(
                     && line_of(k + 1) == line_of(k) + 1
                     && restorable(program.blocks.get(k + 1), plain_line(k + 1)))
         },
-        inverse,
     );
     let mut summary = Summary {
         blocks_in: program.blocks.len(),

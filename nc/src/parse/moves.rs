@@ -111,6 +111,7 @@ impl Parser<'_> {
             end,
             orientation: self.orientation,
             feed_mm_min: 0.0,
+            inverse_time: false,
             tooling,
         }));
         self.here = Some(end);
@@ -197,6 +198,7 @@ impl Parser<'_> {
             end,
             orientation,
             feed_mm_min,
+            inverse_time: !rapid && self.modal.inverse_time,
             tooling,
         }));
     }
