@@ -4,7 +4,9 @@
 //! `q''' = q_s s''' + 3 q_ss s' s'' + q_sss s'^3` (derivatives of the joints by path length
 //! at the stations, `s'` the path speed). The path terms `q_s s''` and `q_s s'''` get what
 //! the curvature terms leave of each axis's share, at the highest speed the section can
-//! have at each station: a straight stretch gets the whole share, a curved one less.
+//! have at each station: a straight stretch gets the whole share, a curved one less. The
+//! jerk's term `3 q_ss s' s''` is taken at the most `s' s''` an S-curve ramp can reach
+//! there ([`speed_times_acc`]), not at the highest speed and acceleration at once.
 
 use super::stations::{Rates, Station};
 use super::{AxisLimit, PlanConfig, A_FLOOR};
@@ -31,11 +33,13 @@ fn side(stations: &[Station], i: usize) -> &Rates {
     }
 }
 
-/// Path acceleration and jerk allowed over `stations`, at most `speed(station)` there.
+/// Path acceleration and jerk allowed over `stations`, at most `speed(station)` there, in a
+/// section no faster than `vmax`.
 fn limits_over(
     stations: &[Station],
     cfg: &PlanConfig,
     speed: impl Fn(&Station) -> f64,
+    vmax: f64,
 ) -> (f64, f64) {
     let acc = least_left(
         stations,
@@ -51,7 +55,11 @@ fn limits_over(
         &speed,
         cfg.path_jerk,
         |ax| ax.jerk,
-        |r, j, v| 3.0 * r.d2(j) * v * acc + r.d3(j) * v * v * v,
+        // The ramps' jerk is at most this pass's result, itself at most the path's: the
+        // bound at the path's jerk holds for any of them.
+        |r, j, v| {
+            3.0 * r.d2(j) * speed_times_acc(v, vmax, acc, cfg.path_jerk) + r.d3(j) * v * v * v
+        },
     );
     (acc, jerk)
 }
@@ -84,9 +92,28 @@ fn least_left(
     out.max(A_FLOOR)
 }
 
+/// The most `s' |s''|` can be at a station the section passes at most at `v`, in a section
+/// no faster than `vmax` whose ramps reach at most acceleration `acc` and change it at most
+/// at `jerk`. A ramp at acceleration `x` is at least `x^2 / (2 jerk)` below the speed it
+/// rises to or falls from (in each of its phases the acceleration must still fall to zero
+/// or has risen from it), so `s' |s''| <= x min(v, vmax - x^2 / (2 jerk))` over `x` in
+/// `0..=acc`: `x v` up to where the two meet, then `x (vmax - x^2 / (2 jerk))`, which
+/// peaks at `x = sqrt(2 jerk vmax / 3)`. Near the feed the acceleration is low, and near
+/// the highest acceleration the speed is.
+fn speed_times_acc(v: f64, vmax: f64, acc: f64, jerk: f64) -> f64 {
+    let meet = (2.0 * jerk * (vmax - v).max(0.0)).sqrt();
+    if acc <= meet {
+        return acc * v;
+    }
+    let x = (2.0 * jerk * vmax / 3.0).sqrt().clamp(meet, acc);
+    (x * (vmax - x * x / (2.0 * jerk)).max(0.0)).max(meet * v)
+}
+
 /// Path acceleration and jerk allowed over stations `a..=b` at their ceilings.
 pub(super) fn section_limits(st: &[Station], a: usize, b: usize, cfg: &PlanConfig) -> (f64, f64) {
-    limits_over(&st[a..=b], cfg, |s| s.vlim)
+    let stations = &st[a..=b];
+    let vmax = stations.iter().map(|x| x.vlim).fold(0.0, f64::max);
+    limits_over(stations, cfg, |s| s.vlim, vmax)
 }
 
 /// What rates `r` allow the path at `share` without the curvature terms: no stretch of path that
@@ -163,7 +190,7 @@ pub(super) fn section_ramps(
             .min(fastest(vb, s_b - x.s, ub))
     };
     let stations = &st[a..=b];
-    let mut ramps = Ramps::both(limits_over(stations, cfg, speed));
+    let mut ramps = Ramps::both(limits_over(stations, cfg, speed, vmax));
     for _ in 0..RAMP_ROUNDS {
         // No change between speeds up to vmax takes longer than vmax * its time from
         // rest (one from 0.3 vmax up to vmax covers more than one from rest).
@@ -178,8 +205,8 @@ pub(super) fn section_ramps(
             .partition_point(|x| x.s <= s_b - d1)
             .saturating_sub(1);
         ramps = Ramps {
-            start: limits_over(&stations[..=hi], cfg, speed),
-            end: limits_over(&stations[lo..], cfg, speed),
+            start: limits_over(&stations[..=hi], cfg, speed, vmax),
+            end: limits_over(&stations[lo..], cfg, speed, vmax),
         };
     }
     ramps
@@ -257,6 +284,46 @@ mod tests {
         // From rest the speed within 0.2 mm stays low, and so does X's curvature term
         // there: more than the least share, which it would get at the ceiling.
         assert!(ramps.start.0 > 0.6 * 2500.0, "{ramps:?}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(500))]
+        /// Whatever a section's speeds, length and limits, at every point of its plan the
+        /// speed times the acceleration is within [`speed_times_acc`] of that speed (the
+        /// bound the jerk's curvature term is taken at).
+        #[test]
+        fn no_section_s_speed_times_acceleration_exceeds_the_bound(
+            (fa, fb) in (0.0f64..1.0, 0.0f64..1.0),
+            len in 0.01f64..50.0,
+            vmax in 1.0f64..200.0,
+            (a0, j0, a1, j1) in (10.0f64..5000.0, 100.0f64..100_000.0, 10.0f64..5000.0, 100.0f64..100_000.0),
+            same in any::<bool>(),
+        ) {
+            let (a1, j1) = if same { (a0, j0) } else { (a1, j1) };
+            let ramps = Ramps { start: (a0, j0), end: (a1, j1) };
+            // The passes leave the lower end reachable from the other.
+            let (mut va, mut vb) = (fa * vmax, fb * vmax);
+            if va > vb {
+                va = va.min(reachable(vb, len, a1, j1));
+            } else {
+                vb = vb.min(reachable(va, len, a0, j0));
+            }
+            let mut phases = Vec::new();
+            push_section(&mut phases, 0.0, 0.0, (va, vb), len, vmax, ramps);
+            for i in 0..=400 {
+                let s = len * i as f64 / 400.0;
+                let (p, tau) = state_at(&phases, s).expect("a phase at every point");
+                let m = p.at(tau);
+                // Each point is on one of the two ramps (or between them, at zero
+                // acceleration): within the larger of their bounds, or its own when they
+                // are the same.
+                let bound = speed_times_acc(m.v, vmax, a0, j0).max(speed_times_acc(m.v, vmax, a1, j1));
+                prop_assert!(
+                    m.v * m.a.abs() <= bound * (1.0 + 1e-9) + 1e-9,
+                    "at {s}: v {} a {} bound {bound}", m.v, m.a
+                );
+            }
+        }
     }
 
     proptest! {
