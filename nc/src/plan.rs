@@ -539,13 +539,16 @@ fn schedule(
 
     let mut phases = Vec::new();
     for round in 0..ROUNDS_MAX {
+        // Every speed a section can have: its stations' ceilings, and its ends' speeds (the
+        // window's start is at the committed speed, which a ceiling lowered since may be
+        // below).
         let vmax: Vec<f64> = crit
             .windows(2)
             .map(|w| {
                 st[w[0].0..=w[1].0]
                     .iter()
                     .map(|x| x.vlim)
-                    .fold(0.0, f64::max)
+                    .fold(w[0].1.max(w[1].1), f64::max)
             })
             .collect();
         let limits: Vec<Ramps> = crit
