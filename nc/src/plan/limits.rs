@@ -49,18 +49,16 @@ fn limits_over(
         |ax| ax.acceleration,
         |r, j, v| r.d2(j) * v * v,
     );
+    // The ramps' jerk is at most this pass's result, itself at most the path's (or the
+    // floor): the bound at that jerk holds for any of them.
+    let most = cfg.path_jerk.max(A_FLOOR);
     let jerk = least_left(
         stations,
         cfg,
         &speed,
         cfg.path_jerk,
         |ax| ax.jerk,
-        // The ramps' jerk is at most this pass's result, itself at most the path's (or the
-        // floor): the bound at that jerk holds for any of them.
-        |r, j, v| {
-            let most = cfg.path_jerk.max(A_FLOOR);
-            3.0 * r.d2(j) * speed_times_acc(v, vmax, acc, most) + r.d3(j) * v * v * v
-        },
+        |r, j, v| 3.0 * r.d2(j) * speed_times_acc(v, vmax, acc, most) + r.d3(j) * v * v * v,
     );
     (acc, jerk)
 }
