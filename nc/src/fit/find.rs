@@ -116,13 +116,13 @@ pub fn run_feed<'m>(
     if !first.inverse_time {
         return Some((first.feed_mm_min, None));
     }
-    let chord = |w: &[Point]| (w[1].p - w[0].p).norm();
-    let minutes: f64 = core::iter::once(first)
+    let (length, minutes) = core::iter::once(first)
         .chain(moves)
         .zip(points.windows(2))
-        .map(|(m, w)| chord(w) / m.feed_mm_min)
-        .sum();
-    let length: f64 = points.windows(2).map(chord).sum();
+        .fold((0.0, 0.0), |(length, minutes), (m, w)| {
+            let chord = (w[1].p - w[0].p).norm();
+            (length + chord, minutes + chord / m.feed_mm_min)
+        });
     let feed = length / minutes;
     (MIN_FEED_MM_MIN..=MAX_FEED_MM_MIN)
         .contains(&feed)
