@@ -5,8 +5,8 @@
 //! Blocks b..=e form a run when each is a feed move (`G01`, not rapid) that follows a
 //! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`], has the
 //! run's feed (within [`INVERSE_FEED_SPREAD`] under `G93`) and tool length and no wait
-//! before it (but the first), and no two of them
-//! meet at a corner sharper than the corner angle; the caller adds its own conditions for
+//! before it (but the first), keeps the tool vertical if the first does and only then
+//! ([`keeps_vertical`]), and no two of them meet at a corner sharper than the corner angle; the caller adds its own conditions for
 //! a run's first move and for each move that joins it.
 
 use super::runs::Options;
@@ -87,6 +87,18 @@ pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) ->
         _ => pa.axis.angle(&pb.axis).to_degrees(),
     };
     !m.rapid && (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
+}
+
+/// The move to `m` from `prev`'s end keeps the tool vertical (within
+/// [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO) at both ends), where a table's C is
+/// undefined and the interpolator keeps it. A run holds such moves only, or none of them: a
+/// fitted orientation curve is exactly vertical only where all its data are, and a tool a
+/// hair off the vertical has C follow its azimuth, anywhere round the table (a pass that
+/// tilts to the vertical and stays there, fitted whole, was refused by the planner where
+/// the moves as posted ran: `nc/tests/compressed_posts.rs`).
+pub fn keeps_vertical(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) -> bool {
+    let vertical = |t: Vector3<f64>| t.x.hypot(t.y) < crate::kinematics::VERTICAL_RHO;
+    vertical(point(prev, kin).axis) && vertical(point(m, kin).axis)
 }
 
 /// Move `m` has the feed, tool length and mode of the run `first` begins: the same feed
@@ -174,6 +186,9 @@ pub fn find_open_runs(
         };
         may_follow(prev, m, kin)
     };
+    let vertical = |b: usize| -> bool {
+        matches!((b.checked_sub(1).and_then(linear), linear(b)), (Some(prev), Some(m)) if keeps_vertical(prev, m, kin))
+    };
     let corner = |b: usize| -> bool {
         let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {
             return true;
@@ -189,8 +204,10 @@ pub fn find_open_runs(
             continue;
         };
         let mut e = b;
+        let upright = vertical(b);
         while e + 1 < program.blocks.len()
             && eligible(e + 1)
+            && vertical(e + 1) == upright
             && may_join(e + 1)
             && linear(e + 1).is_some_and(|m| same_run(first, m) && !m.tooling.wait.is_some())
             && !corner(e)

@@ -10,7 +10,9 @@
 //! the angle tolerance, or the curve bulges away from a move's chord by more than the
 //! tolerance and the sag of the arc the neighbouring moves turn on (the NURBS Book 9.4; the
 //! normal equations are banded and solved by Cholesky). Each insertion splits the data in
-//! the span in two, so a run costs a few refits, each linear in its points.
+//! the span in two, so a run costs a few refits, each linear in its points. Near the vertical,
+//! where a table's C follows the tool axis's azimuth, a span also fails where the fitted axis
+//! turns about the vertical more than the programmed great circles do.
 //!
 //! [`runs`] finds the runs in a program's text and writes the result; [`rewrite`] does the
 //! same as the text is read, a window of moves at a time (what `dnurbs fit` runs), and
@@ -36,6 +38,18 @@ pub const ROT_MM: f64 = 10.0;
 const MAX_ROUNDS: usize = 60;
 /// Parameter corrections per refit.
 const CORRECTIONS: usize = 3;
+/// Where a move's programmed tool axis is within this of the vertical (rad, 5 degrees), the
+/// fitted axis's turn about the vertical along the move is checked: a table's C follows that
+/// turn, and a fitted axis within the angle tolerance of the programmed ones can pass the
+/// vertical on the other side, where C swings half a turn (farther out, a 0.01 degree
+/// tolerance moves the azimuth by at most 0.12 degrees).
+const NEAR_VERTICAL: f64 = 0.09;
+/// How much more (rad, a quarter of a degree) the fitted axis may turn about the vertical
+/// over a move than the great circle between the move's programmed axes does (what
+/// `G01 I J K` interpolates).
+const TURN_SLACK: f64 = 0.0044;
+/// Samples per move of that check.
+const TURN_SAMPLES: usize = 8;
 
 /// Position and tool-axis tolerances.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -125,6 +139,50 @@ fn bulge_allowance(points: &[Point], k: usize, tol: f64) -> f64 {
     tol + 0.5 * h * theta
 }
 
+/// How far `tool(f)` turns about the vertical for f in 0..=1: the azimuth of its horizontal
+/// part, sampled, its changes summed in magnitude (rad). Samples within
+/// [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO) of the vertical, where the interpolator
+/// keeps C, are skipped.
+fn turn_about_vertical(tool: impl Fn(f64) -> Vector3<f64>) -> f64 {
+    let (mut sum, mut last) = (0.0, None);
+    for i in 0..=TURN_SAMPLES {
+        let t = tool(i as f64 / TURN_SAMPLES as f64);
+        let rho = t.x.hypot(t.y);
+        // (NaN fails the comparison and is skipped too.)
+        let tilted = rho >= crate::kinematics::VERTICAL_RHO * t.norm();
+        if !tilted {
+            continue;
+        }
+        let az = t.y.atan2(t.x);
+        if let Some(l) = last {
+            let d: f64 = az - l;
+            // Wrapped into -pi..=pi: a half turn between two samples counts as one.
+            sum += (d - std::f64::consts::TAU * (d / std::f64::consts::TAU).round()).abs();
+        }
+        last = Some(az);
+    }
+    sum
+}
+
+/// The fitted axis turns about the vertical over move k (points k - 1 .. k, at parameters
+/// `u0..u1`) by more than [`TURN_SLACK`] beyond the great circle between its programmed
+/// axes; checked only where one of them is within [`NEAR_VERTICAL`] of the vertical.
+fn turns_more_than_programmed(
+    curve: &Fitted,
+    points: &[Point],
+    k: usize,
+    u0: f64,
+    u1: f64,
+) -> bool {
+    let (a, b) = (points[k - 1].axis, points[k].axis);
+    if a.x.hypot(a.y).min(b.x.hypot(b.y)) >= NEAR_VERTICAL {
+        return false;
+    }
+    let programmed = turn_about_vertical(|f| a + (b - a) * f);
+    let fitted = turn_about_vertical(|f| curve.eval(u0 + (u1 - u0) * f).1);
+    fitted > programmed + TURN_SLACK
+}
+
 /// Fit `points` (at least degree + 1 of them) within `tol`. `None` if nothing moves, or no
 /// curve with fewer control points than points meets the tolerance.
 pub fn fit(points: &[Point], tol: Tolerance, degree: usize) -> Option<Fitted> {
@@ -183,7 +241,9 @@ pub fn fit(points: &[Point], tol: Tolerance, degree: usize) -> Option<Fitted> {
                 let um = 0.5 * (u[k - 1] + u[k]);
                 let (cm, _) = curve.eval(um);
                 let chord = deviation::to_segment(&cm, &points[k - 1].p, &pt.p);
-                if chord > bulge_allowance(points, k, tol.mm) {
+                if chord > bulge_allowance(points, k, tol.mm)
+                    || turns_more_than_programmed(&curve, points, k, u[k - 1], u[k])
+                {
                     fail(um, &mut split);
                 }
             }

@@ -7,7 +7,7 @@
 //! those [`super::compress::compress`] makes of the whole program (tested).
 
 use super::compress::{fitted_block, Compressed};
-use super::find::{is_corner, may_follow, point, run_feed, same_run};
+use super::find::{is_corner, keeps_vertical, may_follow, point, run_feed, same_run};
 use super::runs::Options;
 use super::{fit, Point};
 use crate::kinematics::MachineKinematics;
@@ -117,7 +117,9 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
     }
 
     /// Move `m` joins the run being gathered: it follows the run's last move, has its feed
-    /// and tool length ([`same_run`]), does not wait, and the run's last move is no corner.
+    /// and tool length ([`same_run`]), does not wait, keeps the tool vertical if the run's
+    /// first move does and only then ([`keeps_vertical`]), and the run's last move is no
+    /// corner.
     fn joins(&self, m: &LinearMove) -> bool {
         let (Some(last), Some(first), Some(opts)) = (self.run.last(), self.run.first(), &self.opts)
         else {
@@ -128,9 +130,13 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
             1 => self.prev_of_run.as_ref(),
             n => self.run.get(n - 2),
         };
+        let upright = |prev: Option<&LinearMove>, m: &LinearMove| {
+            prev.is_some_and(|p| keeps_vertical(p, m, self.kin))
+        };
         self.run.len() < MAX_RUN
             && may_follow(last, m, self.kin)
             && same_run(first, m)
+            && upright(Some(last), m) == upright(self.prev_of_run.as_ref(), first)
             && !m.tooling.wait.is_some()
             && before.is_some_and(|b| !is_corner(b, last, m, opts.corner_deg))
     }
