@@ -5,7 +5,7 @@
 use crate::interp::{Interpolator, Method, Setpoint};
 use crate::kinematics::{MachineKinematics, RotaryLimits};
 use crate::plan::{AxisLimit, FeedProfile, PlanConfig};
-use crate::segment::{BuildLimits, Path};
+use crate::segment::{BuildLimits, Geometry, Path};
 use nalgebra::Vector3;
 
 /// The programs of `tests/data` the planner's tests plan on the small mill: the test
@@ -198,4 +198,68 @@ pub fn interpolate(
         }
     }
     None
+}
+
+/// Largest distance between the curve of NURBS segment `seg` and the chord of its setpoints
+/// `a` and `b` (seven points between them): the chord error the generated-input suites
+/// check, 0 on a line.
+pub fn chord_error(path: &Path, seg: usize, a: &Setpoint, b: &Setpoint) -> f64 {
+    let Some(Geometry::Nurbs { curve, .. }) = path.segments.get(seg).map(|s| &s.geometry) else {
+        return 0.0;
+    };
+    let (Some(ua), Some(ub)) = (a.u, b.u) else {
+        return 0.0;
+    };
+    let ab = b.p - a.p;
+    (1..8)
+        .map(|i| {
+            let p = curve.cutter(ua + (ub - ua) * f64::from(i) / 8.0, 0).p;
+            let f = if ab.norm_squared() > 0.0 {
+                ((p - a.p).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (p - (a.p + ab * f)).norm()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Every axis on the four setpoints `w` (oldest first), by finite differences at `period`:
+/// velocity and acceleration on the newest, jerk too if `jerk`, and the travel, each within
+/// `cfg`'s limit (to a relative 1e-6). What the generated-input suites check on every
+/// window of setpoints; the error names the axis, the value, the limit and the time.
+pub fn axes_within(
+    cfg: &PlanConfig,
+    period: f64,
+    w: [&Setpoint; 4],
+    jerk: bool,
+) -> Result<(), String> {
+    let slack = 1.0 + 1e-6;
+    let t = w[3].t;
+    for (j, ax) in cfg.axes.iter().enumerate() {
+        let [q0, q1, q2, q3] = w.map(|x| x.joints[j]);
+        if !q3.is_finite() {
+            return Err(format!("NaN setpoint of axis {j} at t={t}"));
+        }
+        let v = ((q3 - q2) / period).abs();
+        let a = ((q3 - 2.0 * q2 + q1) / period.powi(2)).abs();
+        let jk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / period.powi(3)).abs();
+        let (lo, hi) = cfg.travel[j];
+        if v > ax.velocity * slack {
+            return Err(format!("axis {j} velocity {v} > {} at t={t}", ax.velocity));
+        }
+        if a > ax.acceleration * slack {
+            return Err(format!(
+                "axis {j} acceleration {a} > {} at t={t}",
+                ax.acceleration
+            ));
+        }
+        if jerk && jk > ax.jerk * slack {
+            return Err(format!("axis {j} jerk {jk} > {} at t={t}", ax.jerk));
+        }
+        if q3 < lo - 1e-9 || q3 > hi + 1e-9 {
+            return Err(format!("axis {j} at {q3} outside travel at t={t}"));
+        }
+    }
+    Ok(())
 }

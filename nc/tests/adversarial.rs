@@ -18,7 +18,7 @@ use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::{Kinematics, MachineKinematics};
 use nc::plan::{plan, PlanConfig};
 use nc::prepass::Refused;
-use nc::segment::{build, BuildLimits, Geometry, Path};
+use nc::segment::{build, BuildLimits};
 use proptest::prelude::*;
 use std::fmt::Write;
 
@@ -432,28 +432,6 @@ struct Counts {
     on_stream: AtomicU64,
 }
 
-/// Largest chord error between two setpoints of one NURBS segment.
-fn chord(path: &Path, seg: usize, a: &Setpoint, b: &Setpoint) -> f64 {
-    let Some(Geometry::Nurbs { curve, .. }) = path.segments.get(seg).map(|s| &s.geometry) else {
-        return 0.0;
-    };
-    let (Some(ua), Some(ub)) = (a.u, b.u) else {
-        return 0.0;
-    };
-    let ab = b.p - a.p;
-    (1..8)
-        .map(|i| {
-            let p = curve.cutter(ua + (ub - ua) * f64::from(i) / 8.0, 0).p;
-            let f = if ab.norm_squared() > 0.0 {
-                ((p - a.p).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (p - (a.p + ab * f)).norm()
-        })
-        .fold(0.0, f64::max)
-}
-
 /// A refusal, which must name its line; counted, and shown with `ADV_VERBOSE` (and the
 /// program with `ADV_SRC`).
 fn refused(
@@ -482,8 +460,7 @@ fn refused(
 }
 
 /// Every axis on the four setpoints `w` (oldest first), by finite differences at the
-/// period: velocity and acceleration on the newest, jerk too if `jerk`, and the travel.
-/// `tag` names the run in a failure.
+/// period ([`nc::fixtures::axes_within`]). `tag` names the run in a failure.
 fn axes_hold(
     cfg: &PlanConfig,
     w: [&Setpoint; 4],
@@ -491,38 +468,8 @@ fn axes_hold(
     tag: &dyn std::fmt::Debug,
     src: &str,
 ) -> Result<(), TestCaseError> {
-    let slack = 1.0 + 1e-6;
-    let t = w[3].t;
-    for (j, ax) in cfg.axes.iter().enumerate() {
-        let [q0, q1, q2, q3] = w.map(|x| x.joints[j]);
-        prop_assert!(q3.is_finite(), "{tag:?}: NaN setpoint");
-        let v = ((q3 - q2) / PERIOD).abs();
-        let a = ((q3 - 2.0 * q2 + q1) / PERIOD.powi(2)).abs();
-        prop_assert!(
-            v <= ax.velocity * slack,
-            "{tag:?}: axis {j} velocity {v} > {} at t={t}\n{src}",
-            ax.velocity
-        );
-        prop_assert!(
-            a <= ax.acceleration * slack,
-            "{tag:?}: axis {j} acceleration {a} > {} at t={t}\n{src}",
-            ax.acceleration
-        );
-        if jerk {
-            let jk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / PERIOD.powi(3)).abs();
-            prop_assert!(
-                jk <= ax.jerk * slack,
-                "{tag:?}: axis {j} jerk {jk} > {} at t={t}\n{src}",
-                ax.jerk
-            );
-        }
-        let (lo, hi) = cfg.travel[j];
-        prop_assert!(
-            q3 >= lo - 1e-9 && q3 <= hi + 1e-9,
-            "{tag:?}: axis {j} at {q3} outside travel at t={t}\n{src}"
-        );
-    }
-    Ok(())
+    nc::fixtures::axes_within(cfg, PERIOD, w, jerk)
+        .map_err(|e| TestCaseError::fail(format!("{tag:?}: {e}\n{src}")))
 }
 
 /// Run the case: Ok(()) when refused with a position or when every limit holds.
@@ -634,7 +581,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
         let same_seg = w.iter().all(|x| x.1 == w[0].1) && k >= 3 && k + 4 <= q.len() - 3;
         axes_hold(&cfg, [0, 1, 2, 3].map(|i| &w[i].0), same_seg, &"plan", src)?;
         if w[2].1 == w[3].1 {
-            let e = chord(&path, w[3].1, c, d);
+            let e = nc::fixtures::chord_error(&path, w[3].1, c, d);
             prop_assert!(e <= cfg.chord_tol * slack, "chord {e} at t={}\n{src}", d.t);
         }
     }
