@@ -236,7 +236,7 @@ pub enum PlanErrorKind {
         c_min: f64,
         c_max: f64,
     },
-    #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x its limit of {limit:.4e} {unit}, even at the slowest feed the planner schedules there ({v:.3e} {path_unit}/s){hint}", subject(*.axis), .quantity.name(), .value / .limit)]
+    #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x its limit of {limit:.4e} {unit}, {}{hint}", subject(*.axis), .quantity.name(), .value / .limit, slowest(*.floor, *.v, .path_unit))]
     Limit {
         /// The axis, or `None` for the chord error of the cutter path.
         axis: Option<char>,
@@ -248,7 +248,20 @@ pub enum PlanErrorKind {
         v: f64,
         path_unit: &'static str,
         hint: &'static str,
+        /// `v` is the slowest feed the planner schedules ([`V_FLOOR`]); else its rounds of
+        /// slowing ended above it.
+        floor: bool,
     },
+}
+
+/// How slow the planner went where it refuses: to its floor, or as far as its rounds went
+/// (a slower pass might hold there; the program is refused, not crawled through).
+fn slowest(floor: bool, v: f64, path_unit: &str) -> String {
+    if floor {
+        format!("even at the slowest feed the planner schedules there ({v:.3e} {path_unit}/s)")
+    } else {
+        format!("still after the planner's rounds of slowing there, at {v:.3e} {path_unit}/s")
+    }
 }
 
 /// An axis's travel for a message: an axis without limits (a C that turns endlessly has
@@ -335,6 +348,7 @@ fn refuse(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig, v: &Violation)
                 t: v.t,
                 v: v.v,
                 path_unit: if rotary_only { "deg" } else { "mm" },
+                floor: v.v <= V_FLOOR * 1.01,
                 hint: if v.v <= 0.0 {
                     ": the axis steps while the path stands still (a jump of the rotary solution between blocks)"
                 } else if rotary {
@@ -617,4 +631,39 @@ fn schedule(
         }
     }
     Some(phases)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only a refusal at the planner's floor says no slower feed is scheduled; one above it
+    /// says the rounds of slowing ended there (a refusal at 5.9 mm/s once read as if no
+    /// speed would do).
+    #[test]
+    fn a_refusal_says_whether_the_planner_reached_its_floor() {
+        let limit = |v: f64, floor: bool| PlanErrorKind::Limit {
+            axis: Some('Y'),
+            quantity: Quantity::Jerk,
+            unit: "mm/s^3",
+            value: 50574.0,
+            limit: 50000.0,
+            t: 4.066,
+            v,
+            path_unit: "mm",
+            hint: "",
+            floor,
+        };
+        let above = limit(5.924, false).to_string();
+        assert!(
+            above.contains("still after the planner's rounds of slowing there, at 5.924e0 mm/s")
+                && !above.contains("slowest"),
+            "{above}"
+        );
+        let at = limit(V_FLOOR, true).to_string();
+        assert!(
+            at.contains("even at the slowest feed the planner schedules there (1.000e-3 mm/s)"),
+            "{at}"
+        );
+    }
 }
