@@ -248,19 +248,20 @@ pub enum PlanErrorKind {
         v: f64,
         path_unit: &'static str,
         hint: &'static str,
-        /// `v` is the slowest feed the planner schedules ([`V_FLOOR`]); else its rounds of
-        /// slowing ended above it.
+        /// `v` is the slowest feed the planner schedules ([`V_FLOOR`]); else the planner
+        /// got no slower there.
         floor: bool,
     },
 }
 
-/// How slow the planner went where it refuses: to its floor, or as far as its rounds went
-/// (a slower pass might hold there; the program is refused, not crawled through).
+/// How slow the planner went where it refuses: to its floor, or only as far as it got (its
+/// rounds of slowing ran out, or a lower ceiling no longer changed its plan there): a slower
+/// pass might hold, but the program is refused, not crawled through.
 fn slowest(floor: bool, v: f64, path_unit: &str) -> String {
     if floor {
         format!("even at the slowest feed the planner schedules there ({v:.3e} {path_unit}/s)")
     } else {
-        format!("still after the planner's rounds of slowing there, at {v:.3e} {path_unit}/s")
+        format!("at {v:.3e} {path_unit}/s, the slowest the planner reached there")
     }
 }
 
@@ -638,8 +639,8 @@ mod tests {
     use super::*;
 
     /// Only a refusal at the planner's floor says no slower feed is scheduled; one above it
-    /// says the rounds of slowing ended there (a refusal at 5.9 mm/s once read as if no
-    /// speed would do).
+    /// says how slow the planner got (a refusal at 5.9 mm/s once read as if no speed would
+    /// do).
     #[test]
     fn a_refusal_says_whether_the_planner_reached_its_floor() {
         let limit = |v: f64, floor: bool| PlanErrorKind::Limit {
@@ -656,8 +657,8 @@ mod tests {
         };
         let above = limit(5.924, false).to_string();
         assert!(
-            above.contains("still after the planner's rounds of slowing there, at 5.924e0 mm/s")
-                && !above.contains("slowest"),
+            above.contains("at 5.924e0 mm/s, the slowest the planner reached there")
+                && !above.contains("even at the slowest feed"),
             "{above}"
         );
         let at = limit(V_FLOOR, true).to_string();
