@@ -6,8 +6,9 @@
 //! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`], has the
 //! run's feed (within [`INVERSE_FEED_SPREAD`] under `G93`) and tool length and no wait
 //! before it (but the first), keeps the tool vertical if the first does and only then
-//! ([`keeps_vertical`]), and no two of them meet at a corner sharper than the corner angle; the caller adds its own conditions for
-//! a run's first move and for each move that joins it.
+//! ([`keeps_vertical`]), and no two of them meet at a corner sharper than the corner angle;
+//! the caller adds its own conditions for a run's first move and for each move that joins
+//! it.
 
 use super::runs::Options;
 use super::{fit, Fitted, Point};
@@ -187,7 +188,10 @@ pub fn find_open_runs(
         may_follow(prev, m, kin)
     };
     let vertical = |b: usize| -> bool {
-        matches!((b.checked_sub(1).and_then(linear), linear(b)), (Some(prev), Some(m)) if keeps_vertical(prev, m, kin))
+        let (Some(prev), Some(m)) = (b.checked_sub(1).and_then(linear), linear(b)) else {
+            return false;
+        };
+        keeps_vertical(prev, m, kin)
     };
     let corner = |b: usize| -> bool {
         let (Some(a), Some(m), Some(c)) = (linear(b - 1), linear(b), linear(b + 1)) else {

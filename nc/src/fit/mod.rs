@@ -166,7 +166,11 @@ fn turn_about_vertical(tool: impl Fn(f64) -> Vector3<f64>) -> f64 {
 
 /// The fitted axis turns about the vertical over move k (points k - 1 .. k, at parameters
 /// `u0..u1`) by more than [`TURN_SLACK`] beyond the great circle between its programmed
-/// axes; checked only where one of them is within [`NEAR_VERTICAL`] of the vertical.
+/// axes; checked only where one of them is within [`NEAR_VERTICAL`] of the vertical, and
+/// not where both are vertical: a run holds such moves only with others like them
+/// ([`find::keeps_vertical`]), and its fitted axis is then as vertical as its data (the
+/// horizontal parts of the tool rows of the least squares are zero, or below
+/// [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO)).
 fn turns_more_than_programmed(
     curve: &Fitted,
     points: &[Point],
@@ -175,7 +179,9 @@ fn turns_more_than_programmed(
     u1: f64,
 ) -> bool {
     let (a, b) = (points[k - 1].axis, points[k].axis);
-    if a.x.hypot(a.y).min(b.x.hypot(b.y)) >= NEAR_VERTICAL {
+    let (ra, rb) = (a.x.hypot(a.y), b.x.hypot(b.y));
+    let vertical = crate::kinematics::VERTICAL_RHO;
+    if ra.min(rb) >= NEAR_VERTICAL || ra.max(rb) < vertical {
         return false;
     }
     let programmed = turn_about_vertical(|f| a + (b - a) * f);
