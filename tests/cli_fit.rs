@@ -318,58 +318,68 @@ fn fit_writes_into_a_link_and_keeps_it_a_link() {
 
 /// SIGINT while `dnurbs fit` works ends it with exit 4 and says so: the output it replaces
 /// is left as it was and the partial file beside it is removed. (The signal is sent once
-/// the partial file exists, so the fit is under way, whatever the machine's speed.)
+/// the partial file exists, so the fit is under way; on a loaded machine the test thread
+/// can be held off until the fit has ended, exit 0 in a clean-clone CI run: then it tries
+/// again with a program three times longer, at most twice.)
 #[test]
 fn fit_stopped_by_sigint_writes_nothing_and_leaves_nothing() {
     use std::io::Read;
     use std::process::{Command, Stdio};
     let dir = temp("fit-sigint");
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let (src, out) = (dir.join("long.nc"), dir.join("out.nc"));
-    std::fs::write(&src, helix(100_000)).unwrap();
-    std::fs::write(&out, "old\n").unwrap();
-    let mach = machine("paper-ac-table.toml");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
-        .args(["fit", src.to_str().unwrap(), "-m", mach.to_str().unwrap()])
-        .args(["-o", out.to_str().unwrap()])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("dnurbs runs");
-    let partial = || {
-        std::fs::read_dir(&dir).unwrap().any(|e| {
-            e.unwrap()
-                .file_name()
-                .to_string_lossy()
-                .ends_with(".partial")
-        })
-    };
-    while !partial() {
-        if let Some(status) = child.try_wait().unwrap() {
-            panic!("dnurbs fit ended ({status}) before it began to write");
+    for n in [100_000, 300_000, 900_000] {
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let (src, out) = (dir.join("long.nc"), dir.join("out.nc"));
+        std::fs::write(&src, helix(n)).unwrap();
+        std::fs::write(&out, "old\n").unwrap();
+        let mach = machine("paper-ac-table.toml");
+        let mut child = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+            .args(["fit", src.to_str().unwrap(), "-m", mach.to_str().unwrap()])
+            .args(["-o", out.to_str().unwrap()])
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("dnurbs runs");
+        let partial = || {
+            std::fs::read_dir(&dir).unwrap().any(|e| {
+                e.unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(".partial")
+            })
+        };
+        while !partial() {
+            if let Some(status) = child.try_wait().unwrap() {
+                panic!("dnurbs fit ended ({status}) before it began to write");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
         }
-        std::thread::sleep(std::time::Duration::from_millis(5));
+        let _ = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        let mut err = String::new();
+        child
+            .stderr
+            .take()
+            .unwrap()
+            .read_to_string(&mut err)
+            .unwrap();
+        let status = child.wait().unwrap();
+        if status.code() == Some(0) && n < 900_000 {
+            // The fit ended before the signal came: not what this test is about.
+            assert!(err.contains("fitted into"), "{err}");
+            continue;
+        }
+        assert_eq!(status.code(), Some(4), "{err}");
+        assert!(
+            err.contains("stop requested (SIGINT/SIGTERM) while fitting")
+                && err.contains("nothing written"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old\n");
+        assert!(!partial(), "a partial file is left");
+        let _ = std::fs::remove_dir_all(&dir);
+        return;
     }
-    let _ = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(4), "{err}");
-    assert!(
-        err.contains("stop requested (SIGINT/SIGTERM) while fitting")
-            && err.contains("nothing written"),
-        "{err}"
-    );
-    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old\n");
-    assert!(!partial(), "a partial file is left");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A file `-o` replaces keeps its permissions (the fitted program is written beside it and
