@@ -205,7 +205,7 @@ fn program(start: [f64; 3], passes: &[Pass], decimals: usize, modal: bool) -> St
     let fmt = |x: f64| format!("{x:.decimals$}");
     let mut here = Vector3::from(start);
     let (mut a_deg, mut c_deg) = (0.0f64, 0.0f64);
-    let mut axis = Vector3::z();
+    let rotary = machine().0.rotary;
     let _ = writeln!(
         s,
         "N10 G01 X{} Y{} Z{} I0 J0 K1 F1000",
@@ -269,35 +269,23 @@ fn program(start: [f64; 3], passes: &[Pass], decimals: usize, modal: bool) -> St
             }
             let tilt = (pass.tilt + pass.swing * (std::f64::consts::TAU * t).sin()).max(0.0);
             let azimuth = azimuth0 + pass.azimuth_turn * t;
+            // The programmed tool axis: tilted from the vertical toward the azimuth.
+            let want = {
+                let (st, ct) = tilt.to_radians().sin_cos();
+                let (sa, ca) = azimuth.to_radians().sin_cos();
+                Vector3::new(st * ca, st * sa, ct)
+            };
             let tool = match pass.tool {
                 ToolWords::None => String::new(),
-                ToolWords::Ijk => {
-                    let (st, ct) = tilt.to_radians().sin_cos();
-                    let (sa, ca) = azimuth.to_radians().sin_cos();
-                    axis = Vector3::new(st * ca, st * sa, ct);
-                    format!(" I{:.6} J{:.6} K{:.6}", axis.x, axis.y, axis.z)
-                }
+                ToolWords::Ijk => format!(" I{:.6} J{:.6} K{:.6}", want.x, want.y, want.z),
                 ToolWords::Angles => {
                     // The post's own inverse kinematics, nearest the last angles.
-                    let want = {
-                        let (st, ct) = tilt.to_radians().sin_cos();
-                        let (sa, ca) = azimuth.to_radians().sin_cos();
-                        Vector3::new(st * ca, st * sa, ct)
-                    };
-                    let (a, c) = kin.angles(
-                        &want,
-                        (a_deg.to_radians(), c_deg.to_radians()),
-                        &nc::kinematics::RotaryLimits {
-                            tilt: ((-95f64).to_radians(), 95f64.to_radians()),
-                            c: (f64::NEG_INFINITY, f64::INFINITY),
-                        },
-                    );
+                    let (a, c) =
+                        kin.angles(&want, (a_deg.to_radians(), c_deg.to_radians()), &rotary);
                     (a_deg, c_deg) = (a.to_degrees(), c.to_degrees());
-                    axis = kin.tool_axis(a, c);
                     format!(" A{:.4} C{:.4}", a_deg, c_deg)
                 }
             };
-            let _ = axis;
             let xyz = [fmt(p.x), fmt(p.y), fmt(p.z)];
             let mut words = String::new();
             for (i, letter) in ['X', 'Y', 'Z'].iter().enumerate() {
