@@ -355,16 +355,30 @@ mod tests {
         found
     }
 
+    /// The threads named `name` once those that have ended are gone. `join` returns when
+    /// the kernel wakes it at the thread's exit, a moment before /proc stops listing the
+    /// task, so a thread that ended may still show; one that still spins shows all 5 s.
+    fn threads_left(name: &str) -> Vec<(i32, usize)> {
+        let deadline = now() + 5_000_000_000;
+        loop {
+            let found = threads_named(name);
+            if found.is_empty() || now() > deadline {
+                return found;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+    }
+
     #[test]
     fn the_idle_poller_runs_at_sched_idle_on_its_cpu_until_dropped() {
         let poller = IdlePoller::start(0).unwrap();
         assert_eq!(threads_named("dnurbs-poll"), [(nix::libc::SCHED_IDLE, 0)]);
         drop(poller);
-        assert_eq!(threads_named("dnurbs-poll"), []);
+        assert_eq!(threads_left("dnurbs-poll"), []);
         // A CPU the machine does not have: an error naming it, and no thread left spinning.
         let e = IdlePoller::start(4095).err().unwrap();
         assert!(matches!(e, RtError::Affinity { cpu: 4095, .. }), "{e:?}");
-        assert_eq!(threads_named("dnurbs-poll"), []);
+        assert_eq!(threads_left("dnurbs-poll"), []);
     }
 
     #[test]
