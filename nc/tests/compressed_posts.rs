@@ -28,6 +28,7 @@
 
 use nalgebra::Vector3;
 use nc::fit::compress::compress;
+use nc::fit::deviation::measure;
 use nc::fit::find::point;
 use nc::fit::runs::Options;
 use nc::interp::{Interpolator, Method, Setpoint};
@@ -453,6 +454,7 @@ struct Counts {
     moves: u64,
     blocks: u64,
     regressed: u64,
+    measured: u64,
 }
 
 fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
@@ -466,13 +468,13 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
         }
     };
     // As posted: whether it is accepted (then compressed it must be too).
-    let plain = build(&posted, &kin, &bl)
-        .map_err(|e| (e.pos.line, e.to_string()))
-        .and_then(|p| {
-            plan(&p, &kin, &cfg)
-                .map(|_| ())
-                .map_err(|e| (e.pos.line, e.to_string()))
-        });
+    let posted_path = build(&posted, &kin, &bl);
+    let plain = match &posted_path {
+        Ok(p) => plan(p, &kin, &cfg)
+            .map(|_| ())
+            .map_err(|e| (e.pos.line, e.to_string())),
+        Err(e) => Err((e.pos.line, e.to_string())),
+    };
     let plain_ok = accepted("posted", plain, src)?;
     let (program, c) = compress(&posted, &kin, &opts);
     counts.moves += c.moves_in as u64;
@@ -490,6 +492,17 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
             return accepted("build", Err((e.pos.line, e.to_string())), src).map(|_| ());
         }
     };
+    if let Ok(posted_path) = &posted_path {
+        // What `dnurbs fit` measures before it writes anything, independently of the fit:
+        // it must find the compressed program within the tolerances the fit claims.
+        let dev = measure(posted_path, &path, &kin, 0.005, opts.tol.mm);
+        prop_assert!(
+            dev.point_mm <= opts.tol.mm + 5e-7
+                && dev.point_deg <= opts.tol.rad.to_degrees() * (1.0 + 1e-3),
+            "measured off the posted program: {dev:?}\n{src}"
+        );
+        counts.measured += 1;
+    }
     let profile = match plan(&path, &kin, &cfg) {
         Ok(p) => p,
         Err(e) => {
@@ -558,8 +571,9 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
     let c = counts.into_inner();
     eprintln!(
         "compressed posts (seed {seed}): {cases} cases: accepted and within every limit {}, \
-         refused with a position {} ({} of them accepted as posted); {} of {} moves fitted into {} G06.5 blocks",
-        c.accepted, c.refused, c.regressed, c.fitted_moves, c.moves, c.blocks
+         refused with a position {} ({} of them accepted as posted); {} of {} moves fitted into {} G06.5 blocks; \
+         {} compressed programs measured against their posts",
+        c.accepted, c.refused, c.regressed, c.fitted_moves, c.moves, c.blocks, c.measured
     );
     if let Err(e) = result {
         panic!("{e}");

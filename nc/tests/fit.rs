@@ -27,7 +27,7 @@ fn fit_and_measure(src: &str, opts: &Options) -> (FitOutput, Deviation) {
     let a = build(&input, &KIN, &bl).expect("input builds");
     let b = build(&fitted, &KIN, &bl)
         .unwrap_or_else(|e| panic!("the result does not build: {e}\n{}", out.text));
-    let dev = measure(&a, &b, &KIN, 0.002);
+    let dev = measure(&a, &b, &KIN, 0.002, opts.tol.mm);
     // The streamed rewrite (`dnurbs fit`) writes the very same program, and its own check,
     // a piece at a time, finds it within what the whole paths' check finds plus the sampling.
     let mut streamed = Vec::new();
@@ -318,7 +318,7 @@ fn compressing_a_program_keeps_its_points_and_its_words() {
         build(&program, &KIN, &bl).unwrap(),
         build(&small, &KIN, &bl).unwrap(),
     );
-    within(&measure(&a, &b, &KIN, 0.002), opts.tol);
+    within(&measure(&a, &b, &KIN, 0.002, opts.tol.mm), opts.tol);
     // Each word stands before a block that starts where it started before.
     let start_of = |p: &nc::program::Program, k: usize| match k.checked_sub(1).map(|j| &p.blocks[j])
     {
@@ -430,8 +430,36 @@ fn a_path_measured_against_itself_is_not_off() {
     src.push_str("G01 X0 Y-40 Z10\nG01 A0 C0\nG01 X0.1 Y-40.05\n");
     let (_, bl) = nc::fixtures::small_mill(0.002);
     let path = build(&nc::parse::parse(&src).unwrap(), &KIN, &bl).unwrap();
-    let dev = measure(&path, &path, &KIN, 0.002);
+    let dev = measure(&path, &path, &KIN, 0.002, 0.001);
     assert!(dev.point_mm < 1e-9 && dev.path_mm < 1e-9, "{dev:?}");
     assert!(dev.point_deg < 1e-6, "{dev:?}");
     assert_eq!(dev.points, 206);
+}
+
+/// A program that goes back over its own path (a reversal, as `compressed_posts.rs`
+/// generates them: 3 um forward, back, on) with the tool tilted on the way back, against
+/// an output that passes its first point 0.5 um off and the rest exactly: each point is
+/// taken where the output first passes within the tolerance after the point before, so
+/// 0.5 um and no angle. Taken at the nearest visit instead, the first point went to the
+/// return's exact visit and its tilted tool (1.15 deg); taken from a few samples behind,
+/// the return's point went to the first visit and its vertical tool (both found by
+/// `compressed_posts.rs`).
+#[test]
+fn a_reversal_is_measured_in_the_order_of_its_points() {
+    let (_, bl) = nc::fixtures::small_mill(0.002);
+    let prog = |first_y: f64| {
+        format!(
+            "G01 X0 Y0 Z0 F600\nX1 Y{first_y} I0 J0 K1\nX1.003 Y0\n\
+             X1 Y0 I0 J0.02 K1\nX1.2 Y0\n"
+        )
+    };
+    let path = |src: &str| build(&nc::parse::parse(src).unwrap(), &KIN, &bl).unwrap();
+    let (input, output) = (path(&prog(0.0)), path(&prog(0.0005)));
+    let dev = measure(&input, &output, &KIN, 0.002, 0.001);
+    assert!(
+        dev.point_mm > 0.0004 && dev.point_mm < 0.0005 + 1e-9,
+        "{dev:?}"
+    );
+    assert!(dev.point_deg < 1e-6, "{dev:?}");
+    assert_eq!(dev.points, 5);
 }

@@ -102,7 +102,7 @@ fn a_run_longer_than_the_window_is_cut_on_a_programmed_point() {
         build(&input, &PAPER, &bl).expect("input builds"),
         build(&output, &PAPER, &bl).expect("output builds"),
     );
-    let dev = measure(&a, &b, &PAPER, 0.002);
+    let dev = measure(&a, &b, &PAPER, 0.002, opts.tol.mm);
     assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{dev:?}");
     assert!(
         dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,
@@ -220,7 +220,7 @@ fn fit_checked(
         build(&input, kin, &bl).expect("input builds"),
         build(&output, kin, &bl).expect("output builds"),
     );
-    let dev = measure(&a, &b, kin, 0.002);
+    let dev = measure(&a, &b, kin, 0.002, opts.tol.mm);
     assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{what}: {dev:?}");
     assert!(
         dev.point_deg <= opts.tol.rad.to_degrees() * 1.001,

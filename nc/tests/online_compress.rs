@@ -184,7 +184,7 @@ fn a_run_longer_than_the_window_is_fitted_in_pieces_within_the_tolerances() {
         build(&input, &KIN, &bl).unwrap(),
         build(&output, &KIN, &bl).unwrap(),
     );
-    let dev = measure(&a, &b, &KIN, 0.005);
+    let dev = measure(&a, &b, &KIN, 0.005, opts.tol.mm);
     // As nc/tests/fit.rs allows: the sampling resolves the distance to 0.5 um.
     assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{dev:?}");
 }

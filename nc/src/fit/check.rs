@@ -47,6 +47,9 @@ pub(super) struct Check<'a> {
     kin: &'a MachineKinematics,
     /// Sampling step of the measurement (mm, or degrees on rotary-only segments).
     step: f64,
+    /// The fit's distance tolerance: a point counts where the other path first passes
+    /// within it ([`measure`]).
+    tol_mm: f64,
     input: Builder<'a>,
     in_segs: Vec<Segment>,
     written: Rc<RefCell<VecDeque<String>>>,
@@ -98,14 +101,14 @@ impl Sum {
 }
 
 impl Measurer {
-    fn new(kin: MachineKinematics, step: f64) -> Self {
+    fn new(kin: MachineKinematics, step: f64, tol_mm: f64) -> Self {
         let (tx, rx) = sync_channel::<(Path, Path)>(2);
         let spawned = std::thread::Builder::new()
             .name("dnurbs-fit-check".into())
             .spawn(move || {
                 let mut sum = Sum::default();
                 for (inp, out) in rx {
-                    sum.add(&measure(&inp, &out, &kin, step));
+                    sum.add(&measure(&inp, &out, &kin, step, tol_mm));
                 }
                 sum.dev
             });
@@ -118,7 +121,7 @@ impl Measurer {
         }
     }
 
-    fn measure(&mut self, inp: Path, out: Path, kin: &MachineKinematics, step: f64) {
+    fn measure(&mut self, inp: Path, out: Path, kin: &MachineKinematics, step: f64, tol_mm: f64) {
         match self {
             Measurer::Thread { pieces, .. } => {
                 // The worker ends only when the sender is dropped, or by a panic, which
@@ -127,7 +130,7 @@ impl Measurer {
                     let _ = tx.send((inp, out));
                 }
             }
-            Measurer::Here(sum) => sum.add(&measure(&inp, &out, kin, step)),
+            Measurer::Here(sum) => sum.add(&measure(&inp, &out, kin, step, tol_mm)),
         }
     }
 
@@ -153,6 +156,7 @@ impl<'a> Check<'a> {
         limits: &'a BuildLimits,
         setup: &'a Setup,
         step: f64,
+        tol_mm: f64,
     ) -> Self {
         let written = Rc::new(RefCell::new(VecDeque::new()));
         let queue = Queue {
@@ -163,6 +167,7 @@ impl<'a> Check<'a> {
         Check {
             kin,
             step,
+            tol_mm,
             input: Builder::new(kin, limits),
             in_segs: Vec::new(),
             written,
@@ -171,7 +176,7 @@ impl<'a> Check<'a> {
             out_segs: Vec::new(),
             out_blocks: 0,
             start: None,
-            measurer: Measurer::new(*kin, step),
+            measurer: Measurer::new(*kin, step, tol_mm),
         }
     }
 
@@ -256,7 +261,8 @@ impl<'a> Check<'a> {
             .last()
             .map(|s| (s.pose(s.length), s.src))
             .or(Some(start));
-        self.measurer.measure(inp, out, self.kin, self.step);
+        self.measurer
+            .measure(inp, out, self.kin, self.step, self.tol_mm);
         Ok(())
     }
 

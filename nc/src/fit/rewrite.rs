@@ -379,7 +379,7 @@ pub fn rewrite<R: BufRead, W: Write>(
         blocks: 0,
         summary: Summary::default(),
         out,
-        check: Check::new(kin, limits, setup, step),
+        check: Check::new(kin, limits, setup, step, opts.tol.mm),
         fit_s: 0.0,
         error: None,
         restore: None,
