@@ -370,8 +370,8 @@ fn project(curve: &Fitted, points: &[Point], u: &mut [f64]) -> bool {
     moved
 }
 
-/// Least squares with the end points fixed: the interior control points of the cutter
-/// curve and of the tool vectors, from one set of normal equations.
+/// Least squares with the end points and the corners' points fixed: the other control
+/// points of the cutter curve and of the tool vectors, from one set of normal equations.
 fn solve(
     points: &[Point],
     u: &[f64],
