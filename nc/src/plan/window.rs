@@ -532,6 +532,7 @@ impl Windows<'_> {
         };
         let mut last: Option<WindowPlan> = None;
         let mut round = 0;
+        let mut widened = false;
         loop {
             let Some(phases) = schedule(st, self.starts, cfg, (from.station, from.t, from.v), end)
             else {
@@ -539,6 +540,24 @@ impl Windows<'_> {
             };
             let phases = with_dwells(phases, path, &profile.seg_start, segs.clone());
             if let Some(prev) = &last {
+                if prev.phases == phases && !widened {
+                    // The caps changed nothing. A violation's stencil can reach past the
+                    // stations it holds, onto a ramp the next station's ceiling sets (an
+                    // X jerk 1.09x its limit at 11.3 mm/s past a station capped to 10.6):
+                    // once, the caps go to the stations on either side too.
+                    widened = true;
+                    for v in &prev.checked.violations {
+                        let Some(f) = v.speed_factor().filter(|f| f.is_finite()) else {
+                            continue;
+                        };
+                        let a = st.partition_point(|x| x.s < v.s.0).saturating_sub(1);
+                        let b = st.partition_point(|x| x.s <= v.s.1).min(st.len() - 1);
+                        let share =
+                            matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
+                        super::cap_stations(st, (st[a].s, st[b].s), v.v * f * CAP_MARGIN, share);
+                    }
+                    continue;
+                }
                 if prev.phases == phases {
                     // The caps changed nothing: the violation lies where this window
                     // cannot slow.
@@ -619,6 +638,7 @@ impl Windows<'_> {
                 trace,
             });
             round += 1;
+            widened = false;
         }
     }
 }
