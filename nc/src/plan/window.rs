@@ -35,7 +35,9 @@ use crate::kinematics::{Joints, MachineKinematics};
 use crate::program::SrcPos;
 use crate::scurve::{change_dist, reachable, Phase};
 use crate::segment::{Path, Pose, Segment};
-use crate::verify::{check_from, g2, Checked, Earlier, Margins, Quantity, Trace, MAX_CYCLES};
+use crate::verify::{
+    check_from, g2, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
+};
 
 /// Stopping distances from the top speed that a window commits; one more lies ahead of
 /// what it commits.
@@ -504,6 +506,15 @@ struct Windows<'a> {
     starts: &'a [usize],
 }
 
+/// Cap the stations over `s` for violation `v`, whose speed must drop by `factor`. An
+/// axis's jerk over its limit lowers the path's share of it there too (slowing down does
+/// not lower the path's own term, `q_s s'''`; an acceleration over it is a corner's
+/// velocity jump or the curvature's term, which slowing down lowers).
+fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
+    let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
+    super::cap_stations(st, s, v.v * factor * CAP_MARGIN, share);
+}
+
 impl Windows<'_> {
     /// Plan and check the window from `from` to station `end` (where it stops), after the
     /// profile's first `committed` phases. None where it cannot start at `from`'s speed
@@ -552,9 +563,7 @@ impl Windows<'_> {
                         };
                         let a = st.partition_point(|x| x.s < v.s.0).saturating_sub(1);
                         let b = st.partition_point(|x| x.s <= v.s.1).min(st.len() - 1);
-                        let share =
-                            matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-                        super::cap_stations(st, (st[a].s, st[b].s), v.v * f * CAP_MARGIN, share);
+                        cap_for(st, v, (st[a].s, st[b].s), f);
                     }
                     continue;
                 }
@@ -624,12 +633,7 @@ impl Windows<'_> {
                     // Behind the window's start: only a slower start would help.
                     return Ok(None);
                 }
-                // An axis's jerk over its limit: the path's share of it is lowered there too
-                // (slowing down does not lower the path's own term, `q_s s'''`; an
-                // acceleration over it is a corner's velocity jump or the curvature's
-                // term, which slowing down lowers).
-                let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-                super::cap_stations(st, v.s, v.v * factor * CAP_MARGIN, share);
+                cap_for(st, v, v.s, factor);
             }
             last = Some(WindowPlan {
                 offset: committed,
