@@ -299,7 +299,12 @@ fn merge(a: Wait, b: Wait) -> Wait {
 
 /// Joints at the end of `seg`, reached from `prev` at its start by following the tool
 /// through the segment finely enough (at most 0.25 degree of tool rotation a step) that the
-/// rotary branch is the one the interpolator, stepping along the same path, ends on.
+/// rotary branch is the one the interpolator, stepping along the same path, ends on. A
+/// segment that ends with the tool vertical ends with C where the interpolator last
+/// follows it ([`vertical_edge`]), not where the last step happened to be: a fitted curve
+/// still turns about the vertical as it arrives (0.0037 degrees over its last 1/1024 on a
+/// generated post, a step the first turn after it took in one period, 1.07x C's
+/// acceleration).
 pub fn follow(seg: &Segment, kin: &MachineKinematics, prev: &Joints, lim: &RotaryLimits) -> Joints {
     let steps = match &seg.tooling {
         Tooling::Fixed(_) | Tooling::Angles { .. } => 1,
@@ -309,12 +314,15 @@ pub fn follow(seg: &Segment, kin: &MachineKinematics, prev: &Joints, lim: &Rotar
         Tooling::Curve => 1024,
     };
     let mut q = *prev;
-    for i in 1..=steps {
+    for i in 1..steps {
         q = seg
             .pose(seg.length * i as f64 / steps as f64)
             .joints(kin, &q, lim);
     }
-    q
+    if let Some(edge) = vertical_edge(seg, kin, End::Last) {
+        q = edge.joints(kin, &q, lim);
+    }
+    seg.pose(seg.length).joints(kin, &q, lim)
 }
 
 /// A rotary-only move that turns C from `joints` to `c` at the start of `seg`, at rest,
@@ -357,26 +365,52 @@ fn c_leaving_vertical(
     prev: &Joints,
     lim: &RotaryLimits,
 ) -> Option<f64> {
-    if !matches!(seg.tooling, Tooling::Curve | Tooling::Slerp { .. })
-        || !is_vertical(&seg.pose(0.0).axis(kin))
-    {
+    let t = vertical_edge(seg, kin, End::First)?.axis(kin);
+    Some(kin.angles(&t, (prev[3], prev[4]), lim).1)
+}
+
+/// An end of a segment.
+#[derive(Clone, Copy, PartialEq)]
+enum End {
+    First,
+    Last,
+}
+
+/// Where a segment that starts (ends) with the tool vertical and turns it (or arrives
+/// from a turned tool) crosses the tilt at which the interpolator starts (stops) following
+/// C: the tilt reaching [`VERTICAL_RHO`] nearest that end. Below it the interpolator keeps
+/// C, above it C follows the tool, so C taken anywhere else is off by what C turns on the
+/// way, and the path would step by that much at the segment's end (C turns fast off the
+/// vertical when the tool curve's first horizontal derivative is small: 5.6e-5 rad in the
+/// long run's seed 7 000 006). None for a segment whose tool does not turn, or whose end is
+/// not vertical.
+fn vertical_edge(seg: &Segment, kin: &MachineKinematics, end: End) -> Option<Pose> {
+    if !matches!(seg.tooling, Tooling::Curve | Tooling::Slerp { .. }) {
+        return None;
+    }
+    let at = if end == End::First { 0.0 } else { seg.length };
+    if !is_vertical(&seg.pose(at).axis(kin)) {
         return None;
     }
     // Along the curve's own parameter where there is one: a cutter that starts at rest
     // in u (a repeated first control point) makes s a power of u, too fine near 0 for the
-    // arc-length table.
+    // arc-length table. `x` runs from the end inward.
     let (span, pose): (f64, &dyn Fn(f64) -> Pose) = match &seg.geometry {
         Geometry::Nurbs { curve, table } => {
             let (u0, u1) = (table.u_of_s(curve, 0.0), table.u_of_s(curve, seg.length));
-            (u1 - u0, &move |x| seg.pose_u(curve, table, u0 + x))
+            let from = move |x: f64| if end == End::First { u0 + x } else { u1 - x };
+            (u1 - u0, &move |x| seg.pose_u(curve, table, from(x)))
         }
-        Geometry::Line { .. } => (seg.length, &|x| seg.pose(x)),
+        Geometry::Line { .. } => {
+            let from = move |x: f64| if end == End::First { x } else { seg.length - x };
+            (seg.length, &move |x| seg.pose(from(x)))
+        }
     };
     let tilt = |x: f64| {
         let t = pose(x).axis(kin);
         t.x.hypot(t.y)
     };
-    // Walk out from the start in decades until the tool has left the vertical.
+    // Walk in from the end in decades until the tool has left the vertical.
     let mut out = span * 1e-9;
     while tilt(out) < VERTICAL_RHO {
         if out >= span {
@@ -384,13 +418,8 @@ fn c_leaving_vertical(
         }
         out = (out * 10.0).min(span);
     }
-    // C must start where the interpolator stops holding it: where the tilt first reaches
-    // VERTICAL_RHO (below it C is kept, above it C follows the tool). C taken where the
-    // tilt has grown measurable is off by what C turns on the way there, and the path
-    // would jump by that much where the segment starts (C turns fast off the vertical
-    // when the tool curve's first horizontal derivative is small: 5.6e-5 rad in the long
-    // run's seed 7 000 006). Halve down all the way (a tool can come back near the
-    // vertical before it leaves: the lowest crossing is the first), then bisect.
+    // Halve down all the way (a tool can come back near the vertical before it leaves:
+    // the crossing nearest the end is the one), then bisect.
     let (mut lo, mut hi) = (0.0, out);
     let mut x = out;
     for _ in 0..1100 {
@@ -415,8 +444,7 @@ fn c_leaving_vertical(
             lo = mid;
         }
     }
-    let t = pose(hi).axis(kin);
-    Some(kin.angles(&t, (prev[3], prev[4]), lim).1)
+    Some(pose(hi))
 }
 
 fn linear_tool(m: &LinearMove) -> Tool {
