@@ -19,11 +19,11 @@
 //!   the tool axis there within the fit's angle plus the turn of one period.
 //!
 //! A program accepted as posted is not always accepted compressed: where the fit turns a
-//! kink of the posted path (a point a few micrometres off its neighbours, the tool tilting
-//! onto the vertical) into a tight smooth turn, the planner, which lets a kink step the jerk
+//! kink of the posted path (a point a few micrometres off its neighbours, a tool turning
+//! past the vertical next to a fitted block) into a tight smooth turn, the planner, which lets a kink step the jerk
 //! but holds it along a curve, may find no speed it can schedule there and refuses it with
 //! its position. Those cases are counted and printed (`POST_VERBOSE=1`, and `POST_SRC=1`
-//! for their text), and must stay under a tenth of the programs accepted as posted.
+//! for their text), and must stay under a twentieth of the programs accepted as posted.
 //! Cases: `POST_CASES` (default 64; `.ci/run` sets 256), seed `POST_SEED` (default 0).
 
 use nalgebra::Vector3;
@@ -614,7 +614,7 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
     // programs it runs as posted (README, *On-line compression on generated posts*). It
     // must not grow.
     assert!(
-        c.regressed * 10 <= c.accepted + c.regressed,
+        c.regressed * 20 <= c.accepted + c.regressed,
         "{} of {} programs accepted as posted were refused compressed",
         c.regressed,
         c.accepted + c.regressed
