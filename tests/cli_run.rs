@@ -36,7 +36,17 @@ fn check_demo(extra: &[&str], banner: &str) {
     // drives 79, so a loaded machine cannot starve them), without it otherwise.
     let mut args = vec!["demo", "--report", dir.to_str().unwrap()];
     args.extend(extra);
-    let out = dnurbs(&args);
+    let mut out = dnurbs(&args);
+    if stalled(&out) {
+        // Once: a stall of the whole machine is not the controller's fault, and a fault of
+        // the controller's would come again.
+        eprintln!(
+            "demo {extra:?} lost a drive while its own thread overran (the machine stalled); \
+             running it once more:\n{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        out = dnurbs(&args);
+    }
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     common::assert_completed(&out);
@@ -92,6 +102,56 @@ fn check_demo(extra: &[&str], banner: &str) {
     let hlog = std::fs::read_to_string(dir.join("latency.hlog")).unwrap();
     assert!(hlog.contains("Tag=compute,") && hlog.contains("Tag=wakeup,"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A demo that stopped because a simulated drive went silent (its feedback or heartbeat
+/// past the machine's timeout) while the controller's own thread overran: on a shared,
+/// non-real-time machine (a VM whose CPU the host takes away for tens of milliseconds) the
+/// drives' thread stalls with it, and the master rightly quick-stops the drives. One such
+/// CI run saw a 37.8 ms wake-up and "no TPDO feedback for 11 cycles" (20 ms allowed).
+fn stalled(out: &std::process::Output) -> bool {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let overran = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("overruns: "))
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse::<u64>().ok())
+        .is_some_and(|n| n > 0);
+    let silent = stdout.lines().any(|l| {
+        l.starts_with("outcome: stopped by a fault")
+            && (l.contains("no TPDO feedback") || l.contains("heartbeat"))
+    });
+    out.status.code() == Some(3) && overran && silent
+}
+
+/// Only a silent drive while the controller overran counts as a stall (the CI run's own
+/// lines); a fault without overruns, or another fault, fails the demo at once.
+#[test]
+fn a_stalled_machine_is_told_from_a_fault() {
+    use std::os::unix::process::ExitStatusExt;
+    let out = |code: i32, overruns: u32, cause: &str| std::process::Output {
+        status: std::process::ExitStatus::from_raw(code << 8),
+        stdout: format!(
+            "overruns: {overruns} (longest run 2)   feed holds (planner underruns): 0\n\
+             outcome: stopped by a fault at program line 11 (exit 3): drive fault: node 1: \
+             {cause}; drives quick-stopped and disabled\n"
+        )
+        .into_bytes(),
+        stderr: Vec::new(),
+    };
+    assert!(stalled(&out(3, 239, "no TPDO feedback for 11 cycles")));
+    assert!(stalled(&out(
+        3,
+        1,
+        "heartbeat lost: none for 310 ms (timeout 300 ms)"
+    )));
+    assert!(!stalled(&out(3, 0, "no TPDO feedback for 11 cycles")));
+    assert!(!stalled(&out(
+        3,
+        239,
+        "following error (statusword 0x2637)"
+    )));
+    assert!(!stalled(&out(5, 239, "no TPDO feedback for 11 cycles")));
 }
 
 #[test]
