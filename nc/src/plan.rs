@@ -392,15 +392,20 @@ pub enum ProgramError {
     Unfinished(u64),
 }
 
-/// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.
-fn cap_stations(st: &mut [Station], (s0, s1): (f64, f64), cap: f64, share: Option<f64>) {
+/// The stations in `s0..=s1`, or the two around it: `st[a..b]`.
+fn stations_over(st: &[Station], (s0, s1): (f64, f64)) -> (usize, usize) {
     let a = st.partition_point(|x| x.s < s0);
     let b = st.partition_point(|x| x.s <= s1);
-    let (a, b) = if a < b {
+    if a < b {
         (a, b)
     } else {
         (a.saturating_sub(1), (b + 1).min(st.len()))
-    };
+    }
+}
+
+/// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.
+fn cap_stations(st: &mut [Station], s: (f64, f64), cap: f64, share: Option<f64>) {
+    let (a, b) = stations_over(st, s);
     for x in &mut st[a..b] {
         x.vlim = x.vlim.min(cap).max(V_FLOOR);
         if let Some(share) = share {

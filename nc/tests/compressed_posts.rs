@@ -620,3 +620,21 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
         c.accepted + c.regressed
     );
 }
+
+/// A post the generator wrote (seed 0, cut to the pass change): a `G01` turns the tool 40
+/// degrees past 0.9 degrees from the vertical, where C's rate peaks over 2 um, between the
+/// planner's stations. Compressed, C's jerk stayed 1.04x its limit at the slowest feed
+/// with half the share of it, and the program was refused where it ran as posted; now the
+/// planner lowers the share there further, and the program runs within every limit and
+/// passes its points.
+#[test]
+fn a_tool_turn_past_the_vertical_after_a_fitted_block_runs_compressed() {
+    let src = include_str!("adversarial/a-tool-turn-past-the-vertical-after-a-fitted-block.nc");
+    let mut counts = Counts::default();
+    check(src, &mut counts).unwrap();
+    assert_eq!(
+        (counts.accepted, counts.regressed),
+        (1, 0),
+        "refused compressed"
+    );
+}

@@ -18,8 +18,12 @@ use crate::scurve::{change_time, Ramps};
 pub(super) const AXIS_SHARE: f64 = 0.9;
 /// The least share of an axis's acceleration and jerk the path terms get, however much of
 /// it the curvature terms would take (the setpoint check lowers the ceilings where that is
-/// too much).
+/// too much), unless the check lowered the station's own share below it.
 pub(super) const AXIS_SHARE_LEAST: f64 = 0.5;
+/// The lowest a station's share goes where an axis's jerk stays over its limit at the
+/// slowest feed ([`super::window`]): a path jerk of a thousandth of what the axis allows at
+/// its rate there.
+pub(super) const AXIS_SHARE_FLOOR: f64 = 1e-3;
 /// Rounds of [`section_ramps`]: each narrows the stretch a ramp is limited over.
 const RAMP_ROUNDS: usize = 3;
 
@@ -65,7 +69,8 @@ fn limits_over(
 
 /// The least, over `stations` and the axes that move there, of what each station's share of
 /// `limit(axis)` leaves after `curving(rates, axis, speed)` (never less than the least
-/// share), per unit of `|dq/ds|`; at most `cap`, at least [`A_FLOOR`].
+/// share, or the station's own share where the check lowered it below that), per unit of
+/// `|dq/ds|`; at most `cap`, at least [`A_FLOOR`].
 fn least_left(
     stations: &[Station],
     cfg: &PlanConfig,
@@ -83,7 +88,7 @@ fn least_left(
         for (j, ax) in cfg.axes.iter().enumerate() {
             if r.d1(j) > 1e-15 {
                 let l = limit(ax);
-                let left = (l * share - curving(r, j, v)).max(l * AXIS_SHARE_LEAST);
+                let left = (l * share - curving(r, j, v)).max(l * share.min(AXIS_SHARE_LEAST));
                 out = out.min(left / r.d1(j));
             }
         }
@@ -242,7 +247,8 @@ mod tests {
     }
 
     /// A straight stretch along X gets X's whole share; one the check found over its jerk
-    /// gets the least (as every section did before the curvature terms were counted).
+    /// gets the least (as every section did before the curvature terms were counted), or
+    /// the station's own where the check lowered it below that.
     #[test]
     fn a_straight_stretch_gets_the_axis_share() {
         let cfg = config();
@@ -255,6 +261,10 @@ mod tests {
         st[5].share = AXIS_SHARE_LEAST as f32;
         let (a, j) = section_limits(&st, 0, 10, &cfg);
         assert!(near(a, 0.5 * 2500.0) && near(j, 0.5 * 50000.0), "{a} {j}");
+        // Where the jerk stayed over at the slowest feed the check lowers it further.
+        st[5].share = 0.01;
+        let (a, j) = section_limits(&st, 0, 10, &cfg);
+        assert!(near(a, 0.01 * 2500.0) && near(j, 0.01 * 50000.0), "{a} {j}");
     }
 
     /// A 40 mm section whose middle turns C fast: its ramps are not held to the middle, and
