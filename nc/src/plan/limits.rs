@@ -21,8 +21,8 @@ pub(super) const AXIS_SHARE: f64 = 0.9;
 /// too much), unless the check lowered the station's own share below it.
 pub(super) const AXIS_SHARE_LEAST: f64 = 0.5;
 /// The lowest a station's share goes where an axis's jerk stays over its limit at the
-/// slowest feed ([`super::window`]): a path jerk of a thousandth of what the axis allows at
-/// its rate there.
+/// slowest feed ([`super::window`]): a path jerk and acceleration of a thousandth of what
+/// the axes allow at their rates there.
 pub(super) const AXIS_SHARE_FLOOR: f64 = 1e-3;
 /// Rounds of [`section_ramps`]: each narrows the stretch a ramp is limited over.
 const RAMP_ROUNDS: usize = 3;

@@ -25,8 +25,7 @@
 //! the memory is that of a window or two, whatever the program's length, and the time is
 //! linear in the program.
 
-use super::limits::section_limits;
-use super::limits::AXIS_SHARE_FLOOR;
+use super::limits::{section_limits, AXIS_SHARE_FLOOR};
 use super::stations::Sampler;
 use super::{
     refuse, schedule, too_long, with_dwells, FeedProfile, PlanConfig, PlanError, Station,
@@ -518,8 +517,9 @@ fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
 
 /// An axis's jerk over its limit at the slowest feed, in a window that starts at rest (it
 /// would be refused): the path's own term `q_s s'''` is what is left, so the stations the
-/// stencil holds get a lower share of the axes' jerk, by the ratio the measurement asks
-/// for (a `G01` turning the tool 40 degrees within a degree of the vertical: C's rate
+/// stencil holds get a lower share of the axes' limits (the path's jerk and acceleration
+/// there), by the ratio the measurement asks for (a `G01` turning the tool 40 degrees
+/// within a degree of the vertical: C's rate
 /// peaks over 2 um, between the stations, and C's jerk stayed 1.04x its limit at half the
 /// share). False where the share would go below [`AXIS_SHARE_FLOOR`], or for any other
 /// quantity.
