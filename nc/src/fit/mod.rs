@@ -16,7 +16,8 @@
 //! programmed point instead, a knot of multiplicity = the degree whose control point is
 //! that point, as the posted moves have a kink there. Near the vertical,
 //! where a table's C follows the tool axis's azimuth, a span also fails where the fitted axis
-//! turns about the vertical more than the programmed great circles do.
+//! turns about the vertical more than the programmed great circles do, measured down to a
+//! hair's tilt where a move ends on the vertical.
 //!
 //! [`runs`] finds the runs in a program's text and writes the result; [`rewrite`] does the
 //! same as the text is read, a window of moves at a time (what `dnurbs fit` runs), and
@@ -54,6 +55,8 @@ const NEAR_VERTICAL: f64 = 0.09;
 const TURN_SLACK: f64 = 0.0044;
 /// Samples per move of that check.
 const TURN_SAMPLES: usize = 8;
+/// Halvings of that check toward an end of the move on the vertical.
+const END_HALVINGS: usize = 40;
 /// No knot is put nearer another than this share of the points' step there; where the
 /// fit would need one, the curve takes a corner on the point (a knot of multiplicity = the
 /// degree, where the planner brings the path to rest if the tangent turns).
@@ -148,13 +151,27 @@ fn bulge_allowance(points: &[Point], k: usize, tol: f64) -> f64 {
 }
 
 /// How far `tool(f)` turns about the vertical for f in 0..=1: the azimuth of its horizontal
-/// part, sampled, its changes summed in magnitude (rad). Samples within
+/// part, sampled, its changes summed in magnitude (rad); `ends`: whether f = 0 and f = 1
+/// are on the vertical, where the samples go on halving toward it. Samples within
 /// [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO) of the vertical, where the interpolator
 /// keeps C, are skipped.
-fn turn_about_vertical(tool: impl Fn(f64) -> Vector3<f64>) -> f64 {
+fn turn_about_vertical(tool: impl Fn(f64) -> Vector3<f64>, ends: (bool, bool)) -> f64 {
     let (mut sum, mut last) = (0.0, None);
-    for i in 0..=TURN_SAMPLES {
-        let t = tool(i as f64 / TURN_SAMPLES as f64);
+    // Toward an end on the vertical, halving down to 2^-40 of the move: the azimuth of an
+    // axis that comes to the vertical sideways turns where the tilt is a hair.
+    let near = |on: bool| {
+        (1..=END_HALVINGS)
+            .filter(move |_| on)
+            .map(|k| 0.5f64.powi(k as i32))
+    };
+    let fractions = near(ends.0)
+        .rev()
+        .chain((0..=TURN_SAMPLES).map(|i| i as f64 / TURN_SAMPLES as f64))
+        .chain(near(ends.1).map(|f| 1.0 - f));
+    let mut fractions: Vec<f64> = fractions.collect();
+    fractions.sort_by(f64::total_cmp);
+    for f in fractions {
+        let t = tool(f);
         let rho = t.x.hypot(t.y);
         // (NaN fails the comparison and is skipped too.)
         let tilted = rho >= crate::kinematics::VERTICAL_RHO * t.norm();
@@ -192,8 +209,9 @@ fn turns_more_than_programmed(
     if ra.min(rb) >= NEAR_VERTICAL || ra.max(rb) < vertical {
         return false;
     }
-    let programmed = turn_about_vertical(|f| a + (b - a) * f);
-    let fitted = turn_about_vertical(|f| curve.eval(u0 + (u1 - u0) * f).1);
+    let ends = (ra < vertical, rb < vertical);
+    let programmed = turn_about_vertical(|f| a + (b - a) * f, ends);
+    let fitted = turn_about_vertical(|f| curve.eval(u0 + (u1 - u0) * f).1, ends);
     fitted > programmed + TURN_SLACK
 }
 

@@ -120,3 +120,45 @@ fn a_point_off_its_neighbours_takes_a_corner_not_a_hook() {
         }
     }
 }
+
+/// A fitted axis that comes to the vertical sideways: its horizontal part runs along X
+/// until, within 1.5e-6 of the move's end, the last term but one (1e-9 along Y) takes
+/// over, and C would follow its azimuth a quarter turn where the tilt is a few
+/// microradians. Eight samples of the move do not see it (the end is on the vertical,
+/// where the azimuth is not measured); the halvings toward that end do. A generated post's
+/// fitted block came to the vertical so: C turned 8.5 degrees in 21 periods at 1.4e-3
+/// mm/s, at 1.4e-8 rad of tilt, and the program was refused compressed (C's acceleration
+/// 1.9x its limit at the slowest feed) where it ran as posted.
+#[test]
+fn an_axis_coming_to_the_vertical_sideways_turns_more_than_programmed() {
+    let tool = |x: f64, y: f64| [x, y, 1.0];
+    let curve = Fitted {
+        degree: 3,
+        knots: vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0],
+        ctrl: vec![[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [3.0, 0.0, 0.0]],
+        tool: vec![
+            tool(1e-3, 0.0),
+            tool(0.67e-3, 0.0),
+            tool(0.0, 1e-9),
+            tool(0.0, 0.0),
+        ],
+        dev_mm: 0.0,
+        dev_rad: 0.0,
+    };
+    let points = [
+        pt([0.0; 3], tool(1e-3, 0.0)),
+        pt([3.0, 0.0, 0.0], tool(0.0, 0.0)),
+    ];
+    assert!(turns_more_than_programmed(&curve, &points, 1, 0.0, 1.0));
+    // The same curve coming straight in (the last term but one along X) does not.
+    let mut straight = curve.clone();
+    straight.tool[2] = tool(1e-9, 0.0);
+    assert!(!turns_more_than_programmed(&straight, &points, 1, 0.0, 1.0));
+    // Nor the same curve leaving the vertical, read the other way, straight.
+    let mut leaving = straight.clone();
+    leaving.tool.reverse();
+    let back = [points[1], points[0]];
+    assert!(!turns_more_than_programmed(&leaving, &back, 1, 0.0, 1.0));
+    leaving.tool[1] = tool(0.0, 1e-9);
+    assert!(turns_more_than_programmed(&leaving, &back, 1, 0.0, 1.0));
+}
