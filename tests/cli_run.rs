@@ -111,12 +111,7 @@ fn check_demo(extra: &[&str], banner: &str) {
 /// CI run saw a 37.8 ms wake-up and "no TPDO feedback for 11 cycles" (20 ms allowed).
 fn stalled(out: &std::process::Output) -> bool {
     let stdout = String::from_utf8_lossy(&out.stdout);
-    let overran = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("overruns: "))
-        .and_then(|r| r.split_whitespace().next())
-        .and_then(|n| n.parse::<u64>().ok())
-        .is_some_and(|n| n > 0);
+    let overran = common::overruns(&stdout).is_some_and(|n| n > 0);
     let silent = stdout.lines().any(|l| {
         l.starts_with("outcome: stopped by a fault")
             && (l.contains("no TPDO feedback") || l.contains("heartbeat"))

@@ -195,18 +195,23 @@ pub fn fractions(rows: &[Row]) -> [(f64, f64); 5] {
     out
 }
 
+/// The overruns a run's summary reports (its `overruns: N ...` line), if it has one.
+pub fn overruns(stdout: &str) -> Option<u64> {
+    stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("overruns: "))
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+}
+
 /// A run that completed: exit 0 without overruns, exit 5 with them (a loaded machine may
 /// miss deadlines, and says so); anything else fails the test. Returns the overruns.
 #[track_caller]
 pub fn assert_completed(out: &Output) -> u64 {
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    let overruns: u64 = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("overruns: "))
-        .and_then(|r| r.split_whitespace().next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no overruns line:\n{stdout}\n{stderr}"));
+    let overruns =
+        overruns(&stdout).unwrap_or_else(|| panic!("no overruns line:\n{stdout}\n{stderr}"));
     match out.status.code() {
         Some(0) => assert_eq!(overruns, 0, "exit 0 with overruns:\n{stdout}"),
         Some(5) => assert!(overruns > 0, "exit 5 without overruns:\n{stdout}"),

@@ -519,10 +519,9 @@ fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
 /// would be refused): the path's own term `q_s s'''` is what is left, so the stations the
 /// stencil holds get a lower share of the axes' limits (the path's jerk and acceleration
 /// there), by the ratio the measurement asks for (a `G01` turning the tool 40 degrees
-/// within a degree of the vertical: C's rate
-/// peaks over 2 um, between the stations, and C's jerk stayed 1.04x its limit at half the
-/// share). False where the share would go below [`AXIS_SHARE_FLOOR`], or for any other
-/// quantity.
+/// within a degree of the vertical: C's rate peaks over 2 um, between the stations, and
+/// C's jerk stayed 1.04x its limit at half the share). False where the share would go
+/// below [`AXIS_SHARE_FLOOR`], or for any other quantity.
 fn lower_share(st: &mut [Station], v: &Violation) -> bool {
     if v.quantity != Quantity::Jerk || !(v.value > v.limit && v.limit > 0.0) {
         return false;
