@@ -37,8 +37,11 @@ fn edges(path: &Path, kin: &MachineKinematics) -> Vec<(f64, f64, bool, bool)> {
             // From the start inward, then from the end inward (x from the edge).
             for (edge, sign, at, is_end) in [(u0, 1.0, joints, false), (u1, -1.0, end, true)] {
                 let pose = |x: f64| seg.pose_u(curve, table, edge + sign * x);
-                // Up to the middle: the other end may be vertical too.
-                if let Some((hi, reverses)) = crossing(&|x| pose(x).axis(kin), (u1 - u0) / 2.0) {
+                // Up to the other end, or the middle where that end is vertical too.
+                let axis = |x: f64| pose(x).axis(kin);
+                let span = u1 - u0;
+                let found = crossing(&axis, span).or_else(|| crossing(&axis, span / 2.0));
+                if let Some((hi, reverses)) = found {
                     let c = pose(hi).joints(kin, &at, &rotary)[4];
                     out.push((at[4], c, reverses, is_end));
                 }
@@ -199,11 +202,14 @@ fn a_g065_block_at_the_vertical_has_c_where_the_interpolator_follows_it() {
             // The tool leaves the vertical through the second derivative only.
             net[1].1 = [0.0, 0.0, 15.0];
         }
-        if arrives && n > 2 {
+        // Control points whose tool is tilted, between the ends and those straight up.
+        let tilted = n - 2 - usize::from(straight_up);
+        if arrives && tilted >= 1 {
             // It comes back to the vertical at the block's end, turning about it as it
-            // arrives (or through the second derivative only).
+            // arrives (or through the second derivative only, where a tilted control point
+            // is left: a tool vertical all along has no edge to check).
             net[n - 1].1 = [0.0, 0.0, 20.0];
-            if straight_up && n > 3 {
+            if straight_up && tilted >= 2 {
                 net[n - 2].1 = [0.0, 0.0, 15.0];
             }
         }
