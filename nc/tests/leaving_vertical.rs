@@ -203,7 +203,7 @@ fn a_g065_block_at_the_vertical_has_c_where_the_interpolator_follows_it() {
             net[1].1 = [0.0, 0.0, 15.0];
         }
         // Control points whose tool is tilted, between the ends and those straight up.
-        let tilted = n - 2 - usize::from(straight_up);
+        let tilted = n.saturating_sub(2 + usize::from(straight_up));
         if arrives && tilted >= 1 {
             // It comes back to the vertical at the block's end, turning about it as it
             // arrives (or through the second derivative only, where a tilted control point
