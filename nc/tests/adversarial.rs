@@ -22,6 +22,8 @@ use nc::segment::{build, BuildLimits};
 use proptest::prelude::*;
 use std::fmt::Write;
 
+mod common;
+use common::{env, seeded_runner};
 #[path = "adversarial/hold.rs"]
 mod hold;
 #[path = "adversarial/streamed.rs"]
@@ -615,10 +617,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
 /// Cases per run: `ADV_CASES` (default 300; CI sets 10 000), shared by the two halves below
 /// so that cargo's test threads run them on two cores at once.
 fn cases() -> u32 {
-    std::env::var("ADV_CASES")
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(300)
+    env("ADV_CASES", 300) as u32
 }
 
 #[test]
@@ -648,19 +647,9 @@ fn run_half(half: u64, cases: u32) {
     );
     // A fixed seed: the same programs on every machine, so a slow plan cannot appear at
     // random in CI; ADV_SEED moves the search elsewhere.
-    let seed: u64 = std::env::var("ADV_SEED")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0u64)
-        .wrapping_add(half.wrapping_mul(1_000_003));
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let rng = proptest::test_runner::TestRng::from_seed(
-        proptest::test_runner::RngAlgorithm::ChaCha,
-        &bytes,
-    );
+    let seed = env("ADV_SEED", 0).wrapping_add(half.wrapping_mul(1_000_003));
     let counts = Counts::default();
-    let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
+    let mut runner = seeded_runner(config, seed);
     let result = runner.run(&strategy, |(start, moves)| {
         let src = program(start, &moves);
         let t0 = std::time::Instant::now();

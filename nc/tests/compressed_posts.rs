@@ -40,6 +40,9 @@ use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 use std::fmt::Write;
 
+mod common;
+use common::{env, seeded_runner};
+
 const PERIOD: f64 = 0.002;
 
 fn machine() -> (PlanConfig, BuildLimits, MachineKinematics) {
@@ -543,13 +546,6 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
     )
 }
 
-fn env(name: &str, default: u64) -> u64 {
-    std::env::var(name)
-        .ok()
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(default)
-}
-
 #[test]
 fn every_compressed_post_holds_every_limit_and_passes_its_points() {
     let cases = env("POST_CASES", 64) as u32;
@@ -566,14 +562,8 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
         3usize..=4,
         any::<bool>(),
     );
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let rng = proptest::test_runner::TestRng::from_seed(
-        proptest::test_runner::RngAlgorithm::ChaCha,
-        &bytes,
-    );
     let counts = std::cell::RefCell::new(Counts::default());
-    let mut runner = proptest::test_runner::TestRunner::new_with_rng(config, rng);
+    let mut runner = seeded_runner(config, seed);
     let result = runner.run(&strategy, |(start, passes, decimals, modal)| {
         let src = program(start, &passes, decimals, modal);
         check(&src, &mut counts.borrow_mut())
