@@ -451,15 +451,18 @@ fn solve(
                 }
             }
         }
-        // A whisper of smoothing (the second differences of the whole net) keeps spans
-        // without data solvable: there (as between corners on neighbouring points) the
-        // control points line up between the fixed ones, and the curve is their chord.
+        // A whisper of smoothing (the second differences of the net about each free
+        // control point) keeps spans without data solvable: there (as between corners on
+        // neighbouring points) the control points line up between the fixed ones, and the
+        // curve is their chord. None about a fixed one: it pulled the free point after a
+        // corner onto the line from the point before it, and the curve between two
+        // neighbouring corners went past the second and came back to it (2.5 um on a post).
         let scale = (0..free)
             .map(|i| a.get(i, i))
             .fold(0.0, f64::max)
             .max(1e-300);
         let lambda = 1e-12 * scale;
-        for i in 1..n - 1 {
+        for i in (1..n - 1).filter(|&i| fixed[i].is_none()) {
             let terms = [(i - 1, 1.0), (i, -2.0), (i + 1, 1.0)];
             for &(ia, ca) in &terms {
                 let Some(ja) = unknown[ia] else {

@@ -162,3 +162,42 @@ fn an_axis_coming_to_the_vertical_sideways_turns_more_than_programmed() {
     leaving.tool[1] = tool(0.0, 1e-9);
     assert!(turns_more_than_programmed(&leaving, &back, 1, 0.0, 1.0));
 }
+
+/// Between corners on neighbouring points no datum holds the curve: it is the chord
+/// between them (what the smoothing gives where nothing else does), not pulled on past the
+/// second corner by the moves before the first (it went 2.5 um past one on a post and came
+/// back, backing up along the move).
+#[test]
+fn between_neighbouring_corners_the_curve_is_the_chord() {
+    let up = [0.0, 0.0, 1.0];
+    let points: Vec<Point> = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [3.0, 0.0, 0.0],
+        [3.0, 1.0, 0.0],
+        [4.0, 1.0, 0.0],
+        [5.0, 1.0, 0.0],
+        [6.0, 1.0, 0.0],
+    ]
+    .into_iter()
+    .map(|p| pt(p, up))
+    .collect();
+    let u: Vec<f64> = (0..8).map(|k| k as f64 / 7.0).collect();
+    let (u3, u4) = (u[3], u[4]);
+    let mut knots = vec![0.0; 4];
+    knots.extend([u3, u3, u3, u4, u4, u4]);
+    knots.extend([1.0; 4]);
+    let curve = solve(&points, &u, &knots, 3, &[(u3, 3), (u4, 4)]).expect("solves");
+    for i in 0..=100 {
+        let (c, _) = curve.eval(u3 + (u4 - u3) * i as f64 / 100.0);
+        assert!(
+            (c.x - 3.0).abs() < 1e-9 && c.z.abs() < 1e-9,
+            "off the chord at {i}/100: {c:?}"
+        );
+        assert!(
+            (c.y - i as f64 / 100.0).abs() < 1e-9,
+            "not along it at {i}/100: {c:?}"
+        );
+    }
+}
