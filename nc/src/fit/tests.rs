@@ -163,6 +163,59 @@ fn an_axis_coming_to_the_vertical_sideways_turns_more_than_programmed() {
     assert!(turns_more_than_programmed(&leaving, &back, 1, 0.0, 1.0));
 }
 
+/// A run as a generated post wrote it (`nc/tests/adversarial/`): from a vertical tool, the
+/// first move of 0.09 mm tilts it 8.9 degrees, the next ones 0.0575 degrees each. The fit
+/// once left the start 4.8 um backwards while the tool tilted, and the planner refused A's
+/// jerk even at its slowest feed. The fitted cutter goes forward along every move, sampled
+/// far more densely than the fit's own check.
+#[test]
+fn a_fast_tool_turn_at_a_runs_start_does_not_pull_the_cutter_backwards() {
+    let src = include_str!("../../tests/adversarial/a-fitted-block-leaving-its-start-backwards.nc");
+    let program = crate::parse::parse(src).expect("parses");
+    let kin = crate::kinematics::MachineKinematics::Paper;
+    // The run: from the program's first point (its start, the tool vertical), every move.
+    let points: Vec<Point> = program
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            crate::program::Block::Linear(m) => Some(find::point(m, &kin)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(points.len(), 80);
+    let curve = fit(&points, TOL, 3).expect("fits");
+    let mut feet = vec![0.0; points.len()];
+    for (k, p) in points.iter().enumerate() {
+        // The nearest of a dense sampling, in order along the curve.
+        let from = feet[k.saturating_sub(1)];
+        let d = |u: f64| (curve.eval(u).0 - p.p).norm();
+        feet[k] = (0..=20_000)
+            .map(|i| from + (1.0 - from) * i as f64 / 20_000.0)
+            .min_by(|&a, &b| d(a).total_cmp(&d(b)))
+            .unwrap();
+        assert!(
+            d(feet[k]) <= TOL.mm * 1.01,
+            "point {k} off by {}",
+            d(feet[k])
+        );
+    }
+    for k in 1..points.len() {
+        let chord = points[k].p - points[k - 1].p;
+        let along = |u: f64| curve.eval(u).0.dot(&chord) / chord.norm();
+        let (u0, u1) = (feet[k - 1], feet[k]);
+        let mut last = along(u0);
+        for i in 1..=1000 {
+            let here = along(u0 + (u1 - u0) * i as f64 / 1000.0);
+            assert!(
+                here >= last - 1e-12,
+                "move {k}: the cutter backs up by {:.4} um, {i}/1000 of the way",
+                (last - here) * 1e3
+            );
+            last = here;
+        }
+    }
+}
+
 /// Between corners on neighbouring points no datum holds the curve: it is the chord
 /// between them (what the smoothing gives where nothing else does), not pulled on past the
 /// second corner by the moves before the first (it went 2.5 um past one on a post and came
