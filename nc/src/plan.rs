@@ -79,8 +79,12 @@ pub struct PlanConfig {
 
 /// Slowest speed the planner schedules where a ceiling would be lower (path units/s), so
 /// that every section ends in finite time: the plan's "exact stop" at a kink passes the
-/// kink at this speed, and its setpoint check holds there.
+/// kink at this speed, and its setpoint check holds there; but a joint where an axis's
+/// rate jumps by more than this speed allows is passed slower ([`V_JOINT_FLOOR`]).
 pub const V_FLOOR: f64 = 1e-3;
+/// Slowest speed a joint is passed at where an axis's rate jumps there by more than the
+/// floor speed allows (path units/s): the jump is taken in one period at that speed.
+pub const V_JOINT_FLOOR: f64 = 1e-7;
 /// Likewise for a section's path acceleration and jerk.
 const A_FLOOR: f64 = 1e-3;
 /// Replanning rounds before every violating station is made critical at once.
@@ -407,7 +411,8 @@ fn stations_over(st: &[Station], (s0, s1): (f64, f64)) -> (usize, usize) {
 fn cap_stations(st: &mut [Station], s: (f64, f64), cap: f64, share: Option<f64>) {
     let (a, b) = stations_over(st, s);
     for x in &mut st[a..b] {
-        x.vlim = x.vlim.min(cap).max(V_FLOOR);
+        // (Never raised: a joint's ceiling can be below the floor, `V_JOINT_FLOOR`.)
+        x.vlim = x.vlim.min(cap).max(V_FLOOR.min(x.vlim));
         if let Some(share) = share {
             x.share = x.share.min(share as f32);
         }

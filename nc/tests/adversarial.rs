@@ -795,3 +795,20 @@ fn the_hold_faults_found_stay_fixed() {
         }
     }
 }
+
+/// A post's `G01` that turns the tool 40 degrees from 0.58 degrees off the vertical, right
+/// after a retract and a plunge (`compressed_posts` seed 7, cut there): C turns 13 600
+/// degrees per mm where the move starts, so its rate jumps at the joint by more than the
+/// planner's floor speed allows in one period (C's acceleration 7.8x its limit at 0.001
+/// mm/s), and the program was refused, posted and compressed, where its moves are feasible
+/// from rest. The joint is now passed at the speed the jump allows, within every limit
+/// through the follower too.
+#[test]
+fn a_joint_where_c_turns_fast_next_to_the_vertical_is_passed_slowly_enough() {
+    let src = include_str!("adversarial/a-joint-where-c-turns-fast-next-to-the-vertical.nc");
+    let counts = Counts::default();
+    if let Err(e) = check(src, &counts) {
+        panic!("{e}");
+    }
+    assert_eq!(counts.accepted.load(Ordering::Relaxed), 1, "refused");
+}

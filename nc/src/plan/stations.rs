@@ -2,7 +2,7 @@
 //! [`super`]), made one segment at a time as segments arrive ([`Sampler`]), so that a
 //! program can be planned while it is read.
 
-use super::{PlanConfig, AXIS_SHARE, V_FLOOR};
+use super::{PlanConfig, AXIS_SHARE, CAP_MARGIN, V_FLOOR, V_JOINT_FLOOR};
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::segment::{Geometry, Segment, Tooling};
 use nalgebra::Vector3;
@@ -362,12 +362,27 @@ impl Sampler {
                     if let (Some(t0), Some(t1)) = (self.prev_tangent, tangent) {
                         vc = vc.min(corner_chord_speed(&t0, &t1, cfg.chord_tol, cfg.period));
                     }
+                    // An axis's rate jumps here: it takes the jump in one period, at the
+                    // speed the joint is passed at. Where that speed is below the floor
+                    // (C next to the vertical: 13 600 deg/mm where a G01 turned the tool
+                    // off 0.58 degrees of tilt, after a plunge), the joint is passed at it,
+                    // with the check's reserve and the caps' margin, since no cap goes
+                    // below the floor: at the floor C's acceleration was 7.8x its limit,
+                    // and the program was refused where its moves are feasible from rest.
+                    let mut v_jump = f64::INFINITY;
                     for (j, ax) in cfg.axes.iter().enumerate() {
                         let jump = (d1[j] - pd1[j]).abs();
                         if jump > 1e-9 {
-                            vc = vc.min(ax.acceleration * cfg.period / jump);
+                            let v = ax.acceleration * cfg.period / jump;
+                            vc = vc.min(v);
+                            let (_, share) = crate::verify::reserve(ax, cfg.period);
+                            v_jump = v_jump.min(v * share * CAP_MARGIN);
                         }
                     }
+                    let floor = match v_jump < V_FLOOR {
+                        true => v_jump.max(V_JOINT_FLOOR),
+                        false => V_FLOOR,
+                    };
                     if smooth {
                         // The setpoints' jerk across the joint mixes both sides' rates.
                         let both = last.before.max(&st.after);
@@ -375,7 +390,10 @@ impl Sampler {
                     } else {
                         last.after = st.after;
                     }
-                    last.vlim = vc.max(V_FLOOR);
+                    last.vlim = match vc < V_FLOOR {
+                        true => floor,
+                        false => vc,
+                    };
                     starts.push(out.len() - 1);
                     continue;
                 }
