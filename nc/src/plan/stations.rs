@@ -379,10 +379,6 @@ impl Sampler {
                             v_jump = v_jump.min(v * share * CAP_MARGIN);
                         }
                     }
-                    let floor = match v_jump < V_FLOOR {
-                        true => v_jump.max(V_JOINT_FLOOR),
-                        false => V_FLOOR,
-                    };
                     if smooth {
                         // The setpoints' jerk across the joint mixes both sides' rates.
                         let both = last.before.max(&st.after);
@@ -390,9 +386,12 @@ impl Sampler {
                     } else {
                         last.after = st.after;
                     }
-                    last.vlim = match vc < V_FLOOR {
-                        true => floor,
-                        false => vc,
+                    last.vlim = if vc >= V_FLOOR {
+                        vc
+                    } else if v_jump < V_FLOOR {
+                        v_jump.max(V_JOINT_FLOOR)
+                    } else {
+                        V_FLOOR
                     };
                     starts.push(out.len() - 1);
                     continue;
