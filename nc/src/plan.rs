@@ -31,7 +31,10 @@
 //! 5. **The setpoint check** measures every axis's velocity, acceleration and jerk by finite
 //!    differences at the period ([`crate::verify`]); where one is over its limit the
 //!    ceilings there are lowered (and for jerk the path's share, to half) and the window is
-//!    planned again.
+//!    planned again. Where the caps stop changing the plan, they go to the stations on
+//!    either side, unless that would make the path crawl to them: then the path's share is
+//!    lowered, or the ceilings the violation holds go on down from where they are, and the
+//!    window falls back to the widened caps if that ends in a refusal ([`remedy`]).
 //!
 //! The result is a [`FeedProfile`]: constant-jerk phases over the whole path, evaluated per
 //! period without allocation.
@@ -44,6 +47,7 @@ use crate::segment::{Path, Segment};
 use crate::verify::{Margins, Quantity, Violation, MAX_CYCLES};
 
 mod limits;
+mod remedy;
 mod stations;
 mod window;
 

@@ -25,19 +25,18 @@
 //! the memory is that of a window or two, whatever the program's length, and the time is
 //! linear in the program.
 
-use super::limits::{section_limits, AXIS_SHARE_FLOOR};
+use super::limits::section_limits;
+use super::remedy::{cap_for, lower_share, widening, Remedy};
 use super::stations::Sampler;
 use super::{
     refuse, schedule, too_long, with_dwells, FeedProfile, PlanConfig, PlanError, Station,
-    AXIS_SHARE_LEAST, CAP_MARGIN, VERIFY_ROUNDS, V_FLOOR,
+    VERIFY_ROUNDS, V_FLOOR,
 };
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::program::SrcPos;
 use crate::scurve::{change_dist, reachable, Phase};
 use crate::segment::{Path, Pose, Segment};
-use crate::verify::{
-    check_from, g2, Checked, Earlier, Margins, Quantity, Trace, Violation, MAX_CYCLES,
-};
+use crate::verify::{check_from, g2, Checked, Earlier, Margins, Quantity, Trace, MAX_CYCLES};
 
 /// Stopping distances from the top speed that a window commits; one more lies ahead of
 /// what it commits.
@@ -506,40 +505,6 @@ struct Windows<'a> {
     starts: &'a [usize],
 }
 
-/// Cap the stations over `s` for violation `v`, whose speed must drop by `factor`. An
-/// axis's jerk over its limit lowers the path's share of it there too (slowing down does
-/// not lower the path's own term, `q_s s'''`; an acceleration over it is a corner's
-/// velocity jump or the curvature's term, which slowing down lowers).
-fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
-    let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-    super::cap_stations(st, s, v.v * factor * CAP_MARGIN, share);
-}
-
-/// An axis's jerk over its limit at the slowest feed, in a window that starts at rest (it
-/// would be refused): the path's own term `q_s s'''` is what is left, so the stations the
-/// stencil holds get a lower share of the axes' limits (the path's jerk and acceleration
-/// there), by the ratio the measurement asks for (a `G01` turning the tool 40 degrees
-/// within a degree of the vertical: C's rate peaks over 2 um, between the stations, and
-/// C's jerk stayed 1.04x its limit at half the share). False where the share would go
-/// below [`AXIS_SHARE_FLOOR`], or for any other quantity.
-fn lower_share(st: &mut [Station], v: &Violation) -> bool {
-    if v.quantity != Quantity::Jerk || !(v.value > v.limit && v.limit > 0.0) {
-        return false;
-    }
-    let (a, b) = super::stations_over(st, v.s);
-    let Some(least) = st[a..b].iter().map(|x| f64::from(x.share)).reduce(f64::min) else {
-        return false;
-    };
-    let share = least.min(AXIS_SHARE_LEAST) * v.limit / v.value * CAP_MARGIN;
-    if share < AXIS_SHARE_FLOOR {
-        return false;
-    }
-    for x in &mut st[a..b] {
-        x.share = x.share.min(share as f32);
-    }
-    true
-}
-
 impl Windows<'_> {
     /// Plan and check the window from `from` to station `end` (where it stops), after the
     /// profile's first `committed` phases. None where it cannot start at `from`'s speed
@@ -569,106 +534,144 @@ impl Windows<'_> {
         let mut last: Option<WindowPlan> = None;
         let mut round = 0;
         let mut widened = false;
-        loop {
-            let Some(phases) = schedule(st, self.starts, cfg, (from.station, from.t, from.v), end)
-            else {
-                return Ok(None);
-            };
-            let phases = with_dwells(phases, path, &profile.seg_start, segs.clone());
-            if let Some(prev) = &last {
-                if prev.phases == phases && !widened {
-                    // The caps changed nothing. A violation's stencil can reach past the
-                    // stations it holds, onto a ramp the next station's ceiling sets (an
-                    // X jerk 1.09x its limit at 11.3 mm/s past a station capped to 10.6):
-                    // once, the caps go to the stations on either side too.
-                    widened = true;
-                    for v in &prev.checked.violations {
-                        let Some(f) = v.speed_factor().filter(|f| f.is_finite()) else {
-                            continue;
-                        };
-                        let a = st.partition_point(|x| x.s < v.s.0).saturating_sub(1);
-                        let b = st.partition_point(|x| x.s <= v.s.1).min(st.len() - 1);
-                        cap_for(st, v, (st[a].s, st[b].s), f);
+        let mut remedied = false;
+        // The stations and the round as they were before the first remedy below, and the
+        // plan they gave: where the remedies end in a refusal, the window goes on from there
+        // without them.
+        let mut tried: Option<(Vec<Station>, Option<WindowPlan>, usize)> = None;
+        let mut may_remedy = true;
+        'rounds: loop {
+            let failed = 'round: {
+                let Some(phases) =
+                    schedule(st, self.starts, cfg, (from.station, from.t, from.v), end)
+                else {
+                    break 'round Ok(None);
+                };
+                let phases = with_dwells(phases, path, &profile.seg_start, segs.clone());
+                if let Some(prev) = &last {
+                    if prev.phases == phases && !widened {
+                        // The caps changed nothing. A violation's stencil can reach past the
+                        // stations it holds, onto a ramp the next station's ceiling sets (an
+                        // X jerk 1.09x its limit at 11.3 mm/s past a station capped to 10.6):
+                        // once, the caps go to the stations on either side too. Where that
+                        // would hold the stretches to them to a crawl, first what the
+                        // violation itself asks for ([`Remedy`]).
+                        if !remedied {
+                            remedied = true;
+                            let asked: Vec<Remedy> = prev
+                                .checked
+                                .violations
+                                .iter()
+                                .filter_map(|v| Remedy::for_crawl(st, v))
+                                .collect();
+                            if may_remedy && !asked.is_empty() {
+                                if tried.is_none() {
+                                    tried = Some((st.to_vec(), last.take(), round));
+                                }
+                                for r in asked {
+                                    r.apply(st);
+                                }
+                                continue 'rounds;
+                            }
+                        }
+                        widened = true;
+                        for v in &prev.checked.violations {
+                            if let Some(w) = widening(st, v) {
+                                cap_for(st, v, w.s, w.factor);
+                            }
+                        }
+                        continue 'rounds;
                     }
-                    continue;
+                    if prev.phases == phases {
+                        // The caps changed nothing: the violation lies where this window
+                        // cannot slow.
+                        break 'round match moving {
+                            true => Ok(None),
+                            false => Err(refuse(path, kin, cfg, &prev.checked.violations[0])),
+                        };
+                    }
                 }
-                if prev.phases == phases {
-                    // The caps changed nothing: the violation lies where this window
-                    // cannot slow.
-                    return match moving {
-                        true => Ok(None),
-                        false => Err(refuse(path, kin, cfg, &prev.checked.violations[0])),
+                let duration = phases.last().map_or(from.t, |p| p.t0 + p.dur);
+                if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
+                    break 'round Err(too_long(
+                        path,
+                        &profile.seg_start,
+                        &phases,
+                        duration,
+                        cfg.period,
+                    ));
+                }
+                profile.phases.truncate(committed);
+                profile.phases.extend_from_slice(&phases);
+                profile.duration = duration;
+                // The profile ends where the window stops (its position from then on).
+                profile.length = st[end].s;
+                let earlier = last.as_ref().or(before).map(WindowPlan::earlier);
+                let (checked, trace) = check_from(path, profile, kin, cfg, self.smooth, earlier);
+                if checked.violations.is_empty() {
+                    return Ok(Some(WindowPlan {
+                        offset: committed,
+                        phases,
+                        checked,
+                        trace,
+                    }));
+                }
+                // Travel: slowing cannot help. Report the farthest excursion of the first block
+                // that leaves the travel.
+                let travel = checked
+                    .violations
+                    .iter()
+                    .filter(|v| v.quantity == Quantity::Travel);
+                if let Some(first) = travel.clone().next() {
+                    let worst =
+                        travel
+                            .filter(|v| v.segment == first.segment)
+                            .fold(first, |w, v| {
+                                if (v.value - v.limit).abs() > (w.value - w.limit).abs() {
+                                    v
+                                } else {
+                                    w
+                                }
+                            });
+                    break 'round Err(refuse(path, kin, cfg, worst));
+                }
+                for v in &checked.violations {
+                    let factor = match v.speed_factor() {
+                        Some(f)
+                            if v.v > V_FLOOR * 1.01
+                                && round + 1 < VERIFY_ROUNDS
+                                && f.is_finite() =>
+                        {
+                            f
+                        }
+                        _ if moving => break 'round Ok(None),
+                        _ if round + 1 < VERIFY_ROUNDS && lower_share(st, v) => continue,
+                        _ => break 'round Err(refuse(path, kin, cfg, v)),
                     };
+                    if moving && v.s.1 < s_from + eps {
+                        // Behind the window's start: only a slower start would help.
+                        break 'round Ok(None);
+                    }
+                    cap_for(st, v, v.s, factor);
                 }
-            }
-            let duration = phases.last().map_or(from.t, |p| p.t0 + p.dur);
-            if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
-                return Err(too_long(
-                    path,
-                    &profile.seg_start,
-                    &phases,
-                    duration,
-                    cfg.period,
-                ));
-            }
-            profile.phases.truncate(committed);
-            profile.phases.extend_from_slice(&phases);
-            profile.duration = duration;
-            // The profile ends where the window stops (its position from then on).
-            profile.length = st[end].s;
-            let earlier = last.as_ref().or(before).map(WindowPlan::earlier);
-            let (checked, trace) = check_from(path, profile, kin, cfg, self.smooth, earlier);
-            if checked.violations.is_empty() {
-                return Ok(Some(WindowPlan {
+                last = Some(WindowPlan {
                     offset: committed,
                     phases,
                     checked,
                     trace,
-                }));
-            }
-            // Travel: slowing cannot help. Report the farthest excursion of the first block
-            // that leaves the travel.
-            let travel = checked
-                .violations
-                .iter()
-                .filter(|v| v.quantity == Quantity::Travel);
-            if let Some(first) = travel.clone().next() {
-                let worst = travel
-                    .filter(|v| v.segment == first.segment)
-                    .fold(first, |w, v| {
-                        if (v.value - v.limit).abs() > (w.value - w.limit).abs() {
-                            v
-                        } else {
-                            w
-                        }
-                    });
-                return Err(refuse(path, kin, cfg, worst));
-            }
-            for v in &checked.violations {
-                let factor = match v.speed_factor() {
-                    Some(f)
-                        if v.v > V_FLOOR * 1.01 && round + 1 < VERIFY_ROUNDS && f.is_finite() =>
-                    {
-                        f
-                    }
-                    _ if moving => return Ok(None),
-                    _ if round + 1 < VERIFY_ROUNDS && lower_share(st, v) => continue,
-                    _ => return Err(refuse(path, kin, cfg, v)),
-                };
-                if moving && v.s.1 < s_from + eps {
-                    // Behind the window's start: only a slower start would help.
-                    return Ok(None);
-                }
-                cap_for(st, v, v.s, factor);
-            }
-            last = Some(WindowPlan {
-                offset: committed,
-                phases,
-                checked,
-                trace,
-            });
-            round += 1;
-            widened = false;
+                });
+                round += 1;
+                widened = false;
+                remedied = false;
+                continue 'rounds;
+            };
+            // The remedies ended in a refusal: back to where they began, and on without
+            // them (as the window would have gone).
+            let Some((saved, plan, r)) = tried.take().filter(|_| may_remedy) else {
+                return failed;
+            };
+            st.copy_from_slice(&saved);
+            (last, round, widened, remedied, may_remedy) = (plan, r, false, true, false);
         }
     }
 }
