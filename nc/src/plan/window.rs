@@ -539,6 +539,7 @@ impl Windows<'_> {
         // plan they gave: where the remedies end in a refusal, the window goes on from there
         // without them.
         let mut tried: Option<(Vec<Station>, Option<WindowPlan>, usize)> = None;
+        // False once the window has fallen back (and `tried` is None again).
         let mut may_remedy = true;
         'rounds: loop {
             let failed = 'round: {
@@ -556,7 +557,7 @@ impl Windows<'_> {
                         // once, the caps go to the stations on either side too. Where that
                         // would hold the stretches to them to a crawl, first what the
                         // violation itself asks for ([`Remedy`]).
-                        if !remedied {
+                        if may_remedy && !remedied {
                             remedied = true;
                             let asked: Vec<Remedy> = prev
                                 .checked
@@ -564,7 +565,7 @@ impl Windows<'_> {
                                 .iter()
                                 .filter_map(|v| Remedy::for_crawl(st, v))
                                 .collect();
-                            if may_remedy && !asked.is_empty() {
+                            if !asked.is_empty() {
                                 if tried.is_none() {
                                     tried = Some((st.to_vec(), last.take(), round));
                                 }
@@ -667,7 +668,7 @@ impl Windows<'_> {
             };
             // The remedies ended in a refusal: back to where they began, and on without
             // them (as the window would have gone).
-            let Some((saved, plan, r)) = tried.take().filter(|_| may_remedy) else {
+            let Some((saved, plan, r)) = tried.take() else {
                 return failed;
             };
             st.copy_from_slice(&saved);
