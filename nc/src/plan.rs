@@ -18,7 +18,7 @@
 //!    passed at speed. Where the cutter path turns by phi there, also at most
 //!    `2 tol / (Ts sin(phi / 2))`: the chord that straddles the corner then keeps the
 //!    tolerance whatever the sampling phase (after a hold, too). The path starts and ends
-//!    at rest.
+//!    at rest, and rests where a move waits (a dwell, the operator, the spindle).
 //! 4. **S-curves between critical points.** Critical points are the start, the end, the
 //!    joints and the local minima of the ceiling. Backward and forward passes make each
 //!    point's speed reachable from its neighbours; then each section gets a jerk-limited

@@ -661,6 +661,20 @@ fn a_ramp_into_a_dwell_that_crawled_runs_compressed_as_fast_as_posted() {
     );
 }
 
+/// A post the generator wrote (seed 3): a pass in angles ends at a `G04`, and the next
+/// move turns C 71 degrees in 0.15 mm past the vertical. The plan arrived at the dwell and
+/// left it at the planner's slowest feed instead of from rest: C's velocity stepped there,
+/// and compressed (where the step fell inside the move's stencils) the program was refused
+/// with C's jerk 2.6x its limit, where it ran as posted. A move that waits now starts from
+/// rest (`waits.rs`).
+#[test]
+fn a_fast_c_move_after_a_dwell_runs_compressed() {
+    assert_runs_compressed_within(
+        include_str!("adversarial/a-fast-c-move-after-a-dwell.nc"),
+        1.0,
+    );
+}
+
 /// A post the generator wrote (seed 0, cut to the pass change): a `G01` turns the tool 40
 /// degrees past 0.9 degrees from the vertical, where C's rate peaks over 2 um, between the
 /// planner's stations. Compressed, C's jerk stayed 1.04x its limit at the slowest feed

@@ -355,8 +355,9 @@ impl Sampler {
                     // (and each side's rates for the section on that side).
                     let mut vc = last.vlim.min(st.vlim);
                     if prev_rotary != seg.rotary_only || seg.stop {
-                        // Path units change (mm <-> degrees), or the tangent kinks inside
-                        // a NURBS block: stop between.
+                        // Path units change (mm <-> degrees), the tangent kinks inside a
+                        // NURBS block, or the move waits: stop between (at the floor speed,
+                        // below; a wait at rest).
                         vc = 0.0;
                     }
                     if let (Some(t0), Some(t1)) = (self.prev_tangent, tangent) {
@@ -386,7 +387,13 @@ impl Sampler {
                     } else {
                         last.after = st.after;
                     }
-                    last.vlim = if vc >= V_FLOOR {
+                    last.vlim = if seg.wait.is_some() {
+                        // A dwell, the operator's resume or the spindle: the path rests here.
+                        // Arriving and leaving at the floor speed stepped each axis's velocity
+                        // by its rate times that speed: C's by 0.47 deg/s where a move turned
+                        // it 474 deg/mm, 5.9x its jerk over one period (`tests/waits.rs`).
+                        0.0
+                    } else if vc >= V_FLOOR {
                         vc
                     } else if v_jump < V_FLOOR {
                         v_jump.max(V_JOINT_FLOOR)
