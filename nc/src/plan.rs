@@ -34,7 +34,8 @@
 //!    planned again. Where the caps stop changing the plan, they go to the stations on
 //!    either side, unless that would make the path crawl to them: then the path's share is
 //!    lowered, or the ceilings the violation holds go on down from where they are, and the
-//!    window falls back to the widened caps if that ends in a refusal ([`remedy`]).
+//!    window falls back to the widened caps if that ends in a refusal ([`remedy`]). No cap
+//!    goes below the floor speed [`V_FLOOR`] but a joint's, down to [`V_JOINT_FLOOR`].
 //!
 //! The result is a [`FeedProfile`]: constant-jerk phases over the whole path, evaluated per
 //! period without allocation.
@@ -411,12 +412,13 @@ fn stations_over(st: &[Station], (s0, s1): (f64, f64)) -> (usize, usize) {
     }
 }
 
-/// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it.
-fn cap_stations(st: &mut [Station], s: (f64, f64), cap: f64, share: Option<f64>) {
+/// Lower the ceiling to `cap` at the stations in `s0..=s1`, or at the two around it, but
+/// not below `floor`.
+fn cap_stations(st: &mut [Station], s: (f64, f64), (cap, floor): (f64, f64), share: Option<f64>) {
     let (a, b) = stations_over(st, s);
     for x in &mut st[a..b] {
         // (Never raised: a joint's ceiling can be below the floor, `V_JOINT_FLOOR`.)
-        x.vlim = x.vlim.min(cap).max(V_FLOOR.min(x.vlim));
+        x.vlim = x.vlim.min(cap).max(floor.min(x.vlim));
         if let Some(share) = share {
             x.share = x.share.min(share as f32);
         }

@@ -26,11 +26,11 @@
 //! linear in the program.
 
 use super::limits::section_limits;
-use super::remedy::{cap_for, lower_share, widening, Remedy};
+use super::remedy::{below_floor, cap_for, lower_share, widening, Remedy};
 use super::stations::Sampler;
 use super::{
     refuse, schedule, too_long, with_dwells, FeedProfile, PlanConfig, PlanError, Station,
-    VERIFY_ROUNDS, V_FLOOR,
+    VERIFY_ROUNDS, V_FLOOR, V_JOINT_FLOOR,
 };
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::program::SrcPos;
@@ -639,7 +639,8 @@ impl Windows<'_> {
                 for v in &checked.violations {
                     let factor = match v.speed_factor() {
                         Some(f)
-                            if v.v > V_FLOOR * 1.01
+                            if (v.v > V_FLOOR * 1.01
+                                || below_floor(v) && v.v > V_JOINT_FLOOR * 1.01)
                                 && round + 1 < VERIFY_ROUNDS
                                 && f.is_finite() =>
                         {
