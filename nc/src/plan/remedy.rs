@@ -14,7 +14,8 @@ use crate::verify::{Quantity, Violation};
 /// velocity jump or the curvature's term, which slowing down lowers).
 pub(super) fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
     let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-    let floor = if below_floor(v) {
+    // (A joint's own caps: widened to the stations beside it, they stop at the floor.)
+    let floor = if below_floor(v) && s == v.s {
         V_JOINT_FLOOR
     } else {
         V_FLOOR
