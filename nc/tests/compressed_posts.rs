@@ -324,6 +324,17 @@ fn program(start: [f64; 3], passes: &[Pass], decimals: usize, modal: bool) -> St
     s
 }
 
+/// With `POST_VERBOSE`, print what a program did that the summary counts (with
+/// `POST_SRC`, its text too).
+fn tell(what: std::fmt::Arguments, src: &str) {
+    if std::env::var_os("POST_VERBOSE").is_some() {
+        eprintln!("{what}");
+        if std::env::var_os("POST_SRC").is_some() {
+            eprintln!("{src}");
+        }
+    }
+}
+
 /// Ok(true) when accepted, Ok(false) when refused with a position.
 fn accepted(stage: &str, r: Result<(), (u32, String)>, src: &str) -> Result<bool, TestCaseError> {
     match r {
@@ -517,12 +528,10 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
         Err(e) => {
             if plain_ok {
                 counts.regressed += 1;
-                if std::env::var_os("POST_VERBOSE").is_some() {
-                    eprintln!("accepted as posted, refused compressed: {e}");
-                    if std::env::var_os("POST_SRC").is_some() {
-                        eprintln!("{src}");
-                    }
-                }
+                tell(
+                    format_args!("accepted as posted, refused compressed: {e}"),
+                    src,
+                );
             }
             counts.refused += 1;
             return accepted("plan", Err((e.pos.line, e.to_string())), src).map(|_| ());
@@ -535,15 +544,12 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
         counts.compressed_s += profile.duration;
         counts.slower += u64::from(profile.duration > 1.01 * t);
         counts.slowest = counts.slowest.max(profile.duration / t);
-        if profile.duration > 1.01 * t && std::env::var_os("POST_VERBOSE").is_some() {
-            eprintln!(
-                "{:.2}x as long compressed: {:.3} s against {t:.3} s as posted",
-                profile.duration / t,
-                profile.duration
+        if profile.duration > 1.01 * t {
+            let (d, x) = (profile.duration, profile.duration / t);
+            tell(
+                format_args!("{x:.2}x as long compressed: {d:.3} s against {t:.3} s as posted"),
+                src,
             );
-            if std::env::var_os("POST_SRC").is_some() {
-                eprintln!("{src}");
-            }
         }
     }
     let sps = setpoints(&path, &profile, &cfg, kin);

@@ -1,25 +1,35 @@
 //! What the planner does where the setpoint check finds a limit broken: the caps on the
 //! stations a violation's stencil holds ([`cap_for`]), and where those change nothing, the
-//! caps widened to the stations on either side ([`widening`]), the path's share of the
-//! axes' limits lowered ([`lower_share`]), or the ceilings lowered from where they are
-//! ([`Remedy`]).
+//! caps widened to the stations on either side ([`widening`], [`cap_widened`]), the path's
+//! share of the axes' limits lowered ([`lower_share`]), or the ceilings lowered from where
+//! they are ([`Remedy`]).
 
 use super::limits::AXIS_SHARE_FLOOR;
 use super::{Station, AXIS_SHARE_LEAST, CAP_MARGIN, V_FLOOR, V_JOINT_FLOOR};
 use crate::verify::{Quantity, Violation};
 
-/// Cap the stations over `s` for violation `v`, whose speed must drop by `factor`. An
+/// Cap the stations violation `v`'s stencil holds, whose speed must drop by `factor`. An
 /// axis's jerk over its limit lowers the path's share of it there too (slowing down does
 /// not lower the path's own term, `q_s s'''`; an acceleration over it is a corner's
-/// velocity jump or the curvature's term, which slowing down lowers).
-pub(super) fn cap_for(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64) {
-    let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-    // (A joint's own caps: widened to the stations beside it, they stop at the floor.)
-    let floor = if below_floor(v) && s == v.s {
-        V_JOINT_FLOOR
-    } else {
-        V_FLOOR
+/// velocity jump or the curvature's term, which slowing down lowers). A joint's step
+/// ([`below_floor`]) is capped down to [`V_JOINT_FLOOR`], every other cap to the floor.
+pub(super) fn cap_for(st: &mut [Station], v: &Violation, factor: f64) {
+    let floor = match below_floor(v) {
+        true => V_JOINT_FLOOR,
+        false => V_FLOOR,
     };
+    cap(st, v, v.s, factor, floor);
+}
+
+/// Cap the stations of violation `v`'s [`widening`] `w`. These caps stop at the floor
+/// speed whatever the violation: a joint's step widened to the stations beside it would
+/// have them crawl.
+pub(super) fn cap_widened(st: &mut [Station], v: &Violation, w: &Widening) {
+    cap(st, v, w.s, w.factor, V_FLOOR);
+}
+
+fn cap(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64, floor: f64) {
+    let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
     super::cap_stations(st, s, (v.v * factor * CAP_MARGIN, floor), share);
 }
 

@@ -26,7 +26,7 @@
 //! linear in the program.
 
 use super::limits::section_limits;
-use super::remedy::{below_floor, cap_for, lower_share, widening, Remedy};
+use super::remedy::{below_floor, cap_for, cap_widened, lower_share, widening, Remedy};
 use super::stations::Sampler;
 use super::{
     refuse, schedule, too_long, with_dwells, FeedProfile, PlanConfig, PlanError, Station,
@@ -578,7 +578,7 @@ impl Windows<'_> {
                         widened = true;
                         for v in &prev.checked.violations {
                             if let Some(w) = widening(st, v) {
-                                cap_for(st, v, w.s, w.factor);
+                                cap_widened(st, v, &w);
                             }
                         }
                         continue 'rounds;
@@ -654,7 +654,7 @@ impl Windows<'_> {
                         // Behind the window's start: only a slower start would help.
                         break 'round Ok(None);
                     }
-                    cap_for(st, v, v.s, factor);
+                    cap_for(st, v, factor);
                 }
                 last = Some(WindowPlan {
                     offset: committed,
