@@ -20,14 +20,16 @@
 //!    tolerance whatever the sampling phase (after a hold, too). The path starts and ends
 //!    at rest, and rests where a move waits (a dwell, the operator, the spindle).
 //! 4. **S-curves between critical points.** Critical points are the start, the end, the
-//!    joints and the local minima of the ceiling. Backward and forward passes make each
-//!    point's speed reachable from its neighbours; then each section gets a jerk-limited
-//!    accelerate / cruise / decelerate profile with the highest cruise speed that fits. Its
-//!    two ramps' path acceleration and jerk are what each axis's share (90 %) leaves after
-//!    the curvature terms, over the stretch each ramp can cover and at the speeds it can
-//!    have there, and never less than half the axis's ([`limits`]). Wherever a section's
-//!    speed exceeds the ceiling at a station, that station becomes a critical point and the
-//!    plan is redone.
+//!    joints, the local minima of the ceiling, and the stations next to where the rates
+//!    jump (the path acceleration they allow drops 8x from one station to the next: a tool
+//!    arriving at the vertical), which would otherwise hold the ramps beside them.
+//!    Backward and forward passes make each point's speed reachable from its neighbours;
+//!    then each section gets a jerk-limited accelerate / cruise / decelerate profile with
+//!    the highest cruise speed that fits. Its two ramps' path acceleration and jerk are
+//!    what each axis's share (90 %) leaves after the curvature terms, over the stretch each
+//!    ramp can cover and at the speeds it can have there, and never less than half the
+//!    axis's ([`limits`]). Wherever a section's speed exceeds the ceiling at a station,
+//!    that station becomes a critical point and the plan is redone.
 //! 5. **The setpoint check** measures every axis's velocity, acceleration and jerk by finite
 //!    differences at the period ([`crate::verify`]); where one is over its limit the
 //!    ceilings there are lowered (and for jerk the path's share, to half) and the window is
@@ -562,7 +564,11 @@ fn schedule(
         }
         let is_joint = starts.get(joint) == Some(&i);
         let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
-        if is_joint || is_min {
+        // The last station before the rates jump (a tool arriving at the vertical), or the
+        // first after: the ramps on this side are not held to the jump's limits.
+        let is_edge = limits::rates_jump(&st[i].before, &st[i + 1].before, cfg)
+            || limits::rates_jump(&st[i].after, &st[i - 1].after, cfg);
+        if is_joint || is_min || is_edge {
             crit.push((i, st[i].vlim));
         }
     }

@@ -710,6 +710,18 @@ fn a_joint_below_the_floor_speed_runs_compressed() {
     );
 }
 
+/// A post the generator wrote (seed 3): fitted, the first block (14.6 mm at F408) ends on
+/// the vertical. The rates at its end held the ramps of the whole block to 0.077 mm/s^2,
+/// where no axis came near its limits: 42.20 s against 20.70 s as posted. Now the station
+/// before such a jump of the rates is a critical point, and the block's ramps are its own.
+#[test]
+fn a_block_is_not_held_to_the_rates_at_its_vertical_end() {
+    assert_runs_compressed_within(
+        include_str!("adversarial/a-block-held-to-the-rates-at-its-vertical-end.nc"),
+        1.0,
+    );
+}
+
 /// A post the generator wrote (seed 0, cut to the pass change): a `G01` turns the tool 40
 /// degrees past 0.9 degrees from the vertical, where C's rate peaks over 2 um, between the
 /// planner's stations. Compressed, C's jerk stayed 1.04x its limit at the slowest feed
