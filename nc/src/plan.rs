@@ -3,9 +3,10 @@
 //!
 //! 1. **Stations.** Each segment is sampled at stations about one period of travel apart
 //!    (16..=4096 per segment; 2 or more along a line with a fixed tool axis, whose joints
-//!    move at constant rates). At each station the machine joints q(s) are computed through
-//!    the kinematics (with rotary continuity), and dq/ds, d2q/ds2, d3q/ds3 by finite
-//!    differences (at a joint of two segments, each side's).
+//!    move at constant rates; eight times as many, up to 4096, where a rotary axis's rate
+//!    changes 8x from one interval to the next). At each station the machine joints q(s)
+//!    are computed through the kinematics (with rotary continuity), and dq/ds, d2q/ds2,
+//!    d3q/ds3 by finite differences (at a joint of two segments, each side's).
 //! 2. **Velocity ceiling** at each station, the least of: the programmed feed; the chord-error
 //!    limit `2 sqrt(2 rho delta - delta^2) / Ts` (rho = 1/curvature, delta = tolerance); the
 //!    centripetal limit `sqrt(A / curvature)`; for every axis j `vmax_j / |dq_j/ds|` and

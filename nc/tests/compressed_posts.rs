@@ -710,6 +710,20 @@ fn a_joint_below_the_floor_speed_runs_compressed() {
     );
 }
 
+/// A post the generator wrote (seed 3): fitted, a block brings the tool onto the vertical
+/// at its end, where C turns like one over the tilt. The planner's stations, a period of
+/// travel apart, saw C's rate go 0.0014, 0.117, then 27 rad/mm at the end; a cap held the
+/// whole interval before it, and the path crawled over its 0.076 mm at 0.4 mm/min: 13.08 s
+/// against 2.69 s as posted. Now a segment whose stations do not resolve a rotary axis's
+/// rate is sampled eight times as densely.
+#[test]
+fn a_block_ending_on_the_vertical_does_not_crawl_over_a_station_interval() {
+    assert_runs_compressed_within(
+        include_str!("adversarial/c-unresolved-as-a-block-ends-on-the-vertical.nc"),
+        1.25,
+    );
+}
+
 /// A post the generator wrote (seed 3): fitted, the first block (14.6 mm at F408) ends on
 /// the vertical. The rates at its end held the ramps of the whole block to 0.077 mm/s^2,
 /// where no axis came near its limits: 42.20 s against 20.70 s as posted. Now the station
