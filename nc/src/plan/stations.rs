@@ -311,14 +311,13 @@ impl Sampler {
                     prev
                 })
                 .collect();
-            (q, prev)
+            (q, prev, h)
         };
-        let (mut q, mut prev) = sample(n);
-        if !lines && n < MOST_STATIONS && unresolved(&q, seg.length / n as f64) {
+        let (mut q, mut prev, mut h) = sample(n);
+        if !lines && n < MOST_STATIONS && unresolved(&q, h) {
             n = (n * REFINE).min(MOST_STATIONS);
-            (q, prev) = sample(n);
+            (q, prev, h) = sample(n);
         }
-        let h = seg.length / n as f64;
         self.prev = prev;
         let (start_rate, end_rate) = end_rates(seg, kin, cfg, &q, h);
         // |d2q/ds2| at each station, and |d3q/ds3| from its change to the neighbours' (for
