@@ -56,7 +56,7 @@ mod stations;
 mod window;
 
 use limits::{section_ramps, AXIS_SHARE, AXIS_SHARE_LEAST};
-use stations::Station;
+use stations::{Rates, Station};
 
 pub use window::{Finished, Planner, Sink};
 
@@ -559,16 +559,25 @@ fn schedule(
     // The joints walked in step with the stations (a search per station over the whole
     // program's joints made the plan n log n).
     let mut joint = starts.partition_point(|&x| x <= from);
+    // What the rates allow the path at stations i and i + 1 on their `before` side, and at
+    // i - 1 and i on their `after` side, carried from one station to the next.
+    let acc = |r: &Rates| limits::rates_acc(r, cfg);
+    let (mut before, mut after) = (
+        (0.0, st.get(from + 1).map_or(0.0, |x| acc(&x.before))),
+        (0.0, acc(&st[from].after)),
+    );
     for i in from + 1..last {
         while starts.get(joint).is_some_and(|&x| x < i) {
             joint += 1;
         }
         let is_joint = starts.get(joint) == Some(&i);
         let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
+        before = (before.1, acc(&st[i + 1].before));
+        after = (after.1, acc(&st[i].after));
         // The last station before the rates jump (a tool arriving at the vertical), or the
         // first after: the ramps on this side are not held to the jump's limits.
-        let is_edge = limits::rates_jump(&st[i].before, &st[i + 1].before, cfg)
-            || limits::rates_jump(&st[i].after, &st[i - 1].after, cfg);
+        let is_edge =
+            limits::rates_jump(before.0, before.1) || limits::rates_jump(after.1, after.0);
         if is_joint || is_min || is_edge {
             crit.push((i, st[i].vlim));
         }

@@ -138,15 +138,19 @@ fn bare_limits(r: &Rates, share: f64, cfg: &PlanConfig) -> (f64, f64) {
 /// the next before the station before the drop is a critical point (`super::schedule`).
 const RATES_JUMP: f64 = 8.0;
 
-/// Rates `b`, a station's neighbour's on its side, allow the path less than
-/// 1/[`RATES_JUMP`] of the acceleration rates `a` allow. A section's ramp is held to the
-/// least its stations allow over the stretch it may cover, and a slow ramp covers the
-/// section: where a block brought the tool onto the vertical, the rates at its end (C's,
-/// turning the tool about the vertical) held the whole 14 mm block to 0.077 mm/s^2, where
-/// no axis came near its limits: 42.2 s against 20.7 s as posted.
-pub(super) fn rates_jump(a: &Rates, b: &Rates, cfg: &PlanConfig) -> bool {
-    let (from, _) = bare_limits(a, 1.0, cfg);
-    let (to, _) = bare_limits(b, 1.0, cfg);
+/// The path acceleration rates `r` allow at the axes' whole limits, without the curvature
+/// terms: what [`rates_jump`] compares between neighbouring stations.
+pub(super) fn rates_acc(r: &Rates, cfg: &PlanConfig) -> f64 {
+    bare_limits(r, 1.0, cfg).0
+}
+
+/// The path acceleration the rates allow drops from `from` to less than 1/[`RATES_JUMP`]
+/// of it at a station's neighbour on its side ([`rates_acc`] of each). A section's ramp is
+/// held to the least its stations allow over the stretch it may cover, and a slow ramp
+/// covers the section: where a block brought the tool onto the vertical, the rates at its
+/// end (C's, turning the tool about the vertical) held the whole 14 mm block to
+/// 0.077 mm/s^2, where no axis came near its limits: 42.2 s against 20.7 s as posted.
+pub(super) fn rates_jump(from: f64, to: f64) -> bool {
     to * RATES_JUMP < from
 }
 
