@@ -759,3 +759,17 @@ fn a_fast_tool_turn_at_a_runs_start_runs_compressed() {
         "adversarial/a-fitted-block-leaving-its-start-backwards.nc"
     ));
 }
+
+/// A post the generator wrote (seed 7, lines 2905-3204): a pass in vectors, then one in
+/// angles whose first move tilts the tool from 8.2 to 0.45 degrees. Joint by joint, A
+/// stays above 0.45 degrees while C turns; fitted into the run, the tool took the short
+/// way, nearer the vertical, and C's velocity was 1.12x its limit at the slowest feed,
+/// where the moves as posted ran. A move in angles from a tilted pose given as a vector
+/// now stays a `G01`: 4.29 s compressed against 4.88 s as posted.
+#[test]
+fn a_move_into_angles_from_a_vector_runs_compressed() {
+    assert_runs_compressed_within(
+        include_str!("adversarial/a-move-into-angles-from-a-vector.nc"),
+        1.0,
+    );
+}

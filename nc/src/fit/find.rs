@@ -3,7 +3,8 @@
 //! ([`super::compress`]) share.
 //!
 //! Blocks b..=e form a run when each is a feed move (`G01`, not rapid) that follows a
-//! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`], has the
+//! linear move, moves the cutter, turns the tool by at most [`MAX_TURN_DEG`] (and is not
+//! a move in machine angles from a tilted pose given as a vector, [`may_follow`]), has the
 //! run's feed (within [`INVERSE_FEED_SPREAD`] under `G93`) and tool length and no wait
 //! before it (but the first), keeps the tool vertical if the first does and only then
 //! ([`keeps_vertical`]), and no two of them meet at a corner sharper than the corner angle;
@@ -80,11 +81,24 @@ pub fn moves_in(program: &Program) -> usize {
 }
 
 /// Move `m` may follow `prev` in a run: a feed move that moves the cutter and turns the
-/// tool by at most [`MAX_TURN_DEG`].
+/// tool by at most [`MAX_TURN_DEG`], and not a move in machine angles from a tilted pose
+/// given as a vector.
+///
+/// A move in angles turns the joints linearly from where the pose before left them, and
+/// after a tilted vector those are the inverse kinematics' choice of two solutions, which
+/// the fit does not know: a move from a tool tilted 8.2 degrees, given as `I J K`, to one
+/// at `A0.4543 C45.7471` turns C by 132 degrees, spread over the move joint by joint (A
+/// stays above 0.45 degrees), while a fitted axis took the short way, nearer the vertical,
+/// where C turns faster per millimetre: refused compressed, C's velocity over its limit at
+/// the slowest feed, where the move as posted ran (`nc/tests/compressed_posts.rs`). Such a
+/// move stays a `G01`. From a vertical vector the fit may take it: there the move as
+/// posted turns C from wherever it was kept while the tool leaves the vertical, and
+/// programs that start so were refused as posted and ran fitted.
 pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) -> bool {
     let (pa, pb) = (point(prev, kin), point(m, kin));
     let rot = match (angles(prev), angles(m)) {
         (Some((a1, c1)), Some((a2, c2))) => (a2 - a1).abs().max((c2 - c1).abs()),
+        (None, Some(_)) if !is_vertical(&pa.axis) => return false,
         _ => pa.axis.angle(&pb.axis).to_degrees(),
     };
     !m.rapid && (pb.p - pa.p).norm() > 1e-6 && rot <= MAX_TURN_DEG
@@ -98,8 +112,13 @@ pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) ->
 /// tilts to the vertical and stays there, fitted whole, was refused by the planner where
 /// the moves as posted ran: `nc/tests/compressed_posts.rs`).
 pub fn keeps_vertical(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) -> bool {
-    let vertical = |t: Vector3<f64>| t.x.hypot(t.y) < crate::kinematics::VERTICAL_RHO;
-    vertical(point(prev, kin).axis) && vertical(point(m, kin).axis)
+    is_vertical(&point(prev, kin).axis) && is_vertical(&point(m, kin).axis)
+}
+
+/// The unit tool axis `t` is within [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO) of
+/// the vertical, where a table's C is undefined.
+fn is_vertical(t: &Vector3<f64>) -> bool {
+    t.x.hypot(t.y) < crate::kinematics::VERTICAL_RHO
 }
 
 /// Move `m` has the feed, tool length and mode of the run `first` begins: the same feed
