@@ -22,8 +22,9 @@
 //!    at rest, and rests where a move waits (a dwell, the operator, the spindle).
 //! 4. **S-curves between critical points.** Critical points are the start, the end, the
 //!    joints, the local minima of the ceiling, and the stations next to where the rates
-//!    jump (the path acceleration they allow drops 8x from one station to the next: a tool
-//!    arriving at the vertical), which would otherwise hold the ramps beside them.
+//!    jump (the path acceleration they allow falls or rises 8x from what it was on the
+//!    stretch leaving the last critical point: a tool arriving at the vertical, or leaving
+//!    it), which would otherwise hold the ramps beside them.
 //!    Backward and forward passes make each point's speed reachable from its neighbours;
 //!    then each section gets a jerk-limited accelerate / cruise / decelerate profile with
 //!    the highest cruise speed that fits. Its two ramps' path acceleration and jerk are
@@ -559,27 +560,30 @@ fn schedule(
     // The joints walked in step with the stations (a search per station over the whole
     // program's joints made the plan n log n).
     let mut joint = starts.partition_point(|&x| x <= from);
-    // What the rates allow the path at stations i and i + 1 on their `before` side, and at
-    // i - 1 and i on their `after` side, carried from one station to the next.
+    // What the rates allow the path (`limits::rates_acc`) on the stretch leaving the last
+    // critical point, and on the stretch arriving at station i + 1.
     let acc = |r: &Rates| limits::rates_acc(r, cfg);
-    let (mut before, mut after) = (
-        (0.0, st.get(from + 1).map_or(0.0, |x| acc(&x.before))),
-        (0.0, acc(&st[from].after)),
-    );
+    let mut at_crit = acc(&st[from].after);
     for i in from + 1..last {
         while starts.get(joint).is_some_and(|&x| x < i) {
             joint += 1;
         }
         let is_joint = starts.get(joint) == Some(&i);
         let is_min = st[i].vlim < st[i - 1].vlim && st[i].vlim <= st[i + 1].vlim;
-        before = (before.1, acc(&st[i + 1].before));
-        after = (after.1, acc(&st[i].after));
-        // The last station before the rates jump (a tool arriving at the vertical), or the
-        // first after: the ramps on this side are not held to the jump's limits.
-        let is_edge =
-            limits::rates_jump(before.0, before.1) || limits::rates_jump(after.1, after.0);
+        let (next, after) = (acc(&st[i + 1].before), acc(&st[i].after));
+        // The last station before the rates allow the path RATES_JUMP times less than on
+        // the stretch leaving the last critical point (a tool coming onto the vertical), or
+        // the first where they allow it that much more (leaving it): the ramps on either
+        // side are not held to the other's limits. Measured from the last critical point,
+        // not the station before: the rates of a block that ends on the vertical grow like
+        // one over the distance to its end, and stations dense enough to resolve them
+        // never see a jump. (From its leaving side: a joint's arriving side is the block
+        // before, and a move whose rates jump at its start had its next station taken for
+        // a fall, a critical point at its ceiling that the caps could not lower.)
+        let is_edge = limits::rates_jump(at_crit, next) || limits::rates_jump(after, at_crit);
         if is_joint || is_min || is_edge {
             crit.push((i, st[i].vlim));
+            at_crit = after;
         }
     }
     crit.push((last, 0.0));

@@ -134,22 +134,24 @@ fn bare_limits(r: &Rates, share: f64, cfg: &PlanConfig) -> (f64, f64) {
     (acc.max(A_FLOOR), jerk.max(A_FLOOR))
 }
 
-/// Factor by which the path acceleration the rates allow may drop from one station to
-/// the next before the station before the drop is a critical point (`super::schedule`).
+/// Factor by which the path acceleration the rates allow may fall (or rise) from the last
+/// critical point before the station before the fall (or the one at the rise) is made
+/// one (`super::schedule`).
 const RATES_JUMP: f64 = 8.0;
 
 /// The path acceleration rates `r` allow at the axes' whole limits, without the curvature
-/// terms: what [`rates_jump`] compares between neighbouring stations.
+/// terms: what [`rates_jump`] compares between the stretch leaving a critical point and
+/// the stations after it.
 pub(super) fn rates_acc(r: &Rates, cfg: &PlanConfig) -> f64 {
     bare_limits(r, 1.0, cfg).0
 }
 
 /// The path acceleration the rates allow drops from `from` to less than 1/[`RATES_JUMP`]
-/// of it at a station's neighbour on its side ([`rates_acc`] of each). A section's ramp is
-/// held to the least its stations allow over the stretch it may cover, and a slow ramp
-/// covers the section: where a block brought the tool onto the vertical, the rates at its
-/// end (C's, turning the tool about the vertical) held the whole 14 mm block to
-/// 0.077 mm/s^2, where no axis came near its limits: 42.2 s against 20.7 s as posted.
+/// of it at `to` ([`rates_acc`] of each). A section's ramp is held to the least its
+/// stations allow over the stretch it may cover, and a slow ramp covers the section: where
+/// a block brought the tool onto the vertical, the rates at its end (C's, turning the tool
+/// about the vertical) held the whole 14 mm block to 0.077 mm/s^2, where no axis came near
+/// its limits: 42.2 s against 20.7 s as posted.
 pub(super) fn rates_jump(from: f64, to: f64) -> bool {
     to * RATES_JUMP < from
 }

@@ -231,7 +231,10 @@ fn end_rates(
 /// Most stations on one segment.
 const MOST_STATIONS: usize = 4096;
 /// A segment is sampled this many times as densely where its stations do not resolve a
-/// rotary axis's rate ([`unresolved`]).
+/// rotary axis's rate ([`unresolved`]), and again while they do not (up to
+/// [`MOST_STATIONS`]: a rate that grows like one over the distance to a block's end on the
+/// vertical is never resolved). Sampled eight times as densely once, the same block had
+/// the path crawl at 0.4 mm/min over the last interval, 0.0095 mm, for 1.5 s.
 const REFINE: usize = 8;
 /// Factor by which a rotary axis's rate may change from one interval between stations to
 /// the next before the stations count as not resolving it.
@@ -314,7 +317,7 @@ impl Sampler {
             (q, prev, h)
         };
         let (mut q, mut prev, mut h) = sample(n);
-        if !lines && n < MOST_STATIONS && unresolved(&q, h) {
+        while !lines && n < MOST_STATIONS && unresolved(&q, h) {
             n = (n * REFINE).min(MOST_STATIONS);
             (q, prev, h) = sample(n);
         }
