@@ -233,8 +233,9 @@ const MOST_STATIONS: usize = 4096;
 /// A segment is sampled this many times as densely where its stations do not resolve a
 /// rotary axis's rate ([`unresolved`]), and again while they do not (up to
 /// [`MOST_STATIONS`]: a rate that grows like one over the distance to a block's end on the
-/// vertical is never resolved). Sampled eight times as densely once, the same block had
-/// the path crawl at 0.4 mm/min over the last interval, 0.0095 mm, for 1.5 s.
+/// vertical is never resolved). Sampled eight times as densely once, the block of
+/// [`unresolved`]'s example still had the path crawl at 0.4 mm/min over its last
+/// interval, 0.0095 mm, for 1.5 s.
 const REFINE: usize = 8;
 /// Factor by which a rotary axis's rate may change from one interval between stations to
 /// the next before the stations count as not resolving it.
