@@ -117,6 +117,12 @@ const TWO_PI: f64 = 2.0 * core::f64::consts::PI;
 /// Below this |(Tx, Ty)| the tool is vertical and C is left where it was.
 pub const VERTICAL_RHO: f64 = 1e-12;
 
+/// The unit tool axis `t` is within [`VERTICAL_RHO`] of the vertical, where a table's C is
+/// undefined and [`Kinematics::angles`] keeps it.
+pub fn is_vertical(t: &Vector3<f64>) -> bool {
+    t.x.hypot(t.y) < VERTICAL_RHO
+}
+
 /// `c` shifted by whole turns to lie nearest `reference`.
 pub fn unwrap_near(c: f64, reference: f64) -> f64 {
     c + TWO_PI * ((reference - c) / TWO_PI).round()
@@ -139,7 +145,7 @@ impl Kinematics for MachineKinematics {
     fn angles(&self, t: &Vector3<f64>, prev: (f64, f64), lim: &RotaryLimits) -> (f64, f64) {
         let rho = t.x.hypot(t.y);
         let tilt = rho.atan2(t.z);
-        if rho < VERTICAL_RHO {
+        if is_vertical(t) {
             // Vertical tool: any C is right; keep it, and keep the tilt's sign.
             return (if prev.0 < 0.0 { -tilt } else { tilt }, prev.1);
         }

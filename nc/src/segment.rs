@@ -350,12 +350,14 @@ fn turn_c(seg: &Segment, joints: &Joints, c: f64, limits: &BuildLimits) -> Segme
     }
 }
 
-/// True when the tool axis is (numerically) vertical, so that C is undefined.
-fn is_vertical(t: &Vector3<f64>) -> bool {
+/// The tool axis is within [`VERTICAL_TOL`] of the vertical: a segment end the C look-ahead
+/// treats as vertical (looser than [`is_vertical`](crate::kinematics::is_vertical), where the
+/// kinematics leave C as it was).
+fn near_vertical(t: &Vector3<f64>) -> bool {
     t.x.hypot(t.y) < VERTICAL_TOL
 }
 
-/// Below this |(Tx, Ty)| a segment's start counts as a vertical tool for the C look-ahead.
+/// Below this |(Tx, Ty)| a segment's end counts as a vertical tool for the C look-ahead.
 const VERTICAL_TOL: f64 = 1e-9;
 
 /// The C a segment needs where it leaves the vertical, if it starts vertical and leaves it.
@@ -389,7 +391,7 @@ fn vertical_edge(seg: &Segment, kin: &MachineKinematics, end: End) -> Option<Pos
         return None;
     }
     let at = if end == End::First { 0.0 } else { seg.length };
-    if !is_vertical(&seg.pose(at).axis(kin)) {
+    if !near_vertical(&seg.pose(at).axis(kin)) {
         return None;
     }
     // Along the curve's own parameter where there is one: a cutter that starts at rest

@@ -13,7 +13,7 @@
 
 use super::runs::Options;
 use super::{fit, Fitted, Point};
-use crate::kinematics::{Kinematics, MachineKinematics};
+use crate::kinematics::{is_vertical, Kinematics, MachineKinematics};
 use crate::parse::MIN_FEED_MM_MIN;
 use crate::program::{Block, LinearMove, Orientation, Program};
 use nalgebra::Vector3;
@@ -113,12 +113,6 @@ pub fn may_follow(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) ->
 /// the moves as posted ran: `nc/tests/compressed_posts.rs`).
 pub fn keeps_vertical(prev: &LinearMove, m: &LinearMove, kin: &MachineKinematics) -> bool {
     is_vertical(&point(prev, kin).axis) && is_vertical(&point(m, kin).axis)
-}
-
-/// The unit tool axis `t` is within [`VERTICAL_RHO`](crate::kinematics::VERTICAL_RHO) of
-/// the vertical, where a table's C is undefined.
-fn is_vertical(t: &Vector3<f64>) -> bool {
-    t.x.hypot(t.y) < crate::kinematics::VERTICAL_RHO
 }
 
 /// Move `m` has the feed, tool length and mode of the run `first` begins: the same feed
