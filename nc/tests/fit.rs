@@ -436,6 +436,27 @@ fn a_path_measured_against_itself_is_not_off() {
     assert_eq!(dev.points, 206);
 }
 
+/// A curve whose span is far longer than the straight line between its ends is measured
+/// along its length: a G06.5 block whose weights run from 0.005 to 768 (found by the fuzz
+/// target `nc_compressed`, the block before a run of moves it fitted) loops between its
+/// knots, and the check looked for a span's end within twice the straight distance to it
+/// and found it 5.7 mm off the block itself, so `dnurbs fit` refused to write a program
+/// whose every point it had kept.
+#[test]
+fn a_looping_nurbs_span_measured_against_itself_is_not_off() {
+    let src = "G90 G21\nG01 X-0.2827 Y-15.433 Z-4.3496 F1000\n\
+        G06.5 P2 F12104.3456 X-0.2827 Y-15.433 Z-4.3496 U-0.28268 V-15.43317 W-1.32146 R1 K0\n\
+        X-4.919203 Y-19.078374 Z-13.635058 U-4.834112 V-19.865217 W-10.712172 R3.750246 K0\n\
+        X-2.590794 Y-19.078374 Z-13.823828 U-1.899286 V-18.831795 W-10.886032 R0.022319 K0\n\
+        X-2.590794 Y-20.844983 Z-8.597086 U-3.205734 V-21.451591 W-5.694759 R768.25415 K0.455003\n\
+        X4.823020 Y-11.247886 Z-14.374911 U6.474493 V-11.220475 W-11.836898 R0.004603 K0.916189\n\
+        K1 K1 K1\n";
+    let (_, bl) = nc::fixtures::small_mill(0.002);
+    let path = build(&nc::parse::parse(src).unwrap(), &KIN, &bl).unwrap();
+    let dev = measure(&path, &path, &KIN, 0.002, 0.001);
+    assert!(dev.point_mm < 1e-6 && dev.path_mm < 1e-6, "{dev:?}");
+}
+
 /// A program that goes back over its own path (a reversal, as `compressed_posts.rs`
 /// generates them: 3 um forward, back, on) with the tool tilted on the way back, against
 /// an output that passes its first point 0.5 um off and the rest exactly: each point is

@@ -414,18 +414,23 @@ pub fn measure(
             nearest(t, q, cursor, 2.0 * h, reach, 0.0)
         }
     };
-    // Programmed points: the start and every input segment's end.
-    let mut points = vec![(input.start, input.start_src.line)];
+    // Programmed points: the start and every input segment's end, with the input's length
+    // to them from the point before.
+    let mut points = vec![(input.start, input.start_src.line, 0.0)];
     points.extend(
         input
             .segments
             .iter()
-            .map(|s| (s.pose(s.length), s.src.line)),
+            .map(|s| (s.pose(s.length), s.src.line, s.length)),
     );
     let mut cursor = Near::START;
     let mut prev = input.start.p;
-    for (pose, line) in points {
-        let step = (pose.p - prev).norm();
+    for (pose, line, length) in points {
+        // The output runs about as far as the input between two points: a curve between
+        // them can be much longer than the straight line (a loop of a NURBS span whose
+        // weights span 1e-3 to 1e3: its end was looked for a tenth of the way along it and
+        // measured 5.7 mm off, where the output was the input's own block).
+        let step = (pose.p - prev).norm().max(length);
         prev = pose.p;
         cursor = pass(&out, &pose.p, cursor, 2.0 * step + 0.5);
         let j = cursor.j;
