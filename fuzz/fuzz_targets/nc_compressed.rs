@@ -1,0 +1,86 @@
+//! NC program bytes compressed on line, as `dnurbs simulate --compress` and `run --compress`
+//! do on the paper's machine: text -> parse -> the compressor (runs of `G01` moves fitted
+//! into G06.5 blocks) -> segments -> plan with its setpoint check. A panic, an abort or a
+//! hang is a finding, and so is:
+//! - a fitted block the compressor says is off its moves by more than the tolerances;
+//! - a compressed program that the independent measurement of `dnurbs fit` (dense sampling
+//!   of the output against the input polyline) finds off a programmed point by more than
+//!   the tolerances, where the program as posted builds (sampled every 5 um, or at 20 000
+//!   samples over a longer path; the programmed points are projected exactly);
+//! - an accepted plan whose own check measured a limit above 100 %.
+//!
+//! Programs whose plan would take more than 200 000 periods are compressed and built but not
+//! planned (as `nc_program`).
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use std::sync::OnceLock;
+
+fn setup() -> &'static dnurbs_tools::setup::MachineSetup {
+    static SETUP: OnceLock<dnurbs_tools::setup::MachineSetup> = OnceLock::new();
+    SETUP.get_or_init(|| {
+        let text = include_str!("../../config/machines/paper-ac-table.toml");
+        let m = config::from_str(text, std::path::Path::new("paper-ac-table.toml"))
+            .expect("the shipped machine file is valid");
+        dnurbs_tools::setup::MachineSetup::new(&m).with_compress(Some(true))
+    })
+}
+
+fuzz_target!(|data: &[u8]| {
+    if data.len() > 4096 {
+        return;
+    }
+    let Ok(text) = dnurbs_tools::program_text(data) else {
+        return;
+    };
+    let Ok(posted) = nc::parse::parse(text) else {
+        return;
+    };
+    let s = setup();
+    let opts = s.compress.as_ref().expect("compression is on");
+    let (program, c) = s.prepare(posted.clone());
+    let c = c.expect("compression is on");
+    let tol_deg = opts.tol.rad.to_degrees();
+    assert!(
+        c.fit_mm <= opts.tol.mm && c.fit_deg <= tol_deg * (1.0 + 1e-9),
+        "the fit claims {} mm and {} deg",
+        c.fit_mm,
+        c.fit_deg
+    );
+    let Ok(path) = nc::segment::build(&program, &s.kin, &s.build) else {
+        return;
+    };
+    if c.fitted_blocks > 0 {
+        if let Ok(input) = nc::segment::build(&posted, &s.kin, &s.build) {
+            // Sampled every 5 um as `compressed_posts.rs` does, or at 20 000 samples over a
+            // longer path (the programmed points are projected exactly either way).
+            let length: f64 = input.segments.iter().map(|x| x.length).sum();
+            if length.is_finite() {
+                let h = (length / 20_000.0).max(0.005);
+                let dev = nc::fit::deviation::measure(&input, &path, &s.kin, h, opts.tol.mm);
+                assert!(
+                    dev.point_mm <= opts.tol.mm + 5e-7 && dev.point_deg <= tol_deg * (1.0 + 1e-3),
+                    "measured off the posted program: {dev:?}"
+                );
+            }
+        }
+    }
+    let periods: f64 = path
+        .segments
+        .iter()
+        .map(|seg| seg.length / seg.feed.max(1e-3) / s.period)
+        .sum();
+    if !(periods <= 200_000.0) {
+        return;
+    }
+    if let Ok(profile) = nc::plan::plan(&path, &s.kin, &s.plan) {
+        let m = profile.margins;
+        let worst = (0..5)
+            .map(|j| m.velocity[j].max(m.acceleration[j]).max(m.jerk[j]))
+            .fold(m.chord, f64::max);
+        assert!(
+            worst <= 1.0 + 1e-9,
+            "accepted compressed plan at {worst}x a limit"
+        );
+    }
+});
