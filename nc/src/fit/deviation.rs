@@ -428,8 +428,9 @@ pub fn measure(
     for (pose, line, length) in points {
         // The output runs about as far as the input between two points: a curve between
         // them can be much longer than the straight line (a loop of a NURBS span whose
-        // weights span 1e-3 to 1e3: its end was looked for a tenth of the way along it and
-        // measured 5.7 mm off, where the output was the input's own block).
+        // weights span 1e-3 to 1e3: its end, looked for within twice the straight distance,
+        // was not reached and measured 5.7 mm off, where the output was the input's own
+        // block).
         let step = (pose.p - prev).norm().max(length);
         prev = pose.p;
         cursor = pass(&out, &pose.p, cursor, 2.0 * step + 0.5);
