@@ -16,24 +16,15 @@
 use libfuzzer_sys::fuzz_target;
 use std::sync::OnceLock;
 
+mod common;
+
 fn setup() -> &'static dnurbs_tools::setup::MachineSetup {
     static SETUP: OnceLock<dnurbs_tools::setup::MachineSetup> = OnceLock::new();
-    SETUP.get_or_init(|| {
-        let text = include_str!("../../config/machines/paper-ac-table.toml");
-        let m = config::from_str(text, std::path::Path::new("paper-ac-table.toml"))
-            .expect("the shipped machine file is valid");
-        dnurbs_tools::setup::MachineSetup::new(&m).with_compress(Some(true))
-    })
+    SETUP.get_or_init(|| common::paper_machine().with_compress(Some(true)))
 }
 
 fuzz_target!(|data: &[u8]| {
-    if data.len() > 4096 {
-        return;
-    }
-    let Ok(text) = dnurbs_tools::program_text(data) else {
-        return;
-    };
-    let Ok(posted) = nc::parse::parse(text) else {
+    let Some(posted) = common::program(data) else {
         return;
     };
     let s = setup();
@@ -67,22 +58,5 @@ fuzz_target!(|data: &[u8]| {
             }
         }
     }
-    let periods: f64 = path
-        .segments
-        .iter()
-        .map(|seg| seg.length / seg.feed.max(1e-3) / s.period)
-        .sum();
-    if !(periods <= 200_000.0) {
-        return;
-    }
-    if let Ok(profile) = nc::plan::plan(&path, &s.kin, &s.plan) {
-        let m = profile.margins;
-        let worst = (0..5)
-            .map(|j| m.velocity[j].max(m.acceleration[j]).max(m.jerk[j]))
-            .fold(m.chord, f64::max);
-        assert!(
-            worst <= 1.0 + 1e-9,
-            "accepted compressed plan at {worst}x a limit"
-        );
-    }
+    common::plan_within_limits(&path, s);
 });
