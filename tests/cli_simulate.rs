@@ -448,3 +448,57 @@ fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
     assert!(!trace.exists(), "a refused program's trace is removed");
     let _ = std::fs::remove_file(&file);
 }
+
+/// A machine file whose jerk is set huge (as one means "none", LinuxCNC having none): every
+/// axis's jerk is planned at 0.098 of its acceleration a period, `simulate` says so on
+/// stderr, and a raster of short moves plans within every limit. With the ramps planned to
+/// 90 % of the acceleration, the check's reserve for a jerk of 1e9 (half the acceleration)
+/// refused it on its first ramp.
+#[test]
+fn a_jerk_set_huge_is_planned_at_a_tenth_of_the_acceleration_a_period_and_said() {
+    let text = std::fs::read_to_string(machine("xyzac-trt-mill.toml")).unwrap();
+    let huge: String = text
+        .lines()
+        .map(|l| match l.split_once('=') {
+            Some((k, _)) if matches!(k.trim(), "jerk" | "path_jerk") => {
+                format!("{k}= 1.0e9")
+            }
+            _ => l.to_owned(),
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    assert_eq!(huge.matches("= 1.0e9").count(), 6, "{huge}");
+    let mill = temp("huge-jerk.toml");
+    std::fs::write(&mill, huge).unwrap();
+    let mut program = String::from("%\nG90 G21 G94\nG01 X0 Y0 Z0 F3000\n");
+    for row in 0..4 {
+        for k in 0..=100 {
+            let x = f64::from(if row % 2 == 0 { k } else { 100 - k }) * 0.1;
+            let z = 0.5 * (x / 1.5).sin();
+            program += &format!("X{x:.4} Y{row}.0 Z{z:.4}\n");
+        }
+    }
+    program += "M30\n%\n";
+    let nc = temp("huge-jerk.nc");
+    std::fs::write(&nc, program).unwrap();
+    let out = dnurbs(&[
+        "simulate",
+        nc.to_str().unwrap(),
+        "--machine",
+        mill.to_str().unwrap(),
+        "--method",
+        "arclength",
+        "--json",
+    ]);
+    let _ = (std::fs::remove_file(&mill), std::fs::remove_file(&nc));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("planned at a jerk of 0.098 of the axis's acceleration a period (1 ms)")
+            && stderr.contains("X 1.0000e9 -> 2.9400e5 mm/s^3")
+            && stderr.contains("C 1.0000e9 -> 1.7640e5 deg/s^3"),
+        "{stderr}"
+    );
+    let s: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_within_limits(&s);
+}

@@ -69,6 +69,27 @@ pub struct AxisLimit {
     pub jerk: f64,
 }
 
+/// The most acceleration a plan's jerk builds up on an axis in one period, as a share of the
+/// axis's acceleration: see [`AxisLimit::planned_jerk`].
+pub const JERK_RISE: f64 = 0.098;
+
+impl AxisLimit {
+    /// The jerk a plan keeps to on this axis, and its setpoint check holds it to: the
+    /// limit, or [`JERK_RISE`] times the acceleration per `period` where that is less. The
+    /// check measures the acceleration at one phase of the period; a hold or an override
+    /// shifts the phase, and between phases the acceleration differs by up to `J Ts / 2`,
+    /// which the check keeps in reserve ([`crate::verify::reserve`]). A jerk that builds
+    /// much of the acceleration within a period (a linear motor, or a jerk set huge to mean
+    /// none, as LinuxCNC has none) left the ramps planned at 90 % of an acceleration the
+    /// check allowed half of, and a plain raster was refused on its first ramp (the
+    /// xyzac-trt-mill with every jerk 1e9: `the X axis acceleration would reach 2.6949e3
+    /// mm/s^2 ... 1.797x its limit of 1.5000e3`). At this jerk the reserve leaves 95 %:
+    /// a ramp reaches the acceleration in ten periods or more.
+    pub fn planned_jerk(&self, period: f64) -> f64 {
+        self.jerk.min(JERK_RISE * self.acceleration / period)
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlanConfig {
     /// Interpolation period, s.

@@ -160,8 +160,9 @@ pub const HOLD_RESERVE: f64 = 1e-3;
 
 /// The fraction of an axis's velocity and acceleration limits the plan's setpoints may use.
 pub fn reserve(ax: &AxisLimit, ts: f64) -> (f64, f64) {
-    let v = 1.0 - HOLD_RESERVE - ax.jerk * ts * ts / (8.0 * ax.velocity);
-    let a = 1.0 - HOLD_RESERVE - ax.jerk * ts / (2.0 * ax.acceleration);
+    let jerk = ax.planned_jerk(ts);
+    let v = 1.0 - HOLD_RESERVE - jerk * ts * ts / (8.0 * ax.velocity);
+    let a = 1.0 - HOLD_RESERVE - jerk * ts / (2.0 * ax.acceleration);
     (v.max(0.5), a.max(0.5))
 }
 /// Most periods a plan may take (24 h at 1 ms): a longer plan is refused, so neither the
@@ -459,6 +460,7 @@ fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
         let acc = ((q3 - 2.0 * q2 + q1) / (ts * ts)).abs();
         let (v_share, a_share) = reserve(ax, ts);
         let (vel_limit, acc_limit) = (ax.velocity * v_share, ax.acceleration * a_share);
+        let jerk_limit = ax.planned_jerk(ts);
         let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / (ts * ts * ts)).abs();
         m.velocity[j] = m.velocity[j].max(vel / ax.velocity);
         m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
@@ -491,21 +493,24 @@ fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
             for side in c.sides.iter().flatten() {
                 let [k0, k1, k2, k3] = side.q.map(|x| x[j]);
                 let jerk = ((k3 - 3.0 * k2 + 3.0 * k1 - k0) / (ts * ts * ts)).abs();
-                m.jerk[j] = m.jerk[j].max(jerk / ax.jerk);
-                if jerk > ax.jerk * (1.0 + SLACK) || jerk.is_nan() {
+                m.jerk[j] = m.jerk[j].max(jerk / jerk_limit);
+                if jerk > jerk_limit * (1.0 + SLACK) || jerk.is_nan() {
                     let v = Violation {
                         s: side.s,
                         v: side.v,
-                        ..violation(Quantity::Jerk, j, w, jerk, ax.jerk)
+                        ..violation(Quantity::Jerk, j, w, jerk, jerk_limit)
                     };
                     keep(v, &mut found);
                 }
             }
         }
         if jerk_ok {
-            m.jerk[j] = m.jerk[j].max(jerk / ax.jerk);
-            if jerk > ax.jerk * (1.0 + SLACK) || jerk.is_nan() {
-                keep(violation(Quantity::Jerk, j, w, jerk, ax.jerk), &mut found);
+            m.jerk[j] = m.jerk[j].max(jerk / jerk_limit);
+            if jerk > jerk_limit * (1.0 + SLACK) || jerk.is_nan() {
+                keep(
+                    violation(Quantity::Jerk, j, w, jerk, jerk_limit),
+                    &mut found,
+                );
             }
         }
     }

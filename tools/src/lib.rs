@@ -89,7 +89,43 @@ pub fn program_text(bytes: &[u8]) -> Result<&str, String> {
 
 /// Read and validate a machine file.
 pub fn load_machine(path: &Path) -> Result<config::Machine, InputError> {
-    Ok(config::load(path)?)
+    let m = config::load(path)?;
+    if let Some(note) = jerk_note(&m) {
+        eprintln!("dnurbs: note: {}: {note}", path.display());
+    }
+    Ok(m)
+}
+
+/// The axes whose jerk the planner keeps below the machine file's
+/// ([`nc::plan::AxisLimit::planned_jerk`]), said rather than done silently.
+pub fn jerk_note(m: &config::Machine) -> Option<String> {
+    let lowered: Vec<String> = m
+        .axes
+        .all()
+        .iter()
+        .enumerate()
+        .filter_map(|(j, (name, l))| {
+            let planned = nc::plan::AxisLimit {
+                velocity: l.velocity,
+                acceleration: l.acceleration,
+                jerk: l.jerk,
+            }
+            .planned_jerk(m.period_s);
+            let unit = if j >= 3 { "deg" } else { "mm" };
+            let said = format!("{name} {:.4e} -> {planned:.4e} {unit}/s^3", l.jerk);
+            (planned < l.jerk).then_some(said)
+        })
+        .collect();
+    (!lowered.is_empty()).then(|| {
+        format!(
+            "planned at a jerk of {} of the axis's acceleration a period ({} ms) where the \
+             file's is higher: {}; the setpoint check keeps in reserve the acceleration a \
+             jerk adds within a period, and a higher jerk would leave the ramps too little",
+            nc::plan::JERK_RISE,
+            m.period_s * 1e3,
+            lowered.join(", ")
+        )
+    })
 }
 
 /// Refuse a machine whose bus is over its load at its period (for the commands that use

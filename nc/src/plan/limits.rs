@@ -61,7 +61,7 @@ fn limits_over(
         cfg,
         &speed,
         cfg.path_jerk,
-        |ax| ax.jerk,
+        |ax| ax.planned_jerk(cfg.period),
         |r, j, v| 3.0 * r.d2(j) * speed_times_acc(v, vmax, acc, most) + r.d3(j) * v * v * v,
     );
     (acc, jerk)
@@ -128,7 +128,7 @@ fn bare_limits(r: &Rates, share: f64, cfg: &PlanConfig) -> (f64, f64) {
     for (j, ax) in cfg.axes.iter().enumerate() {
         if r.d1(j) > 1e-15 {
             acc = acc.min(ax.acceleration * share / r.d1(j));
-            jerk = jerk.min(ax.jerk * share / r.d1(j));
+            jerk = jerk.min(ax.planned_jerk(cfg.period) * share / r.d1(j));
         }
     }
     (acc.max(A_FLOOR), jerk.max(A_FLOOR))
@@ -411,10 +411,11 @@ mod tests {
                         r.d1(j) * m.a.abs() <= acc_left * (1.0 + 1e-9) + 1e-9,
                         "station {i} axis {j}: a {} v {} {ramps:?}", m.a, m.v
                     );
-                    let jerk_left = (ax.jerk * AXIS_SHARE
+                    let jerk = ax.planned_jerk(cfg.period);
+                    let jerk_left = (jerk * AXIS_SHARE
                         - 3.0 * r.d2(j) * m.v * m.a.abs()
                         - r.d3(j) * m.v.powi(3))
-                    .max(ax.jerk * AXIS_SHARE_LEAST);
+                    .max(jerk * AXIS_SHARE_LEAST);
                     prop_assert!(
                         r.d1(j) * p.j.abs() <= jerk_left * (1.0 + 1e-9) + 1e-9,
                         "station {i} axis {j}: j {} a {} v {} {ramps:?}", p.j, m.a, m.v

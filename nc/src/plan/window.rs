@@ -120,7 +120,7 @@ impl Top {
             let dq = self.dq[k];
             if dq > 1e-15 {
                 a = a.min(ax.acceleration / (2.0 * dq));
-                j = j.min(ax.jerk / (2.0 * dq));
+                j = j.min(ax.planned_jerk(cfg.period) / (2.0 * dq));
             }
         }
         change_dist(self.v, 0.0, a.max(1e-3), j.max(1e-3))

@@ -51,7 +51,8 @@ impl AxisHold {
         // phase can add (`crate::verify::reserve`).
         let f: [f64; 5] = core::array::from_fn(|j| {
             let ax = &hold.axes[j];
-            let f = margins.acceleration[j] + ax.jerk * hold.period / (2.0 * ax.acceleration);
+            let jerk = ax.planned_jerk(hold.period);
+            let f = margins.acceleration[j] + jerk * hold.period / (2.0 * ax.acceleration);
             if f.is_finite() {
                 f.clamp(0.0, 1.0 - crate::verify::HOLD_RESERVE)
             } else {
