@@ -1,5 +1,7 @@
-//! What the NC fuzz targets share: the paper's machine, the input bound and parse, and the
-//! plan of a built path with its setpoint check.
+//! What the fuzz targets share: the paper's machine, the input bound and parse, the bound
+//! on the plans made, and the plan of a built path with its setpoint check. (Each target
+//! uses part of it.)
+#![allow(dead_code)]
 
 /// The shipped paper machine, set up as `simulate` and `run` set it up.
 pub fn paper_machine() -> dnurbs_tools::setup::MachineSetup {
@@ -18,16 +20,21 @@ pub fn program(data: &[u8]) -> Option<nc::program::Program> {
     nc::parse::parse(text).ok()
 }
 
-/// Plan `path` as `simulate` and `run` do, unless its plan would take more than 200 000
-/// periods (400 s; kept out for the fuzzer's rate, the generated-input suite covers long
-/// plans); an accepted plan whose own check measured a limit above 100 % is a finding.
-pub fn plan_within_limits(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSetup) {
+/// Whether `path` is short enough to plan for the fuzzer's rate: at most 200 000 periods
+/// (400 s at 2 ms) at its programmed feeds (the generated-input suite covers long plans).
+pub fn short_enough(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSetup) -> bool {
     let periods: f64 = path
         .segments
         .iter()
         .map(|seg| seg.length / seg.feed.max(1e-3) / s.period)
         .sum();
-    if !(periods <= 200_000.0) {
+    periods <= 200_000.0
+}
+
+/// Plan `path` as `simulate` and `run` do, if it is [`short_enough`]; an accepted plan
+/// whose own check measured a limit above 100 % is a finding.
+pub fn plan_within_limits(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSetup) {
+    if !short_enough(path, s) {
         return;
     }
     if let Ok(profile) = nc::plan::plan(path, &s.kin, &s.plan) {

@@ -12,6 +12,8 @@
 
 use libfuzzer_sys::fuzz_target;
 
+mod common;
+
 const PAPER: &str = include_str!("../../tests/data/paper-example.nc");
 
 /// Three rows of 0.5 mm G01 moves over a wave, 1 mm step-overs, F1200.
@@ -25,12 +27,7 @@ fn plan_within_limits(src: &str, s: &dnurbs_tools::setup::MachineSetup) {
     let Ok(path) = nc::segment::build(&program, &s.kin, &s.build) else {
         return;
     };
-    let periods: f64 = path
-        .segments
-        .iter()
-        .map(|seg| seg.length / seg.feed.max(1e-3) / s.period)
-        .sum();
-    if !(periods <= 200_000.0) {
+    if !common::short_enough(&path, s) {
         return;
     }
     let Ok(profile) = nc::plan::plan(&path, &s.kin, &s.plan) else {
