@@ -434,3 +434,34 @@ fn the_pre_pass_passes_the_examples_and_refuses_a_point_outside_the_travel() {
     );
     assert!(stderr.contains(&want), "expected `{want}` in\n{stderr}");
 }
+
+/// A refusal measured against less than the machine file's limit names both numbers: it
+/// said "1.003x its limit of 1.7981e2 deg/s" of a C whose file says 180, as if the file had
+/// been misread. (The tool axis passes within a thousandth of a degree of the vertical.)
+#[test]
+fn a_refusal_names_what_a_plan_may_use_beside_the_files_limit() {
+    let path = temp("near-the-vertical.nc");
+    std::fs::write(
+        &path,
+        "G90 G21 G94\nG01 X0 Y0 Z10 I0.1 J0 K1 F600\nX10 Y0.001 Z10 I-0.1 J0.00001 K1\nM30\n",
+    )
+    .unwrap();
+    let mill = machine("xyzac-trt-mill.toml");
+    let out = dnurbs(&[
+        "simulate",
+        path.to_str().unwrap(),
+        "--machine",
+        mill.to_str().unwrap(),
+    ]);
+    let _ = std::fs::remove_file(&path);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("near-the-vertical.nc:3:1: the C axis velocity would reach")
+            && stderr.contains(
+                "deg/s a plan may use of its limit of 1.8000e2 deg/s (99.9 %: the rest is kept \
+                 for feed holds and overrides)"
+            ),
+        "{stderr}"
+    );
+}

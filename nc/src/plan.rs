@@ -270,14 +270,19 @@ pub enum PlanErrorKind {
         c_min: f64,
         c_max: f64,
     },
-    #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x its limit of {limit:.4e} {unit}, {}{hint}", subject(*.axis), .quantity.name(), .value / .limit, slowest(*.floor, *.v, .path_unit))]
+    #[error("the {} {} would reach {value:.4e} {unit} at t = {t:.3} s, {:.3}x {}, {}{hint}", subject(*.axis), .quantity.name(), .value / .limit, against(*.quantity, *.limit, *.machine, .unit), slowest(*.floor, *.v, .path_unit))]
     Limit {
         /// The axis, or `None` for the chord error of the cutter path.
         axis: Option<char>,
         quantity: Quantity,
         unit: &'static str,
         value: f64,
+        /// What the plan's setpoints may reach: the machine file's limit, less the check's
+        /// reserve ([`crate::verify::reserve`]) or at the planned jerk
+        /// ([`AxisLimit::planned_jerk`]).
         limit: f64,
+        /// The machine file's limit.
+        machine: f64,
         t: f64,
         v: f64,
         path_unit: &'static str,
@@ -308,6 +313,25 @@ pub(crate) fn travel(min: f64, max: f64, unit: &str) -> String {
         (false, true) => format!("up to {max} {unit}, no lower limit"),
         (false, false) => "no travel limit".to_string(),
     }
+}
+
+/// The limit a refusal measures against. Where the plan may use less than the machine
+/// file's limit, both are named: a refusal that said "its limit of 2.94e5 mm/s^3" of an
+/// axis whose file says 1e9 read as a misparsed file.
+fn against(quantity: Quantity, limit: f64, machine: f64, unit: &str) -> String {
+    if (limit - machine).abs() <= 1e-9 * machine.abs() {
+        return format!("its limit of {limit:.4e} {unit}");
+    }
+    let why = match quantity {
+        Quantity::Jerk => {
+            format!("a plan's jerk is at most {JERK_RISE} x the acceleration per period")
+        }
+        _ => format!(
+            "{:.1} %: the rest is kept for feed holds and overrides",
+            100.0 * limit / machine
+        ),
+    };
+    format!("the {limit:.4e} {unit} a plan may use of its limit of {machine:.4e} {unit} ({why})")
 }
 
 fn subject(axis: Option<char>) -> String {
@@ -380,6 +404,12 @@ fn refuse(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig, v: &Violation)
                 unit,
                 value: conv(v.value),
                 limit: conv(v.limit),
+                machine: conv(match (q, cfg.axes.get(v.axis)) {
+                    (Quantity::Velocity, Some(ax)) => ax.velocity,
+                    (Quantity::Acceleration, Some(ax)) => ax.acceleration,
+                    (Quantity::Jerk, Some(ax)) => ax.jerk,
+                    _ => v.limit,
+                }),
                 t: v.t,
                 v: v.v,
                 path_unit: if rotary_only { "deg" } else { "mm" },
@@ -706,6 +736,7 @@ mod tests {
             unit: "mm/s^3",
             value: 50574.0,
             limit: 50000.0,
+            machine: 50000.0,
             t: 4.066,
             v,
             path_unit: "mm",
@@ -719,9 +750,65 @@ mod tests {
             "{above}"
         );
         let at = limit(V_FLOOR, true).to_string();
+        assert!(at.contains("1.011x its limit of 5.0000e4 mm/s^3,"), "{at}");
         assert!(
             at.contains("even at the slowest feed the planner schedules there (1.000e-3 mm/s)"),
             "{at}"
+        );
+    }
+    /// Where the plan may use less than the machine file says, a refusal names both: the
+    /// mill with its jerks set to 1e9 is planned at 2.94e5 mm/s^3, and "its limit of
+    /// 2.9400e5" read as if the file had been misread.
+    #[test]
+    fn a_refusal_names_the_planned_limit_beside_the_files() {
+        let x = AxisLimit {
+            velocity: 300.0,
+            acceleration: 3000.0,
+            jerk: 1e9,
+        };
+        let refusal = |quantity, unit, value, limit, machine| {
+            PlanErrorKind::Limit {
+                axis: Some('X'),
+                quantity,
+                unit,
+                value,
+                limit,
+                machine,
+                t: 1.0,
+                v: 2.0,
+                path_unit: "mm",
+                hint: "",
+                floor: false,
+            }
+            .to_string()
+        };
+        let msg = refusal(
+            Quantity::Jerk,
+            "mm/s^3",
+            3.0e5,
+            x.planned_jerk(1e-3),
+            x.jerk,
+        );
+        assert!(
+            msg.contains(
+                "1.020x the 2.9400e5 mm/s^3 a plan may use of its limit of 1.0000e9 mm/s^3 \
+                 (a plan's jerk is at most 0.098 x the acceleration per period)"
+            ),
+            "{msg}"
+        );
+        let share = crate::verify::reserve(&x, 1e-3).1;
+        let msg = refusal(
+            Quantity::Acceleration,
+            "mm/s^2",
+            2900.0,
+            3000.0 * share,
+            3000.0,
+        );
+        assert!(
+            msg.contains(
+                "of its limit of 3.0000e3 mm/s^2 (95.0 %: the rest is kept for feed holds and overrides)"
+            ),
+            "{msg}"
         );
     }
 }

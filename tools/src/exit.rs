@@ -87,11 +87,12 @@ pub enum InputError {
         file: String,
         errors: nc::parse::ParseErrors,
     },
-    /// The program does not fit the machine: geometry or plan.
+    /// The program does not fit the machine: geometry or plan (boxed: a plan's refusal
+    /// carries the numbers of its message).
     #[error("{file}:{error}")]
     Program {
         file: String,
-        error: nc::plan::ProgramError,
+        error: Box<nc::plan::ProgramError>,
     },
     /// Refused by the pre-pass (`dnurbs check`): geometry or a programmed point outside
     /// the travel.
@@ -156,7 +157,7 @@ impl InputError {
     pub fn program(file: &Path, source: impl Into<nc::plan::ProgramError>) -> Self {
         InputError::Program {
             file: file.display().to_string(),
-            error: source.into(),
+            error: Box::new(source.into()),
         }
     }
 
