@@ -16,9 +16,10 @@
 use nalgebra::Vector3;
 use nc::interp::{Interpolator, Method, Setpoint};
 use nc::kinematics::{Kinematics, MachineKinematics};
-use nc::plan::{plan, PlanConfig};
+use nc::plan::{plan, PlanConfig, PlanErrorKind};
 use nc::prepass::Refused;
 use nc::segment::{build, BuildLimits};
+use nc::verify::Quantity;
 use proptest::prelude::*;
 use std::fmt::Write;
 
@@ -461,6 +462,49 @@ fn refused(
     Ok(())
 }
 
+/// A plan's refusal for an axis limit names the machine's limit as configured, and what a
+/// plan may use of it is no more (a refusal once named only the reserved one, as "its
+/// limit", and read as a misparsed machine file).
+fn names_its_limits(
+    kind: &PlanErrorKind,
+    cfg: &PlanConfig,
+    src: &str,
+) -> Result<(), TestCaseError> {
+    let PlanErrorKind::Limit {
+        axis: Some(axis),
+        quantity,
+        limit,
+        machine,
+        ..
+    } = kind
+    else {
+        return Ok(());
+    };
+    let j = match axis {
+        'X' => 0,
+        'Y' => 1,
+        'Z' => 2,
+        'A' | 'B' => 3,
+        _ => 4,
+    };
+    let ax = &cfg.axes[j];
+    let configured = match quantity {
+        Quantity::Velocity => ax.velocity,
+        Quantity::Acceleration => ax.acceleration,
+        _ => ax.jerk,
+    };
+    let configured = if j >= 3 {
+        configured.to_degrees()
+    } else {
+        configured
+    };
+    prop_assert!(
+        (machine - configured).abs() <= 1e-12 * configured && *limit > 0.0 && *limit <= machine * (1.0 + 1e-12),
+        "a refusal names {limit} of {machine}, the machine's {quantity:?} being {configured}: {kind}\n{src}"
+    );
+    Ok(())
+}
+
 /// Every axis on the four setpoints `w` (oldest first), by finite differences at the
 /// period ([`nc::fixtures::axes_within`]). `tag` names the run in a failure.
 fn axes_hold(
@@ -533,6 +577,7 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
                 counts.prepass_travel.fetch_add(1, Ordering::Relaxed);
             }
             streamed::refused_too(&stream, e.pos.line, src)?;
+            names_its_limits(&e.kind, &cfg, src)?;
             return refused("plan", e.pos.line, &e, src, counts);
         }
     };
