@@ -756,6 +756,7 @@ mod tests {
             "{at}"
         );
     }
+
     /// Where the plan may use less than the machine file says, a refusal names both: the
     /// mill with its jerks set to 1e9 is planned at 2.94e5 mm/s^3, and "its limit of
     /// 2.9400e5" read as if the file had been misread.
