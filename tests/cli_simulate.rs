@@ -416,7 +416,7 @@ fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
 
     let m = dnurbs_tools::load_machine(&mach).unwrap();
     let shop = dnurbs_tools::shop::ShopArgs::default().load().unwrap();
-    let prog = nc::parse::parse_with(&text, &dnurbs_tools::shop::parse_setup(&m, &shop)).unwrap();
+    let prog = nc_lang::parse_with(&text, &dnurbs_tools::shop::parse_setup(&m, &shop)).unwrap();
     let setup = dnurbs_tools::setup::MachineSetup::new(&m);
     let whole = dnurbs_tools::simulate::run(&prog, &setup, setup.method).unwrap();
     let mut want = dnurbs_tools::simulate::summarize(&whole, &setup, prog.blocks.len());

@@ -90,7 +90,7 @@ fn every_post_plans_within_the_machine_limits() {
     }
 }
 
-/// `dnurbs fit` streams the program (`nc::fit::rewrite`): on every post it writes what the
+/// `dnurbs fit` streams the program (`nc_fit::rewrite`): on every post it writes what the
 /// whole-text fit writes, byte for byte, and its own check finds the result within the
 /// tolerances.
 #[test]
@@ -99,14 +99,14 @@ fn every_post_is_fitted_as_the_whole_text_fit_fits_it() {
     let mut parse = parse_setup(&m, &shop());
     parse.work_offsets = [Some([0.0; 3]); 6];
     let setup = MachineSetup::new(&m);
-    let opts = nc::fit::runs::Options::default();
+    let opts = nc_fit::runs::Options::default();
     let mut fitted = 0;
     for name in POSTS {
         let src = std::fs::read_to_string(posts(name)).expect("the post");
-        let prog = nc::parse::parse_with(&src, &parse).unwrap_or_else(|e| panic!("{name}: {e:?}"));
-        let whole = nc::fit::runs::fit_program(&src, &prog, &setup.kin, &opts);
+        let prog = nc_lang::parse_with(&src, &parse).unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        let whole = nc_fit::runs::fit_program(&src, &prog, &setup.kin, &opts);
         let mut out = Vec::new();
-        let done = nc::fit::rewrite::rewrite(
+        let done = nc_fit::rewrite::rewrite(
             src.as_bytes(),
             &parse,
             &setup.kin,
@@ -247,8 +247,8 @@ fn check_run(
         .blocks
         .iter()
         .filter_map(|b| match b {
-            nc::program::Block::Linear(l) => l.tooling.wait.operator,
-            nc::program::Block::Nurbs(n) => n.tooling.wait.operator,
+            nc_geom::program::Block::Linear(l) => l.tooling.wait.operator,
+            nc_geom::program::Block::Nurbs(n) => n.tooling.wait.operator,
         })
         .map(|p| p.line)
         .collect();
@@ -260,7 +260,7 @@ fn check_run(
     );
     // The first block's wait (a tool change before the first move) is not a stop.
     let expected: Vec<u32> = match prog.blocks.first() {
-        Some(nc::program::Block::Linear(l)) if l.tooling.wait.operator.is_some() => {
+        Some(nc_geom::program::Block::Linear(l)) if l.tooling.wait.operator.is_some() => {
             stops[1..].to_vec()
         }
         _ => stops,
@@ -314,7 +314,7 @@ fn the_offline_interpolation(
     name: &str,
     m: &config::Machine,
     setup: &MachineSetup,
-    prog: &nc::program::Program,
+    prog: &nc_geom::program::Program,
     axes: &[Vec<i32>],
 ) {
     // Sampled at a quarter of the period: the same path, its polyline 16 times closer to
@@ -323,7 +323,7 @@ fn the_offline_interpolation(
     fine.period /= FINER;
     fine.plan.period /= FINER;
     let sim = dnurbs_tools::simulate::run(prog, &fine, setup.method).unwrap();
-    let counts = |j: &nc::kinematics::Joints| -> Vec5 {
+    let counts = |j: &nc_geom::kinematics::Joints| -> Vec5 {
         Vec5::from_iterator(m.drives.iter().map(|d| {
             let v = if d.axis >= 3 {
                 j[d.axis].to_degrees()
@@ -444,7 +444,7 @@ fn nearest(pts: &[Vec5], from: usize, q: &Vec5, ahead: f64) -> (usize, f64, f64)
 }
 
 /// Drive counts of a setpoint's joints, in drive order.
-fn joint_counts(m: &config::Machine, j: &nc::kinematics::Joints) -> Vec<i32> {
+fn joint_counts(m: &config::Machine, j: &nc_geom::kinematics::Joints) -> Vec<i32> {
     m.drives
         .iter()
         .map(|d| {
@@ -463,11 +463,11 @@ fn joint_counts(m: &config::Machine, j: &nc::kinematics::Joints) -> Vec<i32> {
 fn spindle_and_coolant_as_programmed(
     name: &str,
     m: &config::Machine,
-    prog: &nc::program::Program,
+    prog: &nc_geom::program::Program,
     records: &PerNode,
 ) {
     let (spindle, coolant) = (m.spindle.as_ref().unwrap(), m.coolant.as_ref().unwrap());
-    let mut aux = nc::program::Aux::default();
+    let mut aux = nc_geom::program::Aux::default();
     let (mut speeds, mut valves) = (vec![0], vec![0]);
     for b in 0..prog.blocks.len() {
         for a in prog.actions.iter().filter(|a| a.before_block == b) {
@@ -494,7 +494,7 @@ fn spindle_and_coolant_as_programmed(
 
 /// The axes' targets (counts, in node order) where the program's first feed move starts,
 /// from the offline interpolation of the program (the path comes to rest there).
-fn first_feed_start(m: &config::Machine, prog: &nc::program::Program) -> Vec<i32> {
+fn first_feed_start(m: &config::Machine, prog: &nc_geom::program::Program) -> Vec<i32> {
     let setup = MachineSetup::new(m);
     let sim = dnurbs_tools::simulate::run(prog, &setup, setup.method).unwrap();
     let seg = sim.path.segments.iter().find(|s| s.wait.spindle).unwrap();
@@ -513,7 +513,7 @@ fn first_feed_start(m: &config::Machine, prog: &nc::program::Program) -> Vec<i32
 fn spindle_at_speed_before_the_first_feed_move(
     name: &str,
     m: &config::Machine,
-    prog: &nc::program::Program,
+    prog: &nc_geom::program::Program,
     records: &PerNode,
 ) -> usize {
     let spindle = m.spindle.as_ref().unwrap();
@@ -572,16 +572,16 @@ fn spindle_at_speed_before_the_first_feed_move(
 fn coolant_on_for_the_cut_and_off_at_the_end(
     name: &str,
     m: &config::Machine,
-    prog: &nc::program::Program,
+    prog: &nc_geom::program::Program,
     records: &PerNode,
     leave: usize,
 ) {
     let coolant = m.coolant.as_ref().unwrap();
-    let mut aux = nc::program::Aux::default();
+    let mut aux = nc_geom::program::Aux::default();
     let first_feed = prog
         .blocks
         .iter()
-        .position(|b| !matches!(b, nc::program::Block::Linear(l) if l.rapid))
+        .position(|b| !matches!(b, nc_geom::program::Block::Linear(l) if l.rapid))
         .unwrap();
     for a in prog.actions.iter().filter(|a| a.before_block <= first_feed) {
         aux.apply(&a.kind);
@@ -640,9 +640,9 @@ fn work_offsets_from_a_linuxcnc_parameter_file_move_the_program_and_errors_name_
     }
     .load()
     .unwrap();
-    let end = |b: &nc::program::Block| match b {
-        nc::program::Block::Linear(l) => l.end,
-        nc::program::Block::Nurbs(n) => *n.ctrl.last().unwrap(),
+    let end = |b: &nc_geom::program::Block| match b {
+        nc_geom::program::Block::Linear(l) => l.end,
+        nc_geom::program::Block::Nurbs(n) => *n.ctrl.last().unwrap(),
     };
     for name in ["fusion-fanuc-3axis.nc", "mastercam-fanuc-3axis.nc"] {
         let plain = dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &shop())).unwrap();

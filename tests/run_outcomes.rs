@@ -142,8 +142,8 @@ fn dense_run(compress: bool) {
             nalgebra::Vector3::new(0.0, 0.0, 1.0),
         )
     };
-    let points = nc::fixtures::resample(wave, std::f64::consts::TAU, 20_000, 0.05);
-    let src = nc::fixtures::g01_program(&points, 3000.0);
+    let points = nc_plan::fixtures::resample(wave, std::f64::consts::TAU, 20_000, 0.05);
+    let src = nc_plan::fixtures::g01_program(&points, 3000.0);
     let mut machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
         .expect("the demo machine");
     machine.realtime.feedback_timeout_s = 2.0;
@@ -151,10 +151,10 @@ fn dense_run(compress: bool) {
     machine.realtime.max_consecutive_overruns = 100_000;
     machine.interpolation.compress = compress;
     let setup = dnurbs_tools::setup::MachineSetup::new(&machine);
-    let program = nc::parse::parse(&src).expect("parses");
+    let program = nc_lang::parse(&src).expect("parses");
     let (program, _) = setup.prepare(program);
-    let path = nc::segment::build(&program, &setup.kin, &setup.build).expect("builds");
-    let planned = nc::plan::plan(&path, &setup.kin, &setup.plan)
+    let path = nc_geom::segment::build(&program, &setup.kin, &setup.build).expect("builds");
+    let planned = nc_plan::plan::plan(&path, &setup.kin, &setup.plan)
         .expect("plans")
         .duration;
     let (links, sim) = common::sim_drives(&machine, |_| Faults::default());

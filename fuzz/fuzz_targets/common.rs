@@ -12,17 +12,17 @@ pub fn paper_machine() -> dnurbs_tools::setup::MachineSetup {
 }
 
 /// The program in `data` (up to 4 KB), if its text parses.
-pub fn program(data: &[u8]) -> Option<nc::program::Program> {
+pub fn program(data: &[u8]) -> Option<nc_geom::program::Program> {
     if data.len() > 4096 {
         return None;
     }
     let text = dnurbs_tools::program_text(data).ok()?;
-    nc::parse::parse(text).ok()
+    nc_lang::parse(text).ok()
 }
 
 /// Whether `path` is short enough to plan for the fuzzer's rate: at most 200 000 periods
 /// (400 s at 2 ms) at its programmed feeds (the generated-input suite covers long plans).
-pub fn short_enough(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSetup) -> bool {
+pub fn short_enough(path: &nc_geom::segment::Path, s: &dnurbs_tools::setup::MachineSetup) -> bool {
     let periods: f64 = path
         .segments
         .iter()
@@ -33,11 +33,11 @@ pub fn short_enough(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSe
 
 /// Plan `path` as `simulate` and `run` do, if it is [`short_enough`]; an accepted plan
 /// whose own check measured a limit above 100 % is a finding.
-pub fn plan_within_limits(path: &nc::segment::Path, s: &dnurbs_tools::setup::MachineSetup) {
+pub fn plan_within_limits(path: &nc_geom::segment::Path, s: &dnurbs_tools::setup::MachineSetup) {
     if !short_enough(path, s) {
         return;
     }
-    if let Ok(profile) = nc::plan::plan(path, &s.kin, &s.plan) {
+    if let Ok(profile) = nc_plan::plan::plan(path, &s.kin, &s.plan) {
         let m = profile.margins;
         let worst = (0..5)
             .map(|j| m.velocity[j].max(m.acceleration[j]).max(m.jerk[j]))

@@ -4,7 +4,7 @@
 //! G01 moves with row-end corners) and interpolated by arc length, as `run` sends them.
 //! A panic, an abort or a hang is a finding; so is an accepted plan one of whose setpoints
 //! moves an axis faster than the machine file's velocity or acceleration, or outside its
-//! travel, by finite differences at the period (`nc::fixtures::axes_within`; the jerk
+//! travel, by finite differences at the period (`nc_plan::fixtures::axes_within`; the jerk
 //! where the four setpoints lie in one block). A refusal is not: a machine file may be too
 //! slow, too small or too coarse for a program. Plans of more than 200 000 periods are not
 //! made, for the fuzzer's rate.
@@ -23,30 +23,30 @@ X2.5 Z-0.1\nX2 Z0\nX1.5 Z0.1\nX1 Z0.15\nX0.5 Z0.1\nX0 Z0\nY2\n\
 X0.5 Z0.1\nX1 Z0.15\nX1.5 Z0.1\nX2 Z0\nX2.5 Z-0.1\nX3 Z-0.15\nM30\n%\n";
 
 fn plan_within_limits(src: &str, s: &dnurbs_tools::setup::MachineSetup) {
-    let program = nc::parse::parse(src).expect("the fixed programs parse");
-    let Ok(path) = nc::segment::build(&program, &s.kin, &s.build) else {
+    let program = nc_lang::parse(src).expect("the fixed programs parse");
+    let Ok(path) = nc_geom::segment::build(&program, &s.kin, &s.build) else {
         return;
     };
     if !common::short_enough(&path, s) {
         return;
     }
-    let Ok(profile) = nc::plan::plan(&path, &s.kin, &s.plan) else {
+    let Ok(profile) = nc_plan::plan::plan(&path, &s.kin, &s.plan) else {
         return;
     };
     let cfg = &s.plan;
-    let sp = nc::fixtures::interpolate(
+    let sp = nc_plan::fixtures::interpolate(
         &path,
         &profile,
         s.kin,
         cfg,
-        nc::interp::Method::ArcLength,
+        nc_plan::interp::Method::ArcLength,
         4_000_000,
     )
     .expect("an accepted plan ends");
     for w in sp.windows(4) {
         let jerk = w.iter().all(|x| x.block == w[0].block);
         if let Err(e) =
-            nc::fixtures::axes_within(cfg, cfg.period, [&w[0], &w[1], &w[2], &w[3]], jerk)
+            nc_plan::fixtures::axes_within(cfg, cfg.period, [&w[0], &w[1], &w[2], &w[3]], jerk)
         {
             panic!("accepted plan over a limit: {e}");
         }

@@ -38,11 +38,11 @@ fuzz_target!(|data: &[u8]| {
         c.fit_mm,
         c.fit_deg
     );
-    let Ok(path) = nc::segment::build(&program, &s.kin, &s.build) else {
+    let Ok(path) = nc_geom::segment::build(&program, &s.kin, &s.build) else {
         return;
     };
     if c.fitted_blocks > 0 {
-        if let Ok(input) = nc::segment::build(&posted, &s.kin, &s.build) {
+        if let Ok(input) = nc_geom::segment::build(&posted, &s.kin, &s.build) {
             // Sampled every 5 um as `compressed_posts.rs` does, on paths up to 500 mm (100 000
             // samples). Not coarser over a longer path: at 3 mm a sample spans a pass that
             // goes back over itself, and a point was taken on the wrong visit (24 um and
@@ -50,7 +50,7 @@ fuzz_target!(|data: &[u8]| {
             let length: f64 = input.segments.iter().map(|x| x.length).sum();
             if length <= 500.0 {
                 let h = 0.005;
-                let dev = nc::fit::deviation::measure(&input, &path, &s.kin, h, opts.tol.mm);
+                let dev = nc_fit::deviation::measure(&input, &path, &s.kin, h, opts.tol.mm);
                 assert!(
                     dev.point_mm <= opts.tol.mm + 5e-7 && dev.point_deg <= tol_deg * (1.0 + 1e-3),
                     "measured off the posted program: {dev:?}"

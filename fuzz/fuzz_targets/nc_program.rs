@@ -21,7 +21,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let s = setup();
-    let Ok(path) = nc::segment::build(&program, &s.kin, &s.build) else {
+    let Ok(path) = nc_geom::segment::build(&program, &s.kin, &s.build) else {
         return;
     };
     common::plan_within_limits(&path, s);

@@ -9,7 +9,7 @@
 //!
 //! Exactly what the body given to [`thread::spawn_rt`] calls: [`latency::periodic`] for
 //! `dnurbs latency`; [`pipeline::drive_loop`] for `run` and `demo`, and through it
-//! `Pipeline::{rehearse, prepare, cycle, publish}`, `nc::stream::Follower::{advance,
+//! `Pipeline::{rehearse, prepare, cycle, publish}`, `nc_follow::Follower::{advance,
 //! evaluate, rehearse}`, `drives::master::Master::cycle` and the link's `send_all` /
 //! `recv_all`, and [`interval::Recorder`]. Each of these says "Real-time thread" in its
 //! documentation; none allocates, locks, prints or panics (`tests/no_alloc.rs`,

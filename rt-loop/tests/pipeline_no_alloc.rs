@@ -11,8 +11,9 @@
 mod common;
 
 use drives::link::{CanLink, MemLink, SocketLink};
-use nc::kinematics::MachineKinematics;
-use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use nc_follow::{Follower, Queues};
+use nc_geom::kinematics::MachineKinematics;
+use nc_plan::stream::chunks;
 use rt_loop::control::{Command, Commands};
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
@@ -43,11 +44,11 @@ fn the_full_pipeline_neither_allocates_nor_faults_over_100k_periods_on_the_memor
 
 fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) {
     let kin = MachineKinematics::Paper;
-    let (cfg, bl) = nc::fixtures::small_mill(PERIOD);
-    let program = nc::parse::parse(PAPER).unwrap();
-    let path = nc::segment::build(&program, &kin, &bl).unwrap();
-    let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, list) = chunks(path, &profile, &HoldConfig::from_plan(&cfg), 4);
+    let (cfg, bl) = nc_plan::fixtures::small_mill(PERIOD);
+    let program = nc_lang::parse(PAPER).unwrap();
+    let path = nc_geom::segment::build(&program, &kin, &bl).unwrap();
+    let profile = nc_plan::plan::plan(&path, &kin, &cfg).unwrap();
+    let (start, list) = chunks(path, &profile, &cfg.hold(), 4);
     let mut source = list.into_iter();
 
     let (bus, sim) = common::sim_bus(link, drive_end, PERIOD, [1e4, 1e4, 1e4, 1e3, 1e3]);
@@ -55,7 +56,7 @@ fn prove<L: CanLink + Send, D: CanLink + Send + 'static>(link: L, drive_end: D) 
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(4);
     feeder.feed(&mut source.by_ref().take(4));
-    let follower = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(&cfg));
+    let follower = Follower::new(inlet, start, kin, cfg.rotary, cfg.hold());
     let lim = ApproachLimits {
         velocity: [250.0, 250.0, 250.0, 90.0, 90.0],
         acceleration: [2500.0, 2500.0, 2500.0, 900.0, 900.0],

@@ -21,7 +21,7 @@ use rt_loop::pipeline::{ApproachLimits, Stage};
 const PERIOD: f64 = 0.001;
 /// Counts per mm (X Y Z) and per degree (A C).
 const CPU: [f64; 5] = [1e6, 1e6, 1e6, 1e5, 1e5];
-/// nc::fixtures::small_mill: velocity, acceleration (mm or degrees, s).
+/// nc_plan::fixtures::small_mill: velocity, acceleration (mm or degrees, s).
 const LIMITS: [(f64, f64); 5] = [
     (250.0, 2500.0),
     (250.0, 2500.0),

@@ -5,10 +5,14 @@
 //! made by any thread ([`arm_all`]), or by the arming thread only ([`arm_this_thread`],
 //! for a loop running beside threads that may allocate freely).
 //!
+//! [`generated`]: case counts and seeds of the generated-input suites, from the environment.
+//!
 //! ```ignore
 //! #[global_allocator]
 //! static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 //! ```
+
+pub mod generated;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -283,9 +283,9 @@ pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::R
 }
 
 /// The first spindle speed a program starts (`M03`/`M04` with a speed above 0), rpm.
-pub fn first_spindle_rpm(prog: &nc::program::Program) -> Option<f64> {
+pub fn first_spindle_rpm(prog: &nc_geom::program::Program) -> Option<f64> {
     prog.actions.iter().find_map(|a| match a.kind {
-        nc::program::ActionKind::Spindle { rpm, .. } if rpm > 0.0 => Some(rpm),
+        nc_geom::program::ActionKind::Spindle { rpm, .. } if rpm > 0.0 => Some(rpm),
         _ => None,
     })
 }

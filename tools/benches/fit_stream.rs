@@ -1,7 +1,7 @@
 //! Is the fit linear in the program, and bounded in memory? A blade-like 5-axis sweep (a
 //! climbing arc of 30 mm radius in moves of 0.1 mm, the tool leaning 5 to 25 degrees toward
 //! the axis and swinging with it) is generated a line at a time, parsed and fitted into
-//! G06.5 blocks as it is read (`nc::fit::online::Compressing`, the compressor `simulate
+//! G06.5 blocks as it is read (`nc_fit::online::Compressing`, the compressor `simulate
 //! --compress` and `run` use: runs of at most 5 000 moves). Per size: moves fitted, blocks,
 //! the time, moves a second and the peak resident memory (reset before each size), and
 //! the ratio to the size before (10x the moves should cost at most 11x the time).
@@ -11,11 +11,11 @@
 
 mod common;
 
-use nc::fit::online::Compressing;
-use nc::fit::runs::Options;
-use nc::kinematics::MachineKinematics;
-use nc::parse::{Entries, Entry, LineSource, ParseError, Setup};
-use nc::program::{Block, SrcPos};
+use nc_fit::online::Compressing;
+use nc_fit::runs::Options;
+use nc_geom::kinematics::MachineKinematics;
+use nc_geom::program::{Block, SrcPos};
+use nc_lang::{Entries, Entry, LineSource, ParseError, Setup};
 use std::fmt::Write;
 use std::time::Instant;
 

@@ -14,8 +14,8 @@
 mod common;
 
 use dnurbs_tools::simulate::{roll, stepping, Summarizer};
-use nc::interp::Method;
-use nc::parse::{Entries, Setup};
+use nc_lang::{Entries, Setup};
+use nc_plan::interp::Method;
 use std::time::Instant;
 
 fn main() {

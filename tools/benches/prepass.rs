@@ -1,6 +1,6 @@
-//! The pre-pass (`dnurbs check`, `nc::prepass`) over long programs: lines read per second
+//! The pre-pass (`dnurbs check`, `nc_plan::prepass`) over long programs: lines read per second
 //! and the process's peak resident memory, per size. A wiggly G01 path of 0.05 mm moves
-//! (the bench `linear`'s, as `nc::fixtures::g01_program` writes it: `N`, `X Y Z`, `I J K`)
+//! (the bench `linear`'s, as `nc_plan::fixtures::g01_program` writes it: `N`, `X Y Z`, `I J K`)
 //! is written to a file in the temporary directory line by line, then read back through
 //! the pre-pass on the paper machine. The peak is reset before each size
 //! (`/proc/self/clear_refs`), so it is the pre-pass's own; it should not grow with the
@@ -11,7 +11,7 @@
 
 mod common;
 
-use nc::parse::Setup;
+use nc_lang::Setup;
 use std::time::Instant;
 
 fn main() {
@@ -28,7 +28,7 @@ fn main() {
         common::reset_peak();
         let clock = Instant::now();
         let lines = common::read_lines(&path);
-        let passed = nc::prepass::check(
+        let passed = nc_plan::prepass::check(
             lines,
             &Setup::default(),
             &setup.kin,

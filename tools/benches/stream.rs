@@ -1,5 +1,5 @@
 //! `dnurbs run`'s planner over long programs: the program read from a file, parsed, built,
-//! planned and cut into chunks a line at a time (`nc::stream::Source`, what the planner
+//! planned and cut into chunks a line at a time (`nc_plan::stream::Source`, what the planner
 //! thread runs), the chunks dropped as the real-time thread would free them. The wiggle of
 //! the bench `linear` (0.05 mm G01 moves at F3000, `N`, `X Y Z`, `I J K`) is written to a
 //! file in the temporary directory. Per size: the time to the first chunk (when motion could
@@ -14,9 +14,9 @@
 
 mod common;
 
-use nc::fit::online::Compressing;
-use nc::parse::{Entries, Setup};
-use nc::stream::Source;
+use nc_fit::online::Compressing;
+use nc_lang::{Entries, Setup};
+use nc_plan::stream::Source;
 use std::time::Instant;
 
 fn main() {

@@ -85,21 +85,21 @@ pub enum InputError {
     #[error("{}", parse_errors(.file, .errors))]
     Parse {
         file: String,
-        errors: nc::parse::ParseErrors,
+        errors: nc_lang::ParseErrors,
     },
     /// The program does not fit the machine: geometry or plan (boxed: a plan's refusal
     /// carries the numbers of its message).
     #[error("{file}:{error}")]
     Program {
         file: String,
-        error: Box<nc::plan::ProgramError>,
+        error: Box<nc_plan::plan::ProgramError>,
     },
     /// Refused by the pre-pass (`dnurbs check`): geometry or a programmed point outside
     /// the travel.
     #[error("{file}:{error}")]
     Checked {
         file: String,
-        error: nc::prepass::Refused,
+        error: nc_plan::prepass::Refused,
     },
     #[error(transparent)]
     Machine(#[from] config::ConfigError),
@@ -134,7 +134,7 @@ pub struct StoppedUnfinished {
 }
 
 /// `file:line:col: message` per error, and a last line when the parse stopped early.
-fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
+fn parse_errors(file: &str, e: &nc_lang::ParseErrors) -> String {
     let mut out: Vec<String> = e.errors.iter().map(|x| format!("{file}:{x}")).collect();
     if e.errors.len() > 1 || e.more {
         out.push(format!(
@@ -143,7 +143,7 @@ fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
             if e.more {
                 format!(
                     " (stopped at {}: fix these and run again)",
-                    nc::parse::MAX_ERRORS
+                    nc_lang::MAX_ERRORS
                 )
             } else {
                 String::new()
@@ -154,7 +154,7 @@ fn parse_errors(file: &str, e: &nc::parse::ParseErrors) -> String {
 }
 
 impl InputError {
-    pub fn program(file: &Path, source: impl Into<nc::plan::ProgramError>) -> Self {
+    pub fn program(file: &Path, source: impl Into<nc_plan::plan::ProgramError>) -> Self {
         InputError::Program {
             file: file.display().to_string(),
             error: Box::new(source.into()),
@@ -162,12 +162,12 @@ impl InputError {
     }
 
     /// A streamed program's refusal: where it was read, built or planned.
-    pub fn stream(file: &str, e: nc::stream::StreamError) -> Self {
-        use nc::stream::StreamError;
+    pub fn stream(file: &str, e: nc_plan::stream::StreamError) -> Self {
+        use nc_plan::stream::StreamError;
         match e {
             StreamError::Parse(p) => InputError::Parse {
                 file: file.to_owned(),
-                errors: nc::parse::ParseErrors {
+                errors: nc_lang::ParseErrors {
                     errors: vec![p],
                     more: false,
                 },

@@ -1,10 +1,10 @@
 //! The planner thread of `dnurbs run` and `dnurbs demo`: the program read, built, planned
-//! and cut into chunks a line at a time ([`nc::stream::Source`]), pushed into the queue as
+//! and cut into chunks a line at a time ([`nc_plan::stream::Source`]), pushed into the queue as
 //! the real-time thread frees room, so memory does not grow with the program and motion
 //! starts once the first window is planned.
 //!
 //! **What is checked before motion.** A program of at most [`CHECK_WHOLE_BYTES`] is read
-//! through the pre-pass ([`nc::prepass`]: syntax, geometry, the travel at every programmed
+//! through the pre-pass ([`nc_plan::prepass`]: syntax, geometry, the travel at every programmed
 //! point) from its first line to its last before anything moves, as `dnurbs check` does: an
 //! error there is exit 2 with nothing touched. A longer one starts after its first window
 //! (checked at the period like every window) while the pre-pass reads the rest beside the
@@ -14,11 +14,12 @@
 
 use crate::exit::InputError;
 use crate::setup::MachineSetup;
-use nc::fit::online::Compressing;
-use nc::kinematics::Joints;
-use nc::parse::{Entries, LineSource, ReadLines};
-use nc::program::Action;
-use nc::stream::{Chunk, Feeder, ProgramSource, Source, Start, StreamError};
+use nc_fit::online::Compressing;
+use nc_follow::{Chunk, Feeder, Start};
+use nc_geom::kinematics::Joints;
+use nc_geom::program::Action;
+use nc_lang::{Entries, LineSource, ReadLines};
+use nc_plan::stream::{ProgramSource, Source, StreamError};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -112,8 +113,8 @@ impl<E: ProgramSource> Iterator for Noting<'_, E> {
     fn next(&mut self) -> Option<Self::Item> {
         let e = self.inner.next();
         match &e {
-            Some(Ok(nc::parse::Entry::Action(a))) => note(self.learned, a),
-            Some(Ok(nc::parse::Entry::Block(_, b))) => {
+            Some(Ok(nc_lang::Entry::Action(a))) => note(self.learned, a),
+            Some(Ok(nc_lang::Entry::Block(_, b))) => {
                 self.learned
                     .planning_line
                     .store(b.pos().line, Ordering::Relaxed);
@@ -125,7 +126,7 @@ impl<E: ProgramSource> Iterator for Noting<'_, E> {
 }
 
 impl<E: ProgramSource> ProgramSource for Noting<'_, E> {
-    fn tilt_word(&self) -> Option<(char, nc::program::SrcPos)> {
+    fn tilt_word(&self) -> Option<(char, nc_geom::program::SrcPos)> {
         self.inner.tilt_word()
     }
 }
@@ -146,7 +147,7 @@ pub struct Job {
     /// The program's name in messages (its path).
     pub name: String,
     pub setup: MachineSetup,
-    pub shop: nc::parse::Setup,
+    pub shop: nc_lang::Setup,
     pub depth: usize,
     /// A control socket serves the run (an operator stop can be resumed).
     pub control: bool,
@@ -191,16 +192,16 @@ impl Job {
     fn prepass(
         &self,
         lines: Box<dyn LineSource + Send>,
-    ) -> Result<nc::prepass::Passed, InputError> {
+    ) -> Result<nc_plan::prepass::Passed, InputError> {
         let s = &self.setup;
-        nc::prepass::check(lines, &self.shop, &s.kin, &s.build, &s.plan.travel)
+        nc_plan::prepass::check(lines, &self.shop, &s.kin, &s.build, &s.plan.travel)
             .map_err(|e| self.refused(e))
     }
 
     /// The pre-pass's refusal as an input error naming the file.
-    fn refused(&self, e: nc::prepass::Refused) -> InputError {
+    fn refused(&self, e: nc_plan::prepass::Refused) -> InputError {
         match e {
-            nc::prepass::Refused::Parse(errors) => InputError::Parse {
+            nc_plan::prepass::Refused::Parse(errors) => InputError::Parse {
                 file: self.name.clone(),
                 errors,
             },
@@ -212,7 +213,7 @@ impl Job {
     }
 
     /// A program that stops for the operator needs someone to resume it.
-    fn operator_reachable(&self, stop: Option<nc::program::SrcPos>) -> Result<(), InputError> {
+    fn operator_reachable(&self, stop: Option<nc_geom::program::SrcPos>) -> Result<(), InputError> {
         match stop {
             Some(pos) if !self.control => Err(InputError::Usage(format!(
                 "{}:{pos}: the program stops here for the operator (M00, M01 or M06) and \
@@ -340,7 +341,7 @@ fn prepare(job: &Job, learned: &Arc<Learned>) -> Result<Prepared, InputError> {
             .name("dnurbs-prepass".into())
             .spawn(move || {
                 let s = &j.setup;
-                match nc::prepass::check(lines, &j.shop, &s.kin, &s.build, &s.plan.travel) {
+                match nc_plan::prepass::check(lines, &j.shop, &s.kin, &s.build, &s.plan.travel) {
                     Ok(p) => match j.operator_reachable(p.operator_stop) {
                         Ok(()) => {
                             let _ = learned.end_joints.set(p.end_joints);

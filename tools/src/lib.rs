@@ -21,8 +21,8 @@ use std::path::Path;
 /// Read and parse an NC program; errors name the file, line and column.
 pub fn load_program(
     path: &Path,
-    setup: &nc::parse::Setup,
-) -> Result<nc::program::Program, InputError> {
+    setup: &nc_lang::Setup,
+) -> Result<nc_geom::program::Program, InputError> {
     let text = read_program(path)?;
     parse_text(&text, &path.display().to_string(), setup)
 }
@@ -49,8 +49,8 @@ pub fn read_program(path: &Path) -> Result<String, InputError> {
 pub fn parse_program(
     bytes: &[u8],
     file: &str,
-    setup: &nc::parse::Setup,
-) -> Result<nc::program::Program, InputError> {
+    setup: &nc_lang::Setup,
+) -> Result<nc_geom::program::Program, InputError> {
     let text = program_text(bytes).map_err(|message| InputError::Encoding {
         file: file.to_owned(),
         message,
@@ -62,9 +62,9 @@ pub fn parse_program(
 pub fn parse_text(
     text: &str,
     file: &str,
-    setup: &nc::parse::Setup,
-) -> Result<nc::program::Program, InputError> {
-    nc::parse::parse_with(text, setup).map_err(|errors| InputError::Parse {
+    setup: &nc_lang::Setup,
+) -> Result<nc_geom::program::Program, InputError> {
+    nc_lang::parse_with(text, setup).map_err(|errors| InputError::Parse {
         file: file.to_owned(),
         errors,
     })
@@ -97,7 +97,7 @@ pub fn load_machine(path: &Path) -> Result<config::Machine, InputError> {
 }
 
 /// The axes whose jerk the planner keeps below the machine file's
-/// ([`nc::plan::AxisLimit::planned_jerk`]), said rather than done silently.
+/// ([`nc_geom::limits::AxisLimit::planned_jerk`]), said rather than done silently.
 pub fn jerk_note(m: &config::Machine) -> Option<String> {
     let lowered: Vec<String> = m
         .axes
@@ -105,7 +105,7 @@ pub fn jerk_note(m: &config::Machine) -> Option<String> {
         .iter()
         .enumerate()
         .filter_map(|(j, (name, l))| {
-            let planned = nc::plan::AxisLimit {
+            let planned = nc_geom::limits::AxisLimit {
                 velocity: l.velocity,
                 acceleration: l.acceleration,
                 jerk: l.jerk,
@@ -121,7 +121,7 @@ pub fn jerk_note(m: &config::Machine) -> Option<String> {
             "planned at a jerk of {} of the axis's acceleration a period ({} ms) where the \
              file's is higher: {}; the setpoint check keeps in reserve the acceleration a \
              jerk adds within a period, and a higher jerk would leave the ramps too little",
-            nc::plan::JERK_RISE,
+            nc_geom::limits::JERK_RISE,
             m.period_s * 1e3,
             lowered.join(", ")
         )

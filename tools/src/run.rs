@@ -21,7 +21,7 @@ use drives::master::{
     configure_nodes, Master, NodeSetup, SetupOptions, Supervision, VelocitySetup,
 };
 use drives::wire::NodeId;
-use nc::stream::{Follower, HoldConfig, Queues};
+use nc_follow::{Follower, Queues};
 use rt_loop::control::{Command, Commands, Producer};
 use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
 use rt_loop::latency::{RtSettings, INTERVAL_NS};
@@ -144,7 +144,7 @@ impl RunResult {
 /// it, or the `finished` flag once it reads it).
 fn start_planner(
     job: crate::feed::Job,
-    feeder: nc::stream::Feeder<'static>,
+    feeder: nc_follow::Feeder<'static>,
     finished: Arc<AtomicBool>,
     learned: Arc<Learned>,
 ) -> anyhow::Result<Ready> {
@@ -369,7 +369,7 @@ pub fn run_input<L: CanLink + Send>(
                 start,
                 setup.kin,
                 setup.plan.rotary,
-                HoldConfig::from_plan(&setup.plan),
+                setup.plan.hold(),
             );
             let enable_cycles = (rtc.boot_timeout_s / period).ceil() as u64;
             let mut pipeline = Pipeline::new(

@@ -6,10 +6,11 @@
 
 use config::{Kinematics as KinConfig, Machine};
 use nalgebra::Vector3;
-use nc::interp::Method;
-use nc::kinematics::{MachineKinematics, RotaryLimits, Tilt};
-use nc::plan::{AxisLimit, PlanConfig};
-use nc::segment::BuildLimits;
+use nc_geom::kinematics::{MachineKinematics, RotaryLimits, Tilt};
+use nc_geom::limits::AxisLimit;
+use nc_geom::segment::BuildLimits;
+use nc_plan::config::PlanConfig;
+use nc_plan::interp::Method;
 
 /// Everything the interpolator needs from the machine file, in its own units.
 #[derive(Clone, Debug)]
@@ -26,9 +27,9 @@ pub struct MachineSetup {
     pub limits: [config::AxisLimits; 5],
     /// On-line compression (`[interpolation] compress`): runs of G01 moves fitted into
     /// G06.5 blocks before the program is built and planned; `None` when off.
-    pub compress: Option<nc::fit::runs::Options>,
+    pub compress: Option<nc_fit::runs::Options>,
     /// The compressor's settings from the machine file, for `--compress`.
-    compression: nc::fit::runs::Options,
+    compression: nc_fit::runs::Options,
 }
 
 pub fn method_of(m: config::Method) -> Method {
@@ -82,13 +83,13 @@ impl MachineSetup {
         });
         let ip = &m.interpolation;
         let c = ip.compression;
-        let compression = nc::fit::runs::Options {
-            tol: nc::fit::Tolerance {
+        let compression = nc_fit::runs::Options {
+            tol: nc_fit::Tolerance {
                 mm: c.tol_mm,
                 rad: c.tol_deg.to_radians(),
             },
             corner_deg: c.corner_deg,
-            ..nc::fit::runs::Options::default()
+            ..nc_fit::runs::Options::default()
         };
         MachineSetup {
             name: m.name.clone(),
@@ -116,9 +117,9 @@ impl MachineSetup {
         }
     }
 
-    /// The machine a streamed program is planned for (`nc::stream::Stages`, `Source`).
-    pub fn machine(&self) -> nc::stream::Machine<'_> {
-        nc::stream::Machine {
+    /// The machine a streamed program is planned for (`nc_plan::stream::Stages`, `Source`).
+    pub fn machine(&self) -> nc_plan::stream::Machine<'_> {
+        nc_plan::stream::Machine {
             kin: &self.kin,
             build: &self.build,
             plan: &self.plan,
@@ -137,11 +138,14 @@ impl MachineSetup {
     /// compressor did.
     pub fn prepare(
         &self,
-        program: nc::program::Program,
-    ) -> (nc::program::Program, Option<nc::fit::compress::Compressed>) {
+        program: nc_geom::program::Program,
+    ) -> (
+        nc_geom::program::Program,
+        Option<nc_fit::compress::Compressed>,
+    ) {
         match &self.compress {
             Some(o) => {
-                let (p, c) = nc::fit::compress::compress(&program, &self.kin, o);
+                let (p, c) = nc_fit::compress::compress(&program, &self.kin, o);
                 (p, Some(c))
             }
             None => (program, None),

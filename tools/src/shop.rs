@@ -1,7 +1,7 @@
 //! The shop's side of a program: the tool table, the work offsets and the operator's
 //! switches (`--tools`, `--offsets`, `--block-delete`, `--optional-stop`), merged with the
 //! machine file's work offsets and reference position into the parser's
-//! [`nc::parse::Setup`].
+//! [`nc_lang::Setup`].
 
 use crate::exit::InputError;
 use std::collections::BTreeMap;
@@ -78,8 +78,8 @@ impl ShopArgs {
 }
 
 /// The parser's setup for `machine` and the shop's options.
-pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc::parse::Setup {
-    nc::parse::Setup {
+pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc_lang::Setup {
+    nc_lang::Setup {
         work_offsets: std::array::from_fn(|k| shop.work_offsets[k].or(machine.work_offsets[k])),
         reference: machine.reference,
         tools: shop.tools.clone(),

@@ -7,15 +7,18 @@
 //! and the tool axis is recovered from the machine angles through forward kinematics.
 
 use crate::setup::MachineSetup;
-use nc::arclen::GL8;
-use nc::fit::online::Compressing;
-use nc::interp::{Interpolator, Method, Rolling, Setpoint, Stepping, Unrolled, Window};
-use nc::nurbs::DoubleNurbs;
-use nc::plan::{plan, FeedProfile, Finished, ProgramError};
-use nc::program::Program;
-use nc::segment::{build, Path};
-use nc::stream::{ProgramSource, Stages};
-pub use nc::verify::MAX_CYCLES;
+use nc_fit::online::Compressing;
+use nc_geom::arclen::GL8;
+use nc_geom::nurbs::DoubleNurbs;
+use nc_geom::program::Program;
+use nc_geom::segment::{build, Path};
+use nc_geom::setpoint::Setpoint;
+use nc_plan::interp::{Interpolator, Method};
+use nc_plan::plan::{plan, Finished, ProgramError};
+use nc_plan::profile::FeedProfile;
+use nc_plan::rolling::{Rolling, Stepping, Unrolled, Window};
+use nc_plan::stream::{ProgramSource, Stages};
+pub use nc_plan::verify::MAX_CYCLES;
 use serde::Serialize;
 
 mod summary;
@@ -92,7 +95,7 @@ pub struct Rolled {
     pub plan: Finished,
     /// Motion blocks planned (after compression).
     pub blocks: usize,
-    pub compressed: Option<nc::fit::compress::Compressed>,
+    pub compressed: Option<nc_fit::compress::Compressed>,
 }
 
 /// A program's entries through the compressor (when it is on), the stages and the rolling
@@ -105,7 +108,7 @@ pub fn roll<E: ProgramSource>(
 ) -> Result<Rolled, Unrolled> {
     let entries = Compressing::new(entries, &setup.kin, setup.compress);
     let mut stages = Stages::new(entries, setup.machine());
-    let (rolling, plan) = nc::interp::interpolate(&mut stages, step, take)?;
+    let (rolling, plan) = nc_plan::rolling::interpolate(&mut stages, step, take)?;
     Ok(Rolled {
         rolling,
         plan,
@@ -142,7 +145,7 @@ pub struct Summary {
     pub chord_tolerance_mm: f64,
     pub axis_velocity_fraction: AxisMap,
     pub axis_acceleration_fraction: AxisMap,
-    /// Jerk as the planner's setpoint check measures it (`nc::verify`: inside blocks and
+    /// Jerk as the planner's setpoint check measures it (`nc_plan::verify`: inside blocks and
     /// across G2-continuous junctions, by third differences at the period).
     pub axis_jerk_fraction: AxisMap,
     pub axis_travel_ok: bool,
@@ -349,7 +352,7 @@ impl Summary {
     }
 }
 
-/// [`nc::fit::compress::Compressed`] for the summary.
+/// [`nc_fit::compress::Compressed`] for the summary.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Compression {
     pub moves_in: usize,
@@ -379,8 +382,8 @@ impl Compression {
     }
 }
 
-impl From<nc::fit::compress::Compressed> for Compression {
-    fn from(c: nc::fit::compress::Compressed) -> Self {
+impl From<nc_fit::compress::Compressed> for Compression {
+    fn from(c: nc_fit::compress::Compressed) -> Self {
         Compression {
             moves_in: c.moves_in,
             moves_fitted: c.moves_fitted,

@@ -2,7 +2,7 @@
 //! lines `simulate` and `run` report. The machines dnurbs drives have no spindle or coolant
 //! drive yet, so these are reported, never silently dropped.
 
-use nc::program::{Action, ActionKind, Coolant, Program, Spindle};
+use nc_geom::program::{Action, ActionKind, Coolant, Program, Spindle};
 
 /// One line per action: `line:col  word  what it does`.
 pub fn describe(program: &Program) -> Vec<String> {
@@ -81,20 +81,20 @@ impl<'w, E> Noted<'w, E> {
     }
 }
 
-impl<E: nc::stream::ProgramSource> Iterator for Noted<'_, E> {
+impl<E: nc_plan::stream::ProgramSource> Iterator for Noted<'_, E> {
     type Item = <E as Iterator>::Item;
 
     fn next(&mut self) -> Option<Self::Item> {
         let e = self.inner.next();
-        if let Some(Ok(nc::parse::Entry::Action(a))) = &e {
+        if let Some(Ok(nc_lang::Entry::Action(a))) = &e {
             self.words.push(describe_action(a));
         }
         e
     }
 }
 
-impl<E: nc::stream::ProgramSource> nc::stream::ProgramSource for Noted<'_, E> {
-    fn tilt_word(&self) -> Option<(char, nc::program::SrcPos)> {
+impl<E: nc_plan::stream::ProgramSource> nc_plan::stream::ProgramSource for Noted<'_, E> {
+    fn tilt_word(&self) -> Option<(char, nc_geom::program::SrcPos)> {
         self.inner.tilt_word()
     }
 }

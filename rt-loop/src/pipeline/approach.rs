@@ -2,7 +2,7 @@
 //! the program's start, every axis within its limits, all arriving together; planned before
 //! the loop, stepped in it.
 
-use nc::scurve::{push_section, Phase, Ramps};
+use nc_geom::scurve::{push_section, Phase, Ramps};
 
 /// Axis limits for the approach, in axis units (mm or degrees), joint order.
 #[derive(Clone, Copy, Debug, PartialEq)]

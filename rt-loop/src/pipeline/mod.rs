@@ -20,7 +20,7 @@
 //!
 //! **Spindle and coolant**: where a bus carries them ([`BusDrives::with_spindle`],
 //! [`BusDrives::with_coolant`]) the spindle drive is sent the speed and the I/O module the
-//! coolant outputs the interpolator commands ([`nc::interp::Setpoint::aux`]); both are off
+//! coolant outputs the interpolator commands ([`nc_geom::setpoint::Setpoint::aux`]); both are off
 //! outside the program and once it is at rest (end or stop), and the drives are disabled
 //! only after the spindle has stopped. A move that needs the spindle at speed waits for the
 //! drive to report it (target reached, bit 10, and its velocity within the window) and the
@@ -47,9 +47,9 @@ use drives::cia402::{Goal, State, Statusword};
 use drives::link::CanLink;
 use drives::master::{DriveFault, Master, NodeKind, NodeStatus, MAX_NODES};
 use heapless::Vec as HVec;
-use nc::kinematics::Joints;
-use nc::program::Aux;
-use nc::stream::Follower;
+use nc_follow::Follower;
+use nc_geom::kinematics::Joints;
+use nc_geom::program::Aux;
 
 /// A drive within this distance of the program's start (mm or degrees) is at the start.
 pub const AT_START_UNITS: f64 = 0.001;

@@ -7,8 +7,9 @@ use drives::link::{CanLink, MemLink};
 use drives::master::{configure, Master, SetupOptions, Supervision};
 use drives::sim::{Record, SimNodeConfig, SimThread};
 use drives::wire::NodeId;
-use nc::kinematics::MachineKinematics;
-use nc::stream::{chunks, Follower, HoldConfig, Queues};
+use nc_follow::{Follower, Queues};
+use nc_geom::kinematics::MachineKinematics;
+use nc_plan::stream::chunks;
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
 use rt_loop::pipeline::{
@@ -102,11 +103,11 @@ pub struct Rig {
 /// segment queue from this thread, `drive_loop` in another, to the simulated drives.
 pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     let kin = MachineKinematics::Paper;
-    let (cfg, bl) = nc::fixtures::small_mill(rig.period);
-    let program = nc::parse::parse(src).unwrap();
-    let path = nc::segment::build(&program, &kin, &bl).unwrap();
-    let profile = nc::plan::plan(&path, &kin, &cfg).unwrap();
-    let (start, list) = chunks(path, &profile, &HoldConfig::from_plan(&cfg), 64);
+    let (cfg, bl) = nc_plan::fixtures::small_mill(rig.period);
+    let program = nc_lang::parse(src).unwrap();
+    let path = nc_geom::segment::build(&program, &kin, &bl).unwrap();
+    let profile = nc_plan::plan::plan(&path, &kin, &cfg).unwrap();
+    let (start, list) = chunks(path, &profile, &cfg.hold(), 64);
     let mut source = list.into_iter();
     let (link, drive_end) = MemLink::pair(1024);
     let (bus, sim) = sim_bus_with(
@@ -120,7 +121,7 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(64);
     feeder.feed(&mut source);
-    let follower = Follower::new(inlet, start, kin, cfg.rotary, HoldConfig::from_plan(&cfg));
+    let follower = Follower::new(inlet, start, kin, cfg.rotary, cfg.hold());
     let mut pipeline = Pipeline::new(
         follower,
         vec![bus],

@@ -110,9 +110,7 @@ pub fn wiggle_file(bench: &str, n: usize) -> (std::path::PathBuf, u64) {
 }
 
 /// The lines of a program file, read as `dnurbs run` and `simulate` read them.
-pub fn read_lines(
-    path: &std::path::Path,
-) -> nc::parse::ReadLines<std::io::BufReader<std::fs::File>> {
+pub fn read_lines(path: &std::path::Path) -> nc_lang::ReadLines<std::io::BufReader<std::fs::File>> {
     let file = std::fs::File::open(path).expect("the program opens");
-    nc::parse::ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file))
+    nc_lang::ReadLines::new(std::io::BufReader::with_capacity(1 << 16, file))
 }

@@ -1,4 +1,4 @@
-//! `check`: the pre-pass alone ([`nc::prepass`]): the program read as a stream, in the
+//! `check`: the pre-pass alone ([`nc_plan::prepass`]): the program read as a stream, in the
 //! memory of one line, checked for syntax, geometry and the travel at every programmed
 //! point; nothing planned, nothing moved.
 
@@ -6,8 +6,8 @@ use crate::exit::{InputError, Outcome};
 use crate::load_machine;
 use crate::setup::MachineSetup;
 use crate::shop::{parse_setup, ShopArgs};
-use nc::parse::ReadLines;
-use nc::prepass::Refused;
+use nc_lang::ReadLines;
+use nc_plan::prepass::Refused;
 use std::path::Path;
 
 pub fn check(
@@ -27,17 +27,18 @@ pub fn check(
     })?;
     let clock = std::time::Instant::now();
     let lines = ReadLines::new(std::io::BufReader::with_capacity(1 << 16, reader));
-    let passed = nc::prepass::check(lines, &parse, &setup.kin, &setup.build, &setup.plan.travel)
-        .map_err(|e| match e {
-            Refused::Parse(errors) => InputError::Parse {
-                file: file.clone(),
-                errors,
-            },
-            other => InputError::Checked {
-                file: file.clone(),
-                error: other,
-            },
-        })?;
+    let passed =
+        nc_plan::prepass::check(lines, &parse, &setup.kin, &setup.build, &setup.plan.travel)
+            .map_err(|e| match e {
+                Refused::Parse(errors) => InputError::Parse {
+                    file: file.clone(),
+                    errors,
+                },
+                other => InputError::Checked {
+                    file: file.clone(),
+                    error: other,
+                },
+            })?;
     let secs = clock.elapsed().as_secs_f64();
     let rate = f64::from(passed.lines) / secs.max(1e-9);
     if json {

@@ -1,4 +1,4 @@
-//! `fit`: runs of G01 moves into G06.5 blocks ([`nc::fit`]), the result measured against
+//! `fit`: runs of G01 moves into G06.5 blocks ([`nc_fit`]), the result measured against
 //! the input before it is written.
 
 use crate::exit::{InputError, Outcome, StoppedUnfinished};
@@ -6,11 +6,11 @@ use crate::load_machine;
 use crate::setup::MachineSetup;
 use crate::shop::parse_setup;
 use anyhow::{bail, Context};
-use nc::fit::deviation::Deviation;
-use nc::fit::rewrite::rewrite;
-use nc::fit::runs::{Options, Summary};
-use nc::fit::Tolerance;
-use nc::parse::ReadLines;
+use nc_fit::deviation::Deviation;
+use nc_fit::rewrite::rewrite;
+use nc_fit::runs::{Options, Summary};
+use nc_fit::Tolerance;
+use nc_lang::ReadLines;
 use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -94,7 +94,7 @@ pub fn fit(
     // first the segment builder refuses), without the travel: the fit reads the program's
     // own numbers.
     let anywhere = [(f64::NEG_INFINITY, f64::INFINITY); 5];
-    let passed = nc::prepass::check(
+    let passed = nc_plan::prepass::check(
         ReadLines::new(open()?),
         &parse,
         &setup.kin,
@@ -103,7 +103,7 @@ pub fn fit(
     )
     .map_err(|error| match error {
         _ if stop.load(Ordering::Relaxed) => anyhow::Error::new(stopped()),
-        nc::prepass::Refused::Parse(errors) => InputError::Parse {
+        nc_plan::prepass::Refused::Parse(errors) => InputError::Parse {
             file: file.clone(),
             errors,
         }

@@ -141,11 +141,11 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
     }
 }
 
-fn method_of(m: MethodArg) -> nc::interp::Method {
+fn method_of(m: MethodArg) -> nc_plan::interp::Method {
     match m {
-        MethodArg::Arclength => nc::interp::Method::ArcLength,
-        MethodArg::Taylor1 => nc::interp::Method::Taylor1,
-        MethodArg::Taylor2 => nc::interp::Method::Taylor2,
+        MethodArg::Arclength => nc_plan::interp::Method::ArcLength,
+        MethodArg::Taylor1 => nc_plan::interp::Method::Taylor1,
+        MethodArg::Taylor2 => nc_plan::interp::Method::Taylor2,
     }
 }
 

@@ -9,10 +9,12 @@ use crate::simulate::{
 use crate::words::Noted;
 use crate::{load_machine, load_program};
 use anyhow::Context;
-use nc::interp::{Method, Setpoint, Unrolled, Window};
-use nc::parse::{Entries, ReadLines};
-use nc::plan::ProgramError;
-use nc::stream::ProgramEntries;
+use nc_geom::setpoint::Setpoint;
+use nc_lang::{Entries, ReadLines};
+use nc_plan::interp::Method;
+use nc_plan::plan::ProgramError;
+use nc_plan::rolling::{Unrolled, Window};
+use nc_plan::stream::ProgramEntries;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

@@ -5,12 +5,14 @@
 
 use super::{arc_between, axis_map, Exceeded, SpindleWaits, Summary};
 use crate::setup::MachineSetup;
-use nc::interp::{Method, Setpoint, Window};
-use nc::kinematics::Kinematics;
-use nc::nurbs::DoubleNurbs;
-use nc::plan::Finished;
-use nc::segment::{Segment, Tooling};
-use nc::verify::dist_to_chord;
+use nc_geom::kinematics::Kinematics;
+use nc_geom::nurbs::DoubleNurbs;
+use nc_geom::segment::{Segment, Tooling};
+use nc_geom::setpoint::Setpoint;
+use nc_plan::interp::Method;
+use nc_plan::plan::Finished;
+use nc_plan::rolling::Window;
+use nc_plan::verify::dist_to_chord;
 
 /// What the summary needs to know about the block the setpoints are in, loaded when they
 /// enter it: the setpoints walk the blocks in order, so a cursor over the segments finds
@@ -29,7 +31,7 @@ struct BlockSegs {
     line: bool,
     /// The block has a turn at rest (the cutter stands while the tool turns).
     turns: bool,
-    /// The block's curve pieces in parameter order (`nc::split`).
+    /// The block's curve pieces in parameter order (`nc_geom::split`).
     pieces: Vec<DoubleNurbs>,
     /// The distinct knots of each piece whose tool axis is its orientation curve, with
     /// the piece's index and whether the tool axis has been measured there, sorted by knot.
@@ -171,7 +173,7 @@ impl<'a> Summarizer<'a> {
     }
 
     /// Take the next setpoint; `window` holds the path's segments from the setpoint's (or
-    /// an earlier one) on ([`nc::interp::Rolling`], or the whole path).
+    /// an earlier one) on ([`nc_plan::rolling::Rolling`], or the whole path).
     pub fn push(&mut self, sp: &Setpoint, window: Window) {
         if sp.block != self.block.number || !self.block.complete {
             self.block
@@ -193,7 +195,7 @@ impl<'a> Summarizer<'a> {
             return;
         }
         // A block may be several segments: pieces of a large or kinked curve
-        // (`nc::split`), a turn at rest before it. A setpoint's u says which piece holds
+        // (`nc_geom::split`), a turn at rest before it. A setpoint's u says which piece holds
         // it; a line's setpoints (no u) belong to the block's straight move.
         let segs = &self.block;
         let ds = match (a.u, b.u) {

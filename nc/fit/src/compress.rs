@@ -1,0 +1,131 @@
+//! On-line compression (`[interpolation] compress` in the machine file, `--compress` on
+//! `simulate` and `run`): the runs of `G01` moves of a parsed program replaced by G06.5
+//! blocks with the same fit as `dnurbs fit`, before the segment builder and the planner see
+//! it. The program's coordinates are already resolved here (work offsets, units, `G91`), so
+//! every run of feed moves qualifies that has no program word (spindle, coolant, stop,
+//! dwell) between its moves ([`super::find`] has the rest of the rules).
+
+use super::find::{find_runs, moves_in};
+use super::runs::{Options, TOOL_MM};
+use super::Fitted;
+use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Program};
+
+/// What the compressor did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Compressed {
+    /// Feed moves in, and those now inside a G06.5 block.
+    pub moves_in: usize,
+    pub moves_fitted: usize,
+    /// Motion blocks in and out.
+    pub blocks_in: usize,
+    pub blocks_out: usize,
+    /// G06.5 blocks written.
+    pub fitted_blocks: usize,
+    /// Runs the fit could not bring within the tolerances (left as G01).
+    pub runs_kept: usize,
+    /// Largest deviations the fit measured at the programmed points (mm, degrees).
+    pub fit_mm: f64,
+    pub fit_deg: f64,
+}
+
+/// `program` with its runs of moves fitted into G06.5 blocks.
+pub fn compress(
+    program: &Program,
+    kin: &nc_geom::kinematics::MachineKinematics,
+    opts: &Options,
+) -> (Program, Compressed) {
+    let n = program.blocks.len();
+    // A program word before block k ends any run there.
+    let mut word_before = vec![false; n + 1];
+    for a in &program.actions {
+        if let Some(w) = word_before.get_mut(a.before_block) {
+            *w = true;
+        }
+    }
+    let runs = find_runs(
+        program,
+        kin,
+        opts,
+        |_| true,
+        |k| !word_before[k],
+        |_, _| true,
+    );
+    let mut out = Compressed {
+        moves_in: moves_in(program),
+        blocks_in: n,
+        ..Compressed::default()
+    };
+    let mut blocks = Vec::with_capacity(n);
+    // New index of each old block (and of the end, n).
+    let mut index = vec![0; n + 1];
+    let mut next = 0;
+    for run in &runs {
+        let (b, e) = run.blocks;
+        let Some(f) = &run.fitted else {
+            out.runs_kept += 1;
+            continue;
+        };
+        let Some(Block::Linear(first)) = program.blocks.get(b) else {
+            continue;
+        };
+        copy(&program.blocks[next..b], next, &mut blocks, &mut index);
+        for slot in &mut index[b..=e] {
+            *slot = blocks.len();
+        }
+        blocks.push(Block::Nurbs(fitted_block(first, f, run.feed_mm_min)));
+        next = e + 1;
+        out.fitted_blocks += 1;
+        out.moves_fitted += e + 1 - b;
+        out.fit_mm = out.fit_mm.max(f.dev_mm);
+        out.fit_deg = out.fit_deg.max(f.dev_rad.to_degrees());
+    }
+    copy(&program.blocks[next..], next, &mut blocks, &mut index);
+    index[n] = blocks.len();
+    out.blocks_out = blocks.len();
+    let mut actions = program.actions.clone();
+    for a in &mut actions {
+        a.before_block = index.get(a.before_block).copied().unwrap_or(blocks.len());
+    }
+    (
+        Program {
+            blocks,
+            actions,
+            end: program.end,
+            tilt_word: program.tilt_word,
+        },
+        out,
+    )
+}
+
+/// The G06.5 block of a run fitted as `f`, whose first move is `first` (its position, `N`
+/// and tooling), at the run's feed (mm/min, [`super::find::run_feed`]).
+pub fn fitted_block(first: &LinearMove, f: &Fitted, feed_mm_min: f64) -> NurbsBlock {
+    let tool_ctrl = f
+        .ctrl
+        .iter()
+        .zip(&f.tool)
+        .map(|(c, t)| core::array::from_fn(|i| c[i] + TOOL_MM * t[i]))
+        .collect();
+    NurbsBlock {
+        pos: first.pos,
+        n: first.n,
+        kind: NurbsKind::G065,
+        degree: f.degree as u8,
+        ctrl: f.ctrl.clone(),
+        tool_ctrl,
+        ctrl_pos: vec![first.pos; f.ctrl.len()],
+        weights: vec![1.0; f.ctrl.len()],
+        knots: f.knots.clone(),
+        feed_mm_min,
+        tooling: first.tooling,
+        turn_to: None,
+    }
+}
+
+/// Blocks `from..` (given as `old`) copied as they are, their new indices noted.
+fn copy(old: &[Block], from: usize, blocks: &mut Vec<Block>, index: &mut [usize]) {
+    for (slot, b) in index[from..].iter_mut().zip(old) {
+        *slot = blocks.len();
+        blocks.push(b.clone());
+    }
+}

@@ -1,0 +1,597 @@
+//! The real-time interpolator over streamed chunks: the override tracker, the operator's
+//! and the spindle's gates, and the pose at the new path position.
+
+use crate::chunk::{Chunk, Start};
+use crate::hold::{AxisHold, HoldConfig};
+use crate::queue::{Inlet, LOOKAHEAD};
+use heapless::Deque;
+use nc_geom::kinematics::{Joints, MachineKinematics, RotaryLimits};
+use nc_geom::program::Aux;
+use nc_geom::scurve::Motion;
+use nc_geom::segment::Pose;
+use nc_geom::setpoint::Setpoint;
+use std::sync::atomic::Ordering;
+
+/// Counters of a streamed run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StreamCounters {
+    /// Holds started because the path that had arrived was about to run out.
+    pub underruns: u64,
+    /// Periods spent holding for data (k < 1 for lack of data).
+    pub hold_periods: u64,
+    /// Periods where the path ran out before the hold stopped the tool (the tool was stopped
+    /// at the end of the data: on the path, but without deceleration). Should stay 0.
+    pub hard_stops: u64,
+    /// Chunks that could not be handed back (cannot happen by the depth rule; leaked
+    /// rather than freed in the real-time thread).
+    pub leaked: u64,
+}
+
+/// The real-time interpolator over streamed chunks (arc-length method).
+pub struct Follower<'q> {
+    inlet: Inlet<'q>,
+    local: Deque<Box<Chunk>, LOOKAHEAD>,
+    kin: MachineKinematics,
+    lim: RotaryLimits,
+    hold: HoldConfig,
+    axis_hold: AxisHold,
+    /// The program's last chunk has arrived.
+    complete: bool,
+    cycle: u64,
+    tau: f64,
+    k: f64,
+    r: f64,
+    phase: usize,
+    motion: Motion,
+    stop_requested: bool,
+    holding: bool,
+    /// The operator's feed override (0..=1) and pause: the tracker's target when the
+    /// data suffices.
+    feed_override: f64,
+    paused: bool,
+    /// Source line of the operator stop (`M00`, `M01`, `M06`) the path waits at.
+    awaiting: Option<u32>,
+    /// Chunks from this index on may still hold an operator stop not yet reached.
+    gate_from: usize,
+    /// Hold at the spindle waits ([`Wait::spindle`](nc_geom::program::Wait)) until the
+    /// spindle is at speed; off without a spindle (dry runs).
+    spindle_gates: bool,
+    /// The speed (rpm, signed) the spindle has reached, as last reported.
+    spindle_at: Option<f64>,
+    /// Chunks from this index on may still hold a spindle wait not yet passed.
+    spindle_gate_from: usize,
+    /// Source line of the move that waits for the spindle, while it waits.
+    awaiting_spindle: Option<u32>,
+    /// Spindle and coolant commanded now.
+    aux: Aux,
+    done: bool,
+    pose: Pose,
+    joints: Joints,
+    block: u32,
+    counters: StreamCounters,
+    pending: Pending,
+}
+
+/// What [`Follower::advance`] leaves for [`Follower::evaluate`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pending {
+    /// The path position moved: evaluate the pose there (cycle).
+    Pose(u64),
+    /// The pose stands: report it again (cycle, feed).
+    Fixed(u64, f64),
+}
+
+impl<'q> Follower<'q> {
+    pub fn new(
+        inlet: Inlet<'q>,
+        start: Start,
+        kin: MachineKinematics,
+        lim: RotaryLimits,
+        hold: HoldConfig,
+    ) -> Self {
+        Follower {
+            inlet,
+            local: Deque::new(),
+            kin,
+            lim,
+            hold,
+            axis_hold: AxisHold::new(&hold, &start.margins),
+            complete: start.empty,
+            cycle: 0,
+            tau: 0.0,
+            k: 1.0,
+            r: 0.0,
+            phase: 0,
+            pending: Pending::Fixed(0, 0.0),
+            motion: Motion::default(),
+            stop_requested: false,
+            holding: false,
+            feed_override: 1.0,
+            paused: false,
+            awaiting: None,
+            gate_from: 0,
+            spindle_gates: false,
+            spindle_at: None,
+            spindle_gate_from: 0,
+            awaiting_spindle: None,
+            aux: Aux::default(),
+            done: start.empty,
+            pose: start.pose,
+            joints: start.joints,
+            block: 1,
+            counters: StreamCounters::default(),
+        }
+    }
+
+    /// Decelerate along the path to a stop and stay there (SIGINT, a drive fault).
+    pub fn request_stop(&mut self) {
+        self.stop_requested = true;
+    }
+
+    /// The source line at which the planner refused the program, once it has: the follower
+    /// is stopping along the path (allocation-free, one atomic load).
+    ///
+    /// Real-time thread.
+    pub fn refused(&self) -> Option<u32> {
+        match self.inlet.refused.load(Ordering::Acquire) {
+            0 => None,
+            line => Some(line),
+        }
+    }
+
+    /// The operator's feed override, a fraction of the planned feed in 0..=1 (clamped; NaN
+    /// counts as 0). Reached, like a feed hold, by the rate- and jerk-limited tracker.
+    pub fn set_override(&mut self, k: f64) {
+        self.feed_override = if k.is_nan() { 0.0 } else { k.clamp(0.0, 1.0) };
+    }
+
+    pub fn feed_override(&self) -> f64 {
+        self.feed_override
+    }
+
+    /// Decelerate along the path and hold there until [`Self::resume`]. Unlike a stop, the
+    /// run is not over.
+    pub fn pause(&mut self) {
+        self.paused = true;
+    }
+
+    pub fn resume(&mut self) {
+        self.paused = false;
+        self.awaiting = None;
+    }
+
+    /// The line of the operator stop (`M00`, `M01`, `M06`) the path stands at, waiting for
+    /// [`Self::resume`].
+    pub fn awaiting(&self) -> Option<u32> {
+        self.awaiting
+    }
+
+    /// Hold at every move that needs the spindle at speed until [`Self::spindle_at_speed`]
+    /// reports that speed (a machine with a spindle drive). Off by default: the spindle
+    /// words then change [`Setpoint::aux`] and nothing waits.
+    pub fn wait_for_spindle(&mut self, on: bool) {
+        self.spindle_gates = on;
+    }
+
+    /// The speed (rpm, signed as [`Aux::spindle_rpm`]) the spindle drive reports it has
+    /// reached, or `None` while it is not at the speed it was sent. Every period, before
+    /// [`Self::advance`].
+    pub fn spindle_at_speed(&mut self, rpm: Option<f64>) {
+        self.spindle_at = rpm;
+    }
+
+    /// The line of the move that waits for the spindle to reach its speed, while it waits.
+    pub fn awaiting_spindle(&self) -> Option<u32> {
+        self.awaiting_spindle
+    }
+
+    /// Spindle and coolant as commanded now: those of the segment being machined, or of
+    /// the one waiting for the spindle.
+    pub fn aux(&self) -> Aux {
+        self.aux
+    }
+
+    pub fn is_paused(&self) -> bool {
+        self.paused
+    }
+
+    /// At rest after [`Self::request_stop`], or at the end of the program.
+    pub fn is_stopped(&self) -> bool {
+        self.done || (self.stop_requested && self.k == 0.0 && self.r == 0.0)
+    }
+
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    pub fn counters(&self) -> StreamCounters {
+        self.counters
+    }
+
+    /// Path position, plan time and override of the last step.
+    pub fn state(&self) -> (f64, f64, f64) {
+        (self.motion.s, self.tau, self.k)
+    }
+
+    /// The last setpoint (the start pose before the first step).
+    pub fn last(&self) -> Setpoint {
+        self.setpoint(self.cycle.saturating_sub(1), self.motion.v)
+    }
+
+    /// Source line of the block being machined (0 before the first has arrived).
+    pub fn line(&self) -> u32 {
+        self.local
+            .front()
+            .and_then(|c| c.segment_at(self.motion.s))
+            .map_or(0, |(seg, _)| seg.src.line)
+    }
+
+    /// How far into the program the tool is, 0..=1 ([`Chunk::progress`] of the chunk at
+    /// hand).
+    pub fn progress(&self) -> f64 {
+        if self.done {
+            return 1.0;
+        }
+        self.local.front().map_or(0.0, |c| c.progress)
+    }
+
+    /// Take what the planner has pushed, up to the look-ahead.
+    fn pull(&mut self) {
+        while !self.local.is_full() {
+            match self.inlet.ready.dequeue() {
+                Some(c) => {
+                    self.complete |= c.last;
+                    // The deque is not full: cannot fail.
+                    if let Err(c) = self.local.push_back(c) {
+                        self.give_back(c);
+                    }
+                }
+                None => break,
+            }
+        }
+    }
+
+    fn give_back(&mut self, c: Box<Chunk>) {
+        if let Err(c) = self.inlet.retired.enqueue(c) {
+            core::mem::forget(c);
+            self.counters.leaked += 1;
+        }
+    }
+
+    fn retire_front(&mut self) {
+        if let Some(c) = self.local.pop_front() {
+            self.give_back(c);
+        }
+        self.phase = 0;
+    }
+
+    /// Distance needed to bring the override to 0 from its current state, travelling at
+    /// most `v` (a bound, not the exact figure).
+    ///
+    /// The check runs before this period's step, which may still raise the override (by at
+    /// most `r Ts + jmax Ts^2`, its rate by `jmax Ts`); the stop is bounded from there, so
+    /// that a hold that begins next period still fits. At rest the distance is next to
+    /// nothing, so a hold creeps on toward the end of the data it has rather than wait for
+    /// data that cannot come (the queue full of what it holds).
+    fn stop_distance(&self, v: f64, rmax: f64, jmax: f64) -> f64 {
+        let ts = self.hold.period;
+        let rise = self.r.max(0.0) + jmax * ts;
+        let k_next = (self.k + self.r.max(0.0) * ts + jmax * ts * ts).min(1.0);
+        let kpk = (k_next + rise * rise / (2.0 * jmax)).min(1.0);
+        // The rate's ramps: up to rmax and back, or a triangle if it never gets there.
+        let ramps = (2.0 * rmax / jmax).min(2.0 * (kpk / jmax).sqrt());
+        let t = rise / jmax + self.axis_hold.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
+        v * kpk * t
+    }
+
+    /// Move the override one period toward `target` with rate <= rmax, rate change <= jmax.
+    /// Where rmax has fallen below the present rate (it tightens as k nears 1), the rate
+    /// drops to it at once: the axes' acceleration comes before the override's smoothness.
+    fn track(&mut self, target: f64, rmax: f64, jmax: f64) {
+        let ts = self.hold.period;
+        let d = target - self.k;
+        let want = d.signum() * rmax.min((2.0 * jmax * d.abs()).sqrt());
+        let dr = (want - self.r).clamp(-jmax * ts, jmax * ts);
+        let r_new = (self.r + dr).clamp(-rmax, rmax);
+        let mut k = self.k + 0.5 * (self.r + r_new) * ts;
+        let mut r = r_new;
+        if (target - k) * d <= 0.0 || d.abs() < 1e-12 {
+            // Reached (or passed) the target this period.
+            k = target;
+            r = 0.0;
+        }
+        self.k = k.clamp(0.0, 1.0);
+        self.r = r;
+    }
+
+    fn motion_in(c: &Chunk, tau: f64, cursor: &mut usize) -> Motion {
+        let n = c.phases.len();
+        if n == 0 {
+            return Motion {
+                s: c.s1,
+                v: 0.0,
+                a: 0.0,
+            };
+        }
+        while *cursor + 1 < n && tau >= c.phases[*cursor + 1].t0 {
+            *cursor += 1;
+        }
+        let ph = &c.phases[(*cursor).min(n - 1)];
+        let mut m = ph.at((tau - ph.t0).clamp(0.0, ph.dur));
+        m.v = m.v.max(0.0);
+        m
+    }
+
+    /// One period: the next setpoint ([`Follower::advance`] then [`Follower::evaluate`]).
+    /// Allocation-free; loops bounded by [`LOOKAHEAD`].
+    pub fn step(&mut self) -> Setpoint {
+        self.advance();
+        self.evaluate()
+    }
+
+    /// The first half of a period: take arrived chunks, move the override and the plan time,
+    /// and find the new path position s. No curve is evaluated here.
+    ///
+    /// Real-time thread.
+    pub fn advance(&mut self) {
+        self.pull();
+        if self.refused().is_some() {
+            self.stop_requested = true;
+        }
+        let ts = self.hold.period;
+        let cycle = self.cycle;
+        self.cycle += 1;
+        if cycle == 0 || self.done {
+            self.pending = Pending::Fixed(cycle, 0.0);
+            return;
+        }
+        // Nothing arrived yet: stay at the start (the plan starts from rest at tau = 0).
+        if self.local.is_empty() {
+            self.k = 0.0;
+            self.r = 0.0;
+            if !self.complete && !self.stop_requested {
+                self.counters.hold_periods += 1;
+            }
+            self.pending = Pending::Fixed(cycle, 0.0);
+            return;
+        }
+        // The hold's scale: the highest planned speed from here to the end, not only over
+        // the chunks at hand. A faster chunk arriving mid-hold would otherwise lower the
+        // hold's jerk under a rate built with the old one, which could then not be undone
+        // before the data ran out.
+        let vb = self
+            .local
+            .front()
+            .map_or(1e-9, |c| c.vmax_ahead)
+            .max(1e-9)
+            .max(self.motion.v);
+        let rmax = self.hold.acc / vb;
+        let mut jmax = self.hold.jerk / vb;
+        let complete = self.complete;
+        let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
+        let room = avail_end - self.motion.s;
+        // Held at rest for data, closer to its end than the least stop distance: creep on
+        // with a gentler jerk whose stop fits in half the room. The planner may be unable to
+        // push more (the queue's depth is in the chunks held here) until the first is left.
+        if !complete && self.k == 0.0 && self.r == 0.0 && room > 0.0 {
+            let d0 = self.stop_distance(vb, rmax, jmax);
+            if d0 >= room {
+                jmax *= 0.5 * room / d0;
+            }
+        }
+        let target = if self.stop_requested {
+            0.0
+        } else if !complete && room <= self.stop_distance(vb, rmax, jmax) {
+            if !self.holding {
+                self.holding = true;
+                self.counters.underruns += 1;
+            }
+            0.0
+        } else {
+            self.holding = false;
+            if self.paused {
+                0.0
+            } else {
+                self.feed_override
+            }
+        };
+        if self.holding {
+            self.counters.hold_periods += 1;
+        }
+        // At rest (the plan at rest, or already held), the override drops to 0 at once:
+        // nothing moves. Otherwise a program whose first chunk is shorter than the distance
+        // to stop from the plan's start would begin to move, then stop short at its end.
+        if target == 0.0 && self.motion.v == 0.0 {
+            self.k = 0.0;
+            self.r = 0.0;
+        }
+        // The axes' bound at the highest override this period can reach (the bound falls
+        // as k rises), so that it holds over the whole period. Within the period the rate
+        // moves linearly from r to the new rate, which is at most r toward a lower target,
+        // else at most one jerk step up, the path's bound and the axes' bound at the
+        // present k. (A bound of a whole jerk step, jmax Ts^2, would be most of the range
+        // where the plan is slow and jmax large: the rate would stay at the bound for k = 1
+        // through the whole stop, far slower than the stop distance assumes.)
+        let up = if target > self.k {
+            (self.r + jmax * ts)
+                .min(rmax)
+                .min(self.axis_hold.rate(self.k))
+        } else {
+            0.0
+        };
+        let k_hi = (self.k + ts * self.r.max(up).max(0.0)).min(1.0);
+        let rate = rmax.min(self.axis_hold.rate(k_hi));
+        let k_old = self.k;
+        self.track(target, rate, jmax);
+        let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
+        // An operator stop ahead: the plan is at rest where it arrives there; hold it there
+        // (paused) until the operator resumes. Only the next boundary can hold one.
+        let gate = self.local.iter().take(2).find(|c| {
+            c.index >= self.gate_from && c.first().is_some_and(|g| g.wait.operator.is_some())
+        });
+        if let Some(c) = gate {
+            if tau >= c.t_start {
+                tau = c.t_start.max(self.tau);
+                self.k = 0.0;
+                self.r = 0.0;
+                self.paused = true;
+                self.awaiting = c.first().and_then(|g| g.wait.operator).map(|p| p.line);
+                self.gate_from = c.index + 1;
+            }
+        }
+        // A move that needs the spindle at speed ahead: the plan is at rest where it starts;
+        // command that move's speed there and hold until the drive reports it.
+        self.awaiting_spindle = None;
+        let mut gate_aux = None;
+        let spindle = self.local.iter().take(2).find(|c| {
+            c.index >= self.spindle_gate_from && c.first().is_some_and(|g| g.wait.spindle)
+        });
+        let spindle = spindle.and_then(|c| Some((c, c.first()?)));
+        // Paused (the operator's stop at the same place, or a pause on the way there) it
+        // holds there too, but the spindle keeps its command until the run resumes: it never
+        // starts while the operator changes the tool.
+        if let Some((c, g)) = spindle {
+            if tau >= c.t_start {
+                let rpm = g.aux.spindle_rpm;
+                if !self.paused {
+                    gate_aux = Some(g.aux);
+                }
+                if !self.paused && (!self.spindle_gates || self.spindle_at == Some(rpm)) {
+                    self.spindle_gate_from = c.index + 1;
+                } else {
+                    tau = c.t_start.max(self.tau);
+                    self.k = 0.0;
+                    self.r = 0.0;
+                    if !self.paused {
+                        self.awaiting_spindle = Some(g.src.line);
+                    }
+                }
+            }
+        }
+        // The data ends where the plan comes to rest (an exact stop at a kink): wait there,
+        // at rest like the plan, for the next chunk. Nothing is cut short: no hard stop.
+        let rest_end = match (self.local.len(), self.local.front()) {
+            (1, Some(c)) => c.rests_at_end && !c.last && tau >= c.t_arrive,
+            _ => false,
+        };
+        let mut m = self.motion;
+        if let (true, Some(c)) = (rest_end, self.local.front()) {
+            tau = c.t_arrive.max(self.tau);
+            m = Self::motion_in(c, tau, &mut self.phase);
+            m.s = m.s.min(c.s1).max(self.motion.s);
+            m.v = 0.0;
+            self.k = 0.0;
+            self.r = 0.0;
+        }
+        // Otherwise find the chunk that holds tau; bounded by the look-ahead.
+        let walk = if rest_end { 0 } else { LOOKAHEAD + 1 };
+        for _ in 0..walk {
+            let Some(c) = self.local.front() else { break };
+            m = Self::motion_in(c, tau, &mut self.phase);
+            if c.last {
+                if tau >= c.t_end {
+                    self.done = true;
+                    m = Motion {
+                        s: c.s1,
+                        v: 0.0,
+                        a: 0.0,
+                    };
+                }
+                break;
+            }
+            if m.s <= c.s1 && tau <= c.t_end {
+                break;
+            }
+            if self.local.len() > 1 {
+                self.retire_front();
+            } else {
+                // The data ran out before the hold had stopped: stop at its end, on the path.
+                let s1 = c.s1;
+                self.counters.hard_stops += 1;
+                self.k = 0.0;
+                self.r = 0.0;
+                self.motion.s = self.motion.s.max(s1.min(m.s));
+                self.motion.v = 0.0;
+                self.motion.a = 0.0;
+                self.pending = Pending::Pose(cycle);
+                return;
+            }
+        }
+        self.tau = tau;
+        m.v *= self.k;
+        self.motion = m;
+        self.aux = match (gate_aux, self.local.front()) {
+            (Some(a), _) => a,
+            (None, Some(c)) => c.segment_at(m.s).map_or(self.aux, |(seg, _)| seg.aux),
+            (None, None) => self.aux,
+        };
+        self.pending = Pending::Pose(cycle);
+    }
+
+    /// The second half of a period, the interpolation proper: u at the new path position
+    /// (arc-length inverse), both curves from one basis evaluation, the tool axis, inverse
+    /// kinematics. Calling it again before the next [`Follower::advance`] repeats the setpoint.
+    ///
+    /// Real-time thread.
+    pub fn evaluate(&mut self) -> Setpoint {
+        match self.pending {
+            Pending::Fixed(cycle, feed) => self.setpoint(cycle, feed),
+            Pending::Pose(cycle) => {
+                let sp = self.pose_setpoint(cycle);
+                self.pending = Pending::Fixed(cycle, self.motion.v);
+                sp
+            }
+        }
+    }
+
+    /// A dry run of [`Follower::evaluate`]'s work where the next period will likely be (one
+    /// period on at the present speed, in whichever chunk holds that): the same arc-length
+    /// inverse, basis functions, both curves and inverse kinematics, with nothing kept. The
+    /// real-time loop calls it before the deadline so that the step's code and data, the
+    /// next segment's at a hand-over, are in the caches when the timed step runs.
+    /// Allocation-free; bounded by [`LOOKAHEAD`].
+    ///
+    /// Real-time thread.
+    pub fn rehearse(&self) -> Joints {
+        let s = self.motion.s + self.motion.v.max(0.0) * self.hold.period;
+        let chunk = self
+            .local
+            .iter()
+            .find(|c| s <= c.s1)
+            .or_else(|| self.local.back());
+        let s = chunk.map_or(s, |c| s.min(c.s1));
+        match chunk.and_then(|c| c.segment_at(s)) {
+            Some((seg, s0)) => seg.pose(s - s0).joints(&self.kin, &self.joints, &self.lim),
+            None => self.joints,
+        }
+    }
+
+    fn pose_setpoint(&mut self, cycle: u64) -> Setpoint {
+        let s = self.motion.s;
+        if let Some((seg, s0)) = self.local.front().and_then(|c| c.segment_at(s)) {
+            self.block = seg.block;
+            self.pose = seg.pose(s - s0);
+        }
+        self.joints = self.pose.joints(&self.kin, &self.joints, &self.lim);
+        if self.done {
+            // The program's last chunk is finished: hand it back now.
+            self.retire_front();
+        }
+        self.setpoint(cycle, self.motion.v)
+    }
+
+    fn setpoint(&self, cycle: u64, feed: f64) -> Setpoint {
+        Setpoint {
+            cycle,
+            t: cycle as f64 * self.hold.period,
+            block: self.block,
+            u: self.pose.u,
+            p: self.pose.p,
+            tool: self.pose.axis(&self.kin),
+            feed: if self.done { 0.0 } else { feed },
+            joints: self.joints,
+            done: self.done,
+            aux: self.aux,
+        }
+    }
+}

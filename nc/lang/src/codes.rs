@@ -1,0 +1,210 @@
+//! The G and M codes dnurbs knows, decoded into their modal groups.
+//!
+//! One code per group on a line (`G00 G01` on one line is an error, `G90 G94 G17 G49 G40 G80`
+//! is six groups). Codes of real posts that dnurbs cannot honour have their own error, never
+//! a silent skip: cutter compensation (`G41`/`G42`), canned cycles (`G73`..`G89`).
+
+use super::error::{Motion, ParseErrorKind};
+use nc_geom::program::{Coolant, Spindle};
+
+/// Working plane of arcs (`G17` XY, `G18` ZX, `G19` YZ).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plane {
+    Xy,
+    Zx,
+    Yz,
+}
+
+impl Plane {
+    pub fn name(self) -> &'static str {
+        match self {
+            Plane::Xy => "G17 (XY)",
+            Plane::Zx => "G18 (ZX)",
+            Plane::Yz => "G19 (YZ)",
+        }
+    }
+
+    /// The centre-offset words of the plane's two axes.
+    pub fn offset_letters(self) -> &'static str {
+        match self {
+            Plane::Xy => "I J",
+            Plane::Zx => "K I",
+            Plane::Yz => "J K",
+        }
+    }
+
+    /// The offset letters by axis index (X Y Z -> I J K).
+    pub fn offset_letter(axis: usize) -> char {
+        match axis {
+            0 => 'I',
+            1 => 'J',
+            _ => 'K',
+        }
+    }
+
+    /// Axis indices (first, second, normal) of the plane, right-handed: a counter-clockwise
+    /// arc (`G03`) turns from the first axis toward the second, seen from +normal.
+    pub fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Plane::Xy => (0, 1, 2),
+            Plane::Zx => (2, 0, 1),
+            Plane::Yz => (1, 2, 0),
+        }
+    }
+}
+
+/// Tool-length compensation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LengthComp {
+    /// `G43 H`: tool length along machine Z.
+    Length,
+    /// `G43.4 H`: tool length and tool-centre-point control (RTCP).
+    Rtcp,
+    /// `G49`.
+    Off,
+}
+
+/// Program stops and ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopCode {
+    /// `M00`.
+    Stop,
+    /// `M01`.
+    Optional,
+    /// `M06`.
+    ToolChange,
+    /// `M02` / `M30`.
+    End,
+}
+
+/// A decoded code.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Code {
+    Motion(Motion),
+    /// `G04` dwell (non-modal).
+    Dwell,
+    /// `G28` return to the reference position (non-modal).
+    Home,
+    /// `G53` move in machine coordinates (non-modal).
+    MachineCoords,
+    Plane(Plane),
+    /// `G20` (true) / `G21`.
+    Inch(bool),
+    /// `G91` (true) / `G90`.
+    Incremental(bool),
+    /// `G93` (true) / `G94`.
+    InverseTime(bool),
+    /// `G40`.
+    CompensationOff,
+    LengthComp(LengthComp),
+    /// `G80`: no canned cycle (dnurbs has none, so this is always in effect).
+    CannedOff,
+    /// `G54`..`G59`: index 0..=5.
+    WorkOffset(u8),
+    /// `G61` exact stop (false) / `G64` blending (true).
+    Blend(bool),
+    Stop(StopCode),
+    Spindle(Spindle),
+    Coolant(Coolant),
+}
+
+/// Modal groups, as indices of [`super::line::Line`]'s code table.
+pub const GROUPS: usize = 14;
+
+impl Code {
+    pub fn group(self) -> usize {
+        match self {
+            Code::Motion(_) => 0,
+            Code::Dwell | Code::Home | Code::MachineCoords => 1,
+            Code::Plane(_) => 2,
+            Code::Inch(_) => 3,
+            Code::Incremental(_) => 4,
+            Code::InverseTime(_) => 5,
+            Code::CompensationOff => 6,
+            Code::LengthComp(_) => 7,
+            Code::CannedOff => 8,
+            Code::WorkOffset(_) => 9,
+            Code::Blend(_) => 10,
+            Code::Stop(_) => 11,
+            Code::Spindle(_) => 12,
+            Code::Coolant(_) => 13,
+        }
+    }
+}
+
+/// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
+/// correctly-rounded f64.
+const G_CODES: [(f64, Code); 30] = [
+    (0.0, Code::Motion(Motion::G00)),
+    (1.0, Code::Motion(Motion::G01)),
+    (2.0, Code::Motion(Motion::G02)),
+    (3.0, Code::Motion(Motion::G03)),
+    (4.0, Code::Dwell),
+    (6.2, Code::Motion(Motion::G062)),
+    (6.5, Code::Motion(Motion::G065)),
+    (17.0, Code::Plane(Plane::Xy)),
+    (18.0, Code::Plane(Plane::Zx)),
+    (19.0, Code::Plane(Plane::Yz)),
+    (20.0, Code::Inch(true)),
+    (21.0, Code::Inch(false)),
+    (28.0, Code::Home),
+    (40.0, Code::CompensationOff),
+    (43.0, Code::LengthComp(LengthComp::Length)),
+    (43.4, Code::LengthComp(LengthComp::Rtcp)),
+    (49.0, Code::LengthComp(LengthComp::Off)),
+    (53.0, Code::MachineCoords),
+    (54.0, Code::WorkOffset(0)),
+    (55.0, Code::WorkOffset(1)),
+    (56.0, Code::WorkOffset(2)),
+    (57.0, Code::WorkOffset(3)),
+    (58.0, Code::WorkOffset(4)),
+    (59.0, Code::WorkOffset(5)),
+    (61.0, Code::Blend(false)),
+    (64.0, Code::Blend(true)),
+    (80.0, Code::CannedOff),
+    (90.0, Code::Incremental(false)),
+    (91.0, Code::Incremental(true)),
+    (93.0, Code::InverseTime(true)),
+];
+
+/// The list the unsupported-code error names.
+pub const G_LIST: &str =
+    "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G80 G90 G91 G93 G94";
+pub const M_LIST: &str = "M00 M01 M02 M03 M04 M05 M06 M07 M08 M09 M30";
+
+pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
+    if value == 94.0 {
+        return Ok(Code::InverseTime(false));
+    }
+    if let Some((_, code)) = G_CODES.iter().find(|(v, _)| *v == value) {
+        return Ok(*code);
+    }
+    Err(if value == 41.0 || value == 42.0 {
+        ParseErrorKind::CutterCompensation { code: value }
+    } else if (73.0..=89.0).contains(&value) && value.fract() == 0.0 {
+        ParseErrorKind::CannedCycle { code: value }
+    } else {
+        ParseErrorKind::UnsupportedGCode { code: value }
+    })
+}
+
+pub fn m_code(value: f64) -> Result<Code, ParseErrorKind> {
+    const M_CODES: [(f64, Code); 11] = [
+        (0.0, Code::Stop(StopCode::Stop)),
+        (1.0, Code::Stop(StopCode::Optional)),
+        (2.0, Code::Stop(StopCode::End)),
+        (3.0, Code::Spindle(Spindle::Cw)),
+        (4.0, Code::Spindle(Spindle::Ccw)),
+        (5.0, Code::Spindle(Spindle::Off)),
+        (6.0, Code::Stop(StopCode::ToolChange)),
+        (7.0, Code::Coolant(Coolant::Mist)),
+        (8.0, Code::Coolant(Coolant::Flood)),
+        (9.0, Code::Coolant(Coolant::Off)),
+        (30.0, Code::Stop(StopCode::End)),
+    ];
+    M_CODES
+        .iter()
+        .find(|(v, _)| *v == value)
+        .map(|(_, c)| *c)
+        .ok_or(ParseErrorKind::UnsupportedMCode { code: value })
+}

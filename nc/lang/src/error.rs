@@ -1,0 +1,314 @@
+//! Parse errors: one [`ParseErrorKind`] variant per rule of the language, each carrying the
+//! offending values, plus the [`SrcPos`] of the token that broke the rule.
+//!
+//! Everything here is `Copy` and heap-free (numbers are carried as `f64`, words as their
+//! letter), so a test can match a variant and its values, and the message is rendered only
+//! when displayed. A message names the bad token or value and the rule it breaks.
+
+use core::fmt;
+
+use super::arc::{ARC_RADIUS_TOL_MM, HELIX_TOL_MM, MIN_ARC_RADIUS_MM};
+use super::codes::{Plane, G_LIST, M_LIST};
+use super::modal::MAX_DWELL_S;
+use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
+use super::parser::{MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH, MIN_WEIGHT};
+use nc_geom::program::SrcPos;
+use nc_geom::program::MAX_BLOCK_CTRL;
+
+/// A parse failure: where it happened and which rule was broken.
+///
+/// Displays as `line:col: message`; the CLI prefixes the file name.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+#[error("{pos}: {kind}")]
+pub struct ParseError {
+    /// Physical line and column of the offending token (continuation lines keep their own
+    /// line numbers).
+    pub pos: SrcPos,
+    pub kind: ParseErrorKind,
+}
+
+/// The motion word of a block, as named in messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    G00,
+    G01,
+    G02,
+    G03,
+    G062,
+    G065,
+}
+
+impl fmt::Display for Motion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Motion::G00 => "G00",
+            Motion::G01 => "G01",
+            Motion::G02 => "G02",
+            Motion::G03 => "G03",
+            Motion::G062 => "G06.2",
+            Motion::G065 => "G06.5",
+        })
+    }
+}
+
+/// The kind of line a word was found on, for [`ParseErrorKind::WordNotAllowed`] and
+/// [`ParseErrorKind::MissingWord`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Context {
+    /// A `G00` / `G01` / `G02` / `G03` line, or a line continuing that modal motion.
+    Move(Motion),
+    /// A line with `G04`.
+    Dwell,
+    /// A line with `G43` / `G43.4`.
+    LengthComp,
+    /// A control-point line of a `G06.2` / `G06.5` block (including the opening line).
+    ControlPoint(Motion),
+    /// A line with no motion at all (only `N`, `F`, `G90`, `G21`, `M02`/`M30`).
+    NoMotion,
+}
+
+impl fmt::Display for Context {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Context::Move(m) => write!(f, "a {m} line"),
+            Context::ControlPoint(m) => write!(f, "a {m} control-point line"),
+            Context::NoMotion => f.write_str("a line without motion"),
+            Context::Dwell => f.write_str("a G04 (dwell) line"),
+            Context::LengthComp => f.write_str("a G43/G43.4 (tool length) line"),
+        }
+    }
+}
+
+/// Which rule was broken, with the offending values.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum ParseErrorKind {
+    // ---- reading the source -------------------------------------------------------------
+    #[error("byte 0x{byte:02x} is not UTF-8: save the program as UTF-8 (or ASCII)")]
+    NotUtf8 { byte: u8 },
+    #[error("the line is longer than {max} bytes: no NC line is, so this is not an NC program")]
+    LineTooLong { max: usize },
+    #[error("the program could not be read on from here: {kind}")]
+    Unreadable { kind: std::io::ErrorKind },
+
+    // ---- lexical rules -----------------------------------------------------------------
+    #[error("unexpected character {ch:?}: expected a word (a letter and a number), a comment, or `\\` at the end of the line")]
+    UnexpectedChar { ch: char },
+    #[error("word letter {letter} is not followed by a number (like {letter}1.5, {letter}-2 or {letter}.5)")]
+    MissingNumber { letter: char },
+    #[error("the number after {letter} ({len} characters) is too large for a finite value")]
+    NumberOutOfRange { letter: char, len: usize },
+    #[error("{letter}{value:e} is outside the range dnurbs accepts for {letter}: at most {max:e} in magnitude (README, NC language)")]
+    OutsideDomain { letter: char, value: f64, max: f64 },
+    #[error("comment `(` is not closed: a comment must end with `)` on the same line")]
+    UnterminatedComment,
+    #[error("`\\` continues a line only as its last character (spaces may follow, nothing else)")]
+    MisplacedBackslash,
+    #[error("`\\` continues the line but the file ends here")]
+    ContinuationAtEof,
+    #[error("`%` (tape marker) must stand alone on its line")]
+    MisplacedTapeMark,
+    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P R S T U V W X Y Z")]
+    UnsupportedWord { letter: char, value: f64 },
+
+    // ---- line structure ----------------------------------------------------------------
+    #[error("sequence number N{value} must be an integer from 0 to {}", u32::MAX)]
+    BadSequenceNumber { value: f64 },
+    #[error("sequence number N{value} must be the first word of its line")]
+    MisplacedSequenceNumber { value: f64 },
+    #[error(
+        "word {letter} appears twice on one line (first at {first}): each word may appear once"
+    )]
+    RepeatedWord { letter: char, first: SrcPos },
+    #[error("{} and {} on one line: they belong to the same modal group", Code(*.letter, *.first), Code(*.letter, *.second))]
+    ConflictingCodes {
+        letter: char,
+        first: f64,
+        second: f64,
+    },
+    #[error("unsupported G-code {}: dnurbs accepts {G_LIST}", Code('G', *.code))]
+    UnsupportedGCode { code: f64 },
+    #[error("unsupported M-code {}: dnurbs accepts {M_LIST}", Code('M', *.code))]
+    UnsupportedMCode { code: f64 },
+    #[error("cutter radius compensation {} is not supported: post the tool-centre path (compensation in the computer) with G40", Code('G', *.code))]
+    CutterCompensation { code: f64 },
+    #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]
+    CannedCycle { code: f64 },
+    #[error("program number O{value} must stand alone on its line (after an optional N)")]
+    MisplacedProgramNumber { value: f64 },
+    #[error("word {letter} after the program end at {end}: only blank lines, comments and `%` may follow M02/M30")]
+    AfterProgramEnd { letter: char, end: SrcPos },
+    #[error("word {letter} is not allowed on {context}")]
+    WordNotAllowed { letter: char, context: Context },
+    #[error("{context} needs the word {letter}")]
+    MissingWord { letter: char, context: Context },
+
+    // ---- modal state -------------------------------------------------------------------
+    #[error("feed F{value} must be from {MIN_FEED_MM_MIN} to 1000000 mm/min")]
+    BadFeed { value: f64 },
+    #[error(
+        "{motion} needs a feed but none is in effect: program F<mm/min> on this or an earlier line"
+    )]
+    NoFeed { motion: Motion },
+    #[error(
+        "word {letter} moves the machine but no motion mode is in effect: start with G00 or G01"
+    )]
+    NoMotionMode { letter: char },
+    #[error("the first move defines the start pose and must give X, Y and Z ({axis} is missing), unless the machine file has a [reference] position to start from")]
+    MissingStartAxis { axis: char },
+    #[error("{motion} block before the start pose: the program must first move with a G00/G01 giving X, Y and Z")]
+    NurbsBeforeStart { motion: Motion },
+
+    #[error("{letter}{value} must be a whole number from 0 to 99999")]
+    BadNumber { letter: char, value: f64 },
+    #[error("spindle speed S{value} must be from 0 to 1000000 rpm")]
+    BadSpeed { value: f64 },
+    #[error(
+        "spindle speed S{value} is above the spindle's maximum of {max} rpm ([spindle] max_rpm)"
+    )]
+    SpeedAboveMax { value: f64, max: f64 },
+    #[error("G04 needs the dwell time: P<seconds> or X<seconds>")]
+    DwellWithoutTime,
+    #[error("dwell of {value} s must be from 0 to {MAX_DWELL_S} s (P and X are seconds here; a post that writes P in milliseconds must be set to seconds)")]
+    BadDwell { value: f64 },
+    #[error(
+        "G93 (inverse-time feed) needs F on every {motion} line: F is 1/minutes for that move"
+    )]
+    InverseTimeWithoutFeed { motion: Motion },
+    #[error("{motion} in G91 (incremental) mode: a NURBS block takes absolute coordinates, program G90 first")]
+    NurbsIncremental { motion: Motion },
+    #[error("work offset {} is not defined: define it under [work_offsets] in the machine file or in an --offsets file", Code('G', *.code))]
+    UnknownWorkOffset { code: f64 },
+    #[error("{} needs the machine's reference position: define [reference] in the machine file", Code('G', *.code))]
+    NoReference { code: f64 },
+    #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]
+    MachineMoveRotated { code: f64, axis: char },
+    #[error("{} needs G00 or G01 in effect (it is a straight move in machine coordinates)", Code('G', *.code))]
+    MachineMoveNotLinear { code: f64 },
+    #[error("tool {tool} is not in the tool table: give --tools FILE (LinuxCNC tool.tbl) with a line T{tool} ... Z<length>")]
+    UnknownTool { tool: u32 },
+    #[error("the tool length changes ({from} -> {to} mm) on a {motion} block: change it on a G00/G01 (posts write G43 Z.. H..)")]
+    LengthChangeOnCurve { motion: Motion, from: f64, to: f64 },
+    #[error("the tool length changes with the tool axis given as angles other than 0: program the change on a line with X Y Z")]
+    LengthChangeTilted,
+
+    // ---- arcs --------------------------------------------------------------------------
+    #[error("{motion} needs its centre: {} offsets, or R", .plane.offset_letters())]
+    ArcWithoutCentre { motion: Motion, plane: Plane },
+    #[error("{motion} with both R and the centre offset {letter}: give one of them")]
+    ArcCentreAndRadius { motion: Motion, letter: char },
+    #[error("centre offset {letter} is not in the {} plane: its offsets are {}", .plane.name(), .plane.offset_letters())]
+    ArcOffsetOutOfPlane { letter: char, plane: Plane },
+    #[error("the arc's radius is {start} mm at its start and {end} mm at its end: they differ by more than {ARC_RADIUS_TOL_MM} mm (check the end point and the centre)")]
+    ArcRadiusMismatch { start: f64, end: f64 },
+    #[error("arc radius R{value} is less than half the distance to the end point ({half} mm): no arc fits")]
+    ArcRadiusTooSmall { value: f64, half: f64 },
+    #[error("an arc given by R cannot end where it starts: program a full circle with its centre offsets")]
+    ArcFullCircleRadius,
+    #[error("arc radius {radius} mm is below {MIN_ARC_RADIUS_MM} mm")]
+    ArcTooSmall { radius: f64 },
+    #[error("a helix rising {rise} mm over {sweep_deg:.3} deg needs {pieces} pieces to stay within {HELIX_TOL_MM} mm of the true helix, more than one block holds: program it as several arcs")]
+    HelixTooSteep {
+        rise: f64,
+        sweep_deg: f64,
+        pieces: f64,
+    },
+
+    // ---- tool orientation on G00/G01 ---------------------------------------------------
+    #[error("angle {angle} and vector word {vector} on one line: give the orientation either as angles or as I J K")]
+    MixedOrientation { angle: char, vector: char },
+    #[error("tool vector word {given} without {missing}: I, J and K must be given together")]
+    IncompleteVector { given: char, missing: char },
+    #[error("tool vector I{} J{} K{} has (near) zero length: its length must exceed {MIN_VECTOR_LENGTH:e}", .ijk[0], .ijk[1], .ijk[2])]
+    ZeroVector { ijk: [f64; 3] },
+    #[error("rotary axis {letter} in a program that uses {first} (first at {first_pos}): a program drives either A C or B C")]
+    MixedRotaryAxes {
+        letter: char,
+        first: char,
+        first_pos: SrcPos,
+    },
+    #[error("only one rotary angle ({given}) after an I J K orientation: give both angles, the other one cannot be inherited from a vector")]
+    PartialAngles { given: char },
+
+    // ---- NURBS blocks ------------------------------------------------------------------
+    #[error("G06.5 needs P<degree> (1 to 5)")]
+    MissingDegree,
+    #[error("{motion} P{value}: {}", if *.motion == Motion::G062 { "the rank (degree + 1) must be an integer from 2 to 6" } else { "the degree must be an integer from 1 to 5" })]
+    BadDegree { motion: Motion, value: f64 },
+    #[error("weight R{value} must be from {MIN_WEIGHT:e} to 1e6")]
+    BadWeight { value: f64 },
+    #[error("too few control points ({count}): a degree-{} block needs at least {min} (degree + 1)", .min - 1)]
+    TooFewControlPoints { count: usize, min: usize },
+    #[error("control point {} exceeds the capacity of a block: at most MAX_BLOCK_CTRL = {} control points", MAX_BLOCK_CTRL + 1, MAX_BLOCK_CTRL)]
+    TooManyControlPoints,
+    #[error(
+        "block opened at {opened} has {have} knots, needs {need} (control points + degree + 1)"
+    )]
+    IncompleteKnots {
+        opened: SrcPos,
+        have: usize,
+        need: usize,
+    },
+    #[error("knot K{value} is one too many: the block opened at {opened} needs {need} knots (control points + degree + 1)")]
+    TooManyKnots {
+        value: f64,
+        opened: SrcPos,
+        need: usize,
+    },
+    #[error(
+        "knot K{value} is smaller than the previous knot {prev}: knots must be non-decreasing"
+    )]
+    DecreasingKnot { value: f64, prev: f64 },
+    #[error("knot K{value} breaks the clamped start: the first {count} knots (degree + 1) must all equal {expected}")]
+    UnclampedStart {
+        value: f64,
+        expected: f64,
+        count: usize,
+    },
+    #[error("knot K{value} breaks the clamped end: the last {count} knots (degree + 1) must all equal {expected}")]
+    UnclampedEnd {
+        value: f64,
+        expected: f64,
+        count: usize,
+    },
+    #[error("knot K{last} equals the first knot {first}: the knot range must not be empty")]
+    EmptyKnotRange { first: f64, last: f64 },
+    #[error("first control point {} is not the current position {}: they must agree within {START_TOLERANCE_MM} mm per axis", Pt(.ctrl), Pt(.current))]
+    StartMismatch { ctrl: [f64; 3], current: [f64; 3] },
+    #[error("orientation point U V W {} is {dist} mm from cutter point X Y Z {}: they must be at least {MIN_TOOL_OFFSET_MM} mm apart", Pt(.uvw), Pt(.xyz))]
+    ToolPointTooClose {
+        xyz: [f64; 3],
+        uvw: [f64; 3],
+        dist: f64,
+    },
+}
+
+/// A G or M code as usually written: `G01`, `G06.5`, `M30`.
+struct Code(char, f64);
+
+impl fmt::Display for Code {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let pad = if (0.0..10.0).contains(&self.1) {
+            "0"
+        } else {
+            ""
+        };
+        write!(f, "{}{pad}{}", self.0, self.1)
+    }
+}
+
+/// A point as `(x, y, z)`.
+struct Pt<'a>(&'a [f64; 3]);
+
+impl fmt::Display for Pt<'_> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let [x, y, z] = self.0;
+        write!(f, "({x}, {y}, {z})")
+    }
+}
+
+impl ParseErrorKind {
+    /// This rule broken at `pos`.
+    pub(super) fn at(self, pos: SrcPos) -> ParseError {
+        ParseError { pos, kind: self }
+    }
+}

@@ -1,0 +1,166 @@
+//! The NC-program parser: source text -> [`Program`], or the first [`ParseError`].
+//!
+//! # The language
+//!
+//! A small, strict G-code dialect: the paper's `G06.5` double-NURBS block (Wang et al. 2007,
+//! docs/paper.md), Fanuc's 3-axis `G06.2` NURBS block and 5-axis `G00`/`G01`. Whatever is
+//! not listed here is an error, never silently ignored.
+//!
+//! ```text
+//! program   = { line } ;
+//! line      = [ "N" uint ] { word } [ "\" newline line ]      (a "\" continues the line)
+//!           | "%"                                             (tape marker, alone on its line)
+//! word      = letter number ;                  letters: A B C F G I J K M N P R U V W X Y Z
+//! number    = [ "+" | "-" ] ( digits [ "." [ digits ] ] | "." digits ) ;   no exponent
+//! comment   = "(" ... ")" on one line  |  ";" ... end of line
+//! ```
+//!
+//! Letters are case-insensitive, spaces between words optional (`G01X1Y2`). Per line:
+//!
+//! - `N` only as the first word; `G90` and `G21` (the defaults, the only modes supported) on
+//!   any line; `M02` / `M30` end the program, after which only blank, comment and `%` lines may
+//!   follow (without them the program ends at the end of the file). One code per modal group
+//!   and one word per letter on a line. A line of only `N`, `F`, `G90`, `G21` or `G00`/`G01`
+//!   sets modes and moves nothing.
+//! - `F` sets the modal feed (mm/min, > 0). Every `G01` move (the start pose too) and every
+//!   NURBS block needs one in effect; `G00` does not.
+//! - `G00` / `G01` are modal: a line of coordinates alone continues the last of them. Missing
+//!   `X Y Z` keep their values. Orientation is `I J K` (a tool vector, all three, normalised;
+//!   so `K` on a `G01` line is the vector's third component, never a knot) or machine angles
+//!   `A C` (`B C` on a B/C machine; a program uses A or B, not both). Missing orientation keeps
+//!   the previous one, a missing angle the previous angle. A single angle after a programmed
+//!   `I J K` is an error (the other angle cannot be inherited from a vector); before any
+//!   orientation was programmed, the implicit vertical tool counts as `A0 C0`.
+//! - **Start pose**: the first move must be a `G00`/`G01` that gives all of `X Y Z` (and an
+//!   orientation, else the tool is vertical, `I0 J0 K1`). The interpolator starts there.
+//! - `G06.5 P<degree>` (P required) and `G06.2 [P<rank>]` (Fanuc: rank = degree + 1, default
+//!   4) open a NURBS block; that line carries the first control point and may carry `F`. Each
+//!   control-point line has `X Y Z` (`G06.5`: also `U V W`, the orientation curve's control
+//!   point; no modal values inside a block), its knot `K` and optionally the weight `R`
+//!   (default 1). Then lines of `K` words only bring the last degree + 1 knots; the block ends
+//!   when it has control points + degree + 1 knots. While knots are missing, a line counts as
+//!   a control-point line if it has no G/M code and has a word only control points have (`K`,
+//!   `R`, and for `G06.5` `U V W`); any other line cuts the block short (an error).
+//! - A block's first control point must be the current position (within 1 um per axis). After
+//!   the block the current position is its last control point and, for `G06.5`, the
+//!   orientation is the vector from the last `X Y Z` to the last `U V W`. A NURBS mode is not
+//!   modal: later coordinate lines continue the last `G00`/`G01`.
+//!
+//! The rules a NURBS block must satisfy (degree 1 to 5, at least degree + 1 and at most
+//! [`MAX_CTRL`](nc_geom::program::MAX_CTRL) control points, finite, non-decreasing, clamped knots
+//! with a non-empty range, positive weights, `U V W` at least 1 um from `X Y Z`) are each a
+//! [`ParseErrorKind`] variant.
+//!
+//! Positions: a block's `pos` is its G word, or the first word of a modal-continuation line;
+//! `ctrl_pos[i]` is the first word of control point `i` (the first of `X Y Z U V W R K` on its
+//! line, so on the opening line it is not the G word). An error at the end of the file points
+//! just past the last character.
+//!
+//! # Design
+//!
+//! Three stages, each in its own file, each checking the rules it can see:
+//!
+//! - `lexer`: characters -> logical lines of words. Handles comments, `%`, continuation
+//!   lines (every word keeps its physical line and column) and number syntax.
+//! - `line`: one logical line -> its `N`, G and M codes decoded by modal group and the other
+//!   words indexed by letter. Rules without state: unknown words, unsupported codes, repeats.
+//! - `parser` (with `nurbs` for an open block): the modal state machine. It resolves every
+//!   modal value, so each [`Block`](nc_geom::program::Block) of the result is complete.
+//!
+//! Errors are reported at the first rule broken, at the offending token; parsing stops there
+//! (an NC program is only run when it is entirely valid). The parser never panics: no indexing
+//! that can fail, checked conversions, and every number is proved finite by the lexer. A
+//! property test feeds it arbitrary text and mutations of the paper's example.
+
+mod arc;
+pub(crate) mod codes;
+mod error;
+mod lexer;
+pub use lexer::continues;
+mod line;
+mod modal;
+mod moves;
+mod nurbs;
+mod parser;
+mod source;
+mod stream;
+#[cfg(test)]
+mod tests;
+
+pub use arc::{arc, ArcNet, Centre, ARC_RADIUS_TOL_MM, HELIX_TOL_MM};
+pub use codes::Plane;
+pub use error::{Context, Motion, ParseError, ParseErrorKind};
+pub use lexer::word_limit;
+pub use modal::{Setup, MAX_DWELL_S, MAX_ERRORS, MM_PER_INCH};
+pub use parser::{MIN_FEED_MM_MIN, MIN_WEIGHT};
+pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
+pub use stream::{Entries, Entry};
+
+use nc_geom::program::Program;
+
+/// Every error of a program, in source order: at most [`MAX_ERRORS`], and `more` when the
+/// parse stopped there.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParseErrors {
+    pub errors: Vec<ParseError>,
+    pub more: bool,
+}
+
+impl ParseErrors {
+    /// The first error (there is always one).
+    pub fn first(&self) -> Option<&ParseError> {
+        self.errors.first()
+    }
+}
+
+/// Parses a whole NC program with no shop setup (no work offsets, reference position or
+/// tools); the first error only.
+///
+/// ```
+/// let program = nc_lang::parse("G00 X0 Y0 Z10\nG01 Z0 F500\nM30\n").unwrap();
+/// assert_eq!(program.blocks.len(), 2);
+/// ```
+pub fn parse(src: &str) -> Result<Program, ParseError> {
+    parse_with(src, &Setup::default()).map_err(|e| {
+        e.errors.first().copied().unwrap_or(ParseError {
+            pos: nc_geom::program::SrcPos::default(),
+            kind: ParseErrorKind::MisplacedTapeMark,
+        })
+    })
+}
+
+/// Parses a whole NC program against the shop's [`Setup`], reporting every error (up to
+/// [`MAX_ERRORS`]). After an error the line is skipped (a NURBS block with it), so later
+/// errors may follow from the first one.
+pub fn parse_with(src: &str, setup: &Setup) -> Result<Program, ParseErrors> {
+    parse_lines(StrLines::new(src), setup)
+}
+
+/// [`parse_with`] from any source of lines ([`ReadLines`] reads a file as it goes).
+pub fn parse_lines<S: LineSource>(lines: S, setup: &Setup) -> Result<Program, ParseErrors> {
+    let mut entries = Entries::new(lines, setup);
+    let mut program = Program::default();
+    let mut errors = Vec::new();
+    while let Some(entry) = entries.next() {
+        match entry {
+            Ok(Entry::Block(_, block)) => program.blocks.push(block),
+            Ok(Entry::Action(action)) => program.actions.push(action),
+            Err(e) => {
+                errors.push(e);
+                if errors.len() >= MAX_ERRORS {
+                    let more = !entries.is_finished();
+                    return Err(ParseErrors { errors, more });
+                }
+            }
+        }
+    }
+    if !errors.is_empty() {
+        return Err(ParseErrors {
+            errors,
+            more: false,
+        });
+    }
+    program.end = entries.end();
+    program.tilt_word = entries.tilt_word();
+    Ok(program)
+}

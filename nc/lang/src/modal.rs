@@ -1,0 +1,92 @@
+//! What the program does not say: the machine's work offsets, reference position and tool
+//! table ([`Setup`]), and the modal state the parser keeps between lines ([`Modal`]).
+
+use super::codes::{LengthComp, Plane};
+use std::collections::BTreeMap;
+
+/// Longest dwell (`G04`), seconds. `P` and `X` are seconds (LinuxCNC's reading); Fanuc
+/// posts that write `P` in milliseconds would ask for 1000 times the dwell, and most such
+/// values land above this bound and are refused.
+pub const MAX_DWELL_S: f64 = 100.0;
+/// Most errors one parse reports.
+pub const MAX_ERRORS: usize = 50;
+/// Millimetres per inch (`G20`).
+pub const MM_PER_INCH: f64 = 25.4;
+
+/// The shop's side of a program: offsets, reference position, tools and switches. The
+/// default has none of them (G54 is then the machine zero; `G28`, `G55`..`G59`, `G43 H` are
+/// errors naming what is missing).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Setup {
+    /// `G54`..`G59`: where the program's zero is, in machine coordinates (mm). `None`: not
+    /// defined (an undefined `G54` is the machine zero; the others are errors).
+    pub work_offsets: [Option<[f64; 3]>; 6],
+    /// The `G28` reference position in machine coordinates (mm). A program whose first move
+    /// does not give all of X Y Z starts here.
+    pub reference: Option<[f64; 3]>,
+    /// Tool number -> length (mm, along the spindle).
+    pub tools: BTreeMap<u32, f64>,
+    /// Skip lines that start with `/` (block delete). Off: the `/` is ignored.
+    pub block_delete: bool,
+    /// `M01` stops (optional stop on). Off: `M01` is reported and passed.
+    pub optional_stop: bool,
+    /// The machine's kinematics, for `G28`/`G53` and tool-length changes with the rotary
+    /// axes away from 0 (the tool tip's workpiece coordinates then follow from the machine
+    /// coordinates only through it). Without it those are refused.
+    pub kinematics: Option<nc_geom::kinematics::MachineKinematics>,
+    /// The spindle's highest speed (rpm), where the machine has a spindle drive: an `S`
+    /// above it is an error. `None`: any speed up to the language's range is reported only.
+    pub max_rpm: Option<f64>,
+}
+
+/// The modal state of the language besides motion and feed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Modal {
+    pub plane: Plane,
+    pub inch: bool,
+    pub incremental: bool,
+    pub inverse_time: bool,
+    /// Active work offset (0 = G54) and its value.
+    pub work: u8,
+    pub offset: [f64; 3],
+    pub comp: LengthComp,
+    /// Tool length in effect (mm).
+    pub tool_length: f64,
+    /// `G64` (true) or `G61`; dnurbs follows the programmed path exactly in both.
+    pub blend: bool,
+    /// Selected tool (`T`) and loaded tool (after `M06`).
+    pub selected: Option<u32>,
+    pub loaded: Option<u32>,
+    /// Spindle speed in effect, rpm.
+    pub rpm: f64,
+}
+
+impl Default for Modal {
+    fn default() -> Self {
+        Modal {
+            plane: Plane::Xy,
+            inch: false,
+            incremental: false,
+            inverse_time: false,
+            work: 0,
+            offset: [0.0; 3],
+            comp: LengthComp::Off,
+            tool_length: 0.0,
+            blend: true,
+            selected: None,
+            loaded: None,
+            rpm: 0.0,
+        }
+    }
+}
+
+impl Modal {
+    /// Millimetres per program unit of length.
+    pub fn scale(&self) -> f64 {
+        if self.inch {
+            MM_PER_INCH
+        } else {
+            1.0
+        }
+    }
+}

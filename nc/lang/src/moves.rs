@@ -1,0 +1,507 @@
+//! The moves of a line: `G00`/`G01` (and their modal continuation), `G02`/`G03` arcs,
+//! `G28`/`G53` moves through machine coordinates, and the opening of a NURBS block.
+//!
+//! Coordinates are resolved here: program units to mm (`G20`), incremental to absolute
+//! (`G91`), program zero to the workpiece frame (the work offset). The workpiece frame is the
+//! machine frame with the rotary axes at 0; positions are the tool tip (the tool length lives
+//! in [`MoveTooling`](nc_geom::program::MoveTooling) and is added by the machine's Z axis).
+
+use super::arc::{self, Centre};
+use super::codes::{Code, Plane};
+use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::lexer::word_limit;
+use super::line::{Line, MOVE_WORDS};
+use super::nurbs::distance;
+use super::parser::{normalise, Parser};
+use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, SrcPos};
+
+const AXES: [char; 3] = ['X', 'Y', 'Z'];
+
+impl Parser<'_> {
+    /// The motion of a line that is not a dwell.
+    pub(super) fn motion(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if let Some((code @ (Code::Home | Code::MachineCoords), pos)) = line.code_of_group(1) {
+            if let Some((m, _)) = line.motion {
+                self.mode = Some(m);
+            }
+            return self.machine_move(line, code, pos);
+        }
+        match line.motion {
+            Some((motion @ (Motion::G062 | Motion::G065), pos)) => {
+                self.open_nurbs(line, motion, pos)
+            }
+            Some((motion, pos)) => {
+                self.mode = Some(motion);
+                self.modal_move(line, motion, pos)
+            }
+            None => match line.first_of(MOVE_WORDS) {
+                Some(w) => {
+                    let Some(motion) = self.mode else {
+                        return Err(ParseErrorKind::NoMotionMode { letter: w.letter }.at(w.pos));
+                    };
+                    self.modal_move(line, motion, line.first)
+                }
+                None => line.only(&self.extra_letters(line, "GMFST"), Context::NoMotion),
+            },
+        }
+    }
+
+    fn modal_move(
+        &mut self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+    ) -> Result<(), ParseError> {
+        match motion {
+            Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
+            _ => self.linear(line, motion, pos),
+        }
+    }
+
+    /// `base` plus `H` on a tool-length line and `P` on a `G64` line.
+    fn extra_letters(&self, line: &Line<'_>, base: &str) -> String {
+        let mut s = base.to_owned();
+        if line.code_of_group(7).is_some() {
+            s.push('H');
+        }
+        if matches!(line.code_of_group(10), Some((Code::Blend(true), _))) {
+            s.push('P');
+        }
+        s
+    }
+
+    /// The feed of a feed move (mm/min): the modal feed, or under `G93` the line's `F` (1/min)
+    /// times the move's length (mm, or degrees for a move that only turns the tool).
+    fn move_feed(
+        &self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+        length: f64,
+    ) -> Result<f64, ParseError> {
+        if self.modal.inverse_time {
+            let f = line
+                .get('F')
+                .ok_or(ParseErrorKind::InverseTimeWithoutFeed { motion }.at(pos))?;
+            return Ok(f.value * length);
+        }
+        self.feed.ok_or(ParseErrorKind::NoFeed { motion }.at(pos))
+    }
+
+    /// The current position, starting at the reference position if the program has none
+    /// yet (`missing` names the axis the line left out, for the error without one).
+    fn here_or_reference(
+        &mut self,
+        line: &Line<'_>,
+        pos: SrcPos,
+        missing: char,
+    ) -> Result<[f64; 3], ParseError> {
+        if let Some(here) = self.here {
+            return Ok(here);
+        }
+        let Some(r) = self.setup.reference else {
+            return Err(ParseErrorKind::MissingStartAxis { axis: missing }.at(pos));
+        };
+        let end = [r[0], r[1], r[2] - self.modal.tool_length];
+        let tooling = self.tooling();
+        self.blocks.push(Block::Linear(LinearMove {
+            pos,
+            n: line.n,
+            rapid: true,
+            end,
+            orientation: self.orientation,
+            feed_mm_min: 0.0,
+            inverse_time: false,
+            tooling,
+        }));
+        self.here = Some(end);
+        Ok(end)
+    }
+
+    /// The end point of a move: each given axis resolved (units, G91, work offset), the
+    /// others kept.
+    fn end_point(&mut self, line: &Line<'_>, pos: SrcPos) -> Result<[f64; 3], ParseError> {
+        let missing = AXES.into_iter().find(|a| line.get(*a).is_none());
+        let here = match (self.here, missing, self.modal.incremental) {
+            (Some(h), _, _) => Some(h),
+            (None, None, false) => None,
+            (None, m, _) => Some(self.here_or_reference(line, pos, m.unwrap_or('X'))?),
+        };
+        let mut end = [0.0; 3];
+        for (i, axis) in AXES.into_iter().enumerate() {
+            let prev = here.map(|h| h[i]).unwrap_or(0.0);
+            end[i] = match line.get(axis) {
+                None => prev,
+                Some(w) => {
+                    let v = w.value * self.modal.scale();
+                    let v = if self.modal.incremental {
+                        prev + v
+                    } else {
+                        v + self.modal.offset[i]
+                    };
+                    check_domain(axis, v, w.pos)?
+                }
+            };
+        }
+        Ok(end)
+    }
+
+    /// A G00/G01 line, or a line continuing that modal motion; `pos` is the block's position.
+    fn linear(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZABCIJK"),
+            Context::Move(motion),
+        )?;
+        if line.first_of("XYZABCIJK").is_none() {
+            return Ok(()); // `G01 F500`: sets the mode, moves nothing
+        }
+        let rapid = motion == Motion::G00;
+        if !rapid && !self.modal.inverse_time && self.feed.is_none() {
+            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+        }
+        let start = self.here;
+        let end = self.end_point(line, pos)?;
+        let orientation = self.orientation(line)?;
+        let from = self.here.or(start).unwrap_or(end);
+        let feed_mm_min = if rapid {
+            self.feed.unwrap_or(0.0)
+        } else {
+            let mm = distance(from, end);
+            let length = if mm > 1e-9 {
+                mm
+            } else {
+                turn_deg(self.orientation, orientation)
+            };
+            self.move_feed(line, motion, pos, length)?
+        };
+        self.orientation_given |= line.first_of("ABCIJK").is_some();
+        self.push_linear(line, pos, rapid, end, orientation, feed_mm_min);
+        Ok(())
+    }
+
+    fn push_linear(
+        &mut self,
+        line: &Line<'_>,
+        pos: SrcPos,
+        rapid: bool,
+        end: [f64; 3],
+        orientation: Orientation,
+        feed_mm_min: f64,
+    ) {
+        let tooling = self.tooling();
+        self.here = Some(end);
+        self.orientation = orientation;
+        self.blocks.push(Block::Linear(LinearMove {
+            pos,
+            n: line.n,
+            rapid,
+            end,
+            orientation,
+            feed_mm_min,
+            inverse_time: !rapid && self.modal.inverse_time,
+            tooling,
+        }));
+    }
+
+    /// A `G02`/`G03` line (or its modal continuation): a rational quadratic NURBS block.
+    fn arc(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZIJKRABC"),
+            Context::Move(motion),
+        )?;
+        if line.first_of("XYZIJKRABC").is_none() {
+            return Ok(());
+        }
+        if !self.modal.inverse_time && self.feed.is_none() {
+            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+        }
+        let plane = self.modal.plane;
+        let (a, b, _) = plane.axes();
+        let centre = match line.get('R') {
+            Some(r) => {
+                if let Some(w) = line.first_of("IJK") {
+                    let kind = ParseErrorKind::ArcCentreAndRadius {
+                        motion,
+                        letter: w.letter,
+                    };
+                    return Err(kind.at(w.pos));
+                }
+                Centre::Radius(r.value * self.modal.scale())
+            }
+            None => {
+                if let Some(w) = line.first_of("IJK").filter(|w| {
+                    w.letter != Plane::offset_letter(a) && w.letter != Plane::offset_letter(b)
+                }) {
+                    let kind = ParseErrorKind::ArcOffsetOutOfPlane {
+                        letter: w.letter,
+                        plane,
+                    };
+                    return Err(kind.at(w.pos));
+                }
+                let off = |i| {
+                    line.value(Plane::offset_letter(i))
+                        .map(|v| v * self.modal.scale())
+                };
+                match (off(a), off(b)) {
+                    (None, None) => {
+                        return Err(ParseErrorKind::ArcWithoutCentre { motion, plane }.at(pos));
+                    }
+                    (i, j) => Centre::Offsets(i.unwrap_or(0.0), j.unwrap_or(0.0)),
+                }
+            }
+        };
+        let end = self.end_point(line, pos)?;
+        // Angle words turn the tool along the arc (I J K are the centre here, never a
+        // tool axis).
+        let turn_to = match line.first_of("ABC") {
+            Some(_) => Some(self.angles(line)?),
+            None => None,
+        };
+        let start = self.here.unwrap_or(end);
+        let net = arc::arc(start, end, plane, motion == Motion::G02, centre)
+            .map_err(|kind| kind.at(pos))?;
+        let length = (net.radius * net.sweep.abs()).hypot(rise(start, end, plane));
+        let feed_mm_min = self.move_feed(line, motion, pos, length)?;
+        let tooling = self.tooling();
+        let count = net.ctrl.len();
+        self.here = Some(end);
+        if let Some((r1_deg, r2_deg)) = turn_to {
+            self.orientation = Orientation::Angles { r1_deg, r2_deg };
+            self.orientation_given = true;
+        }
+        self.blocks.push(Block::Nurbs(NurbsBlock {
+            pos,
+            n: line.n,
+            kind: NurbsKind::G062,
+            degree: net.degree,
+            ctrl: net.ctrl,
+            tool_ctrl: Vec::new(),
+            ctrl_pos: vec![pos; count],
+            weights: net.weights,
+            knots: net.knots,
+            feed_mm_min,
+            tooling,
+            turn_to,
+        }));
+        Ok(())
+    }
+
+    /// `G53` (a straight move to machine coordinates) and `G28` (a rapid move through the
+    /// line's intermediate point to the reference position). Both need the workpiece frame
+    /// to be the machine's along the axes they move: see [`Parser::machine_frame`].
+    fn machine_move(&mut self, line: &Line<'_>, code: Code, pos: SrcPos) -> Result<(), ParseError> {
+        line.only(
+            &self.extra_letters(line, "GMFSTXYZ"),
+            Context::Move(self.mode.unwrap_or(Motion::G00)),
+        )?;
+        let home = code == Code::Home;
+        let value = if home { 28.0 } else { 53.0 };
+        let rapid = match (home, self.mode) {
+            (true, _) | (false, Some(Motion::G00)) => true,
+            (false, Some(Motion::G01)) => false,
+            (false, _) => return Err(ParseErrorKind::MachineMoveNotLinear { code: value }.at(pos)),
+        };
+        let given: Vec<usize> = (0..3).filter(|&i| line.get(AXES[i]).is_some()).collect();
+        let target = if home {
+            let reference = self
+                .setup
+                .reference
+                .ok_or(ParseErrorKind::NoReference { code: value }.at(pos))?;
+            let via = self.end_point(line, pos)?;
+            if self.here.is_some_and(|h| distance(h, via) > 0.0) {
+                let o = self.orientation;
+                self.push_linear(line, pos, true, via, o, 0.0);
+            }
+            reference
+        } else {
+            let here = self.here_or_reference(line, pos, 'X')?;
+            let mut m = here;
+            for &i in &given {
+                m[i] = line.value(AXES[i]).unwrap_or(0.0) * self.modal.scale();
+            }
+            m
+        };
+        let here = self.here_or_reference(line, pos, 'X')?;
+        let axes: Vec<usize> = if home && given.is_empty() {
+            vec![0, 1, 2]
+        } else {
+            given
+        };
+        let length = self.modal.tool_length;
+        let mut end = here;
+        if let (Some(kin), Orientation::Angles { r1_deg, r2_deg }) =
+            (&self.setup.kinematics, self.orientation)
+        {
+            // Through the machine's kinematics, the table standing where the angles put it:
+            // a straight move in machine coordinates is one in the workpiece frame too.
+            use nalgebra::Vector3;
+            use nc_geom::kinematics::Kinematics;
+            let (a, c) = (r1_deg.to_radians(), r2_deg.to_radians());
+            let mut m = kin.place(&Vector3::from(here), a, c);
+            for &i in &axes {
+                m[i] = target[i] - if i == 2 { length } else { 0.0 };
+            }
+            let p = kin.unplace(&m, a, c);
+            for (i, e) in end.iter_mut().enumerate() {
+                *e = check_domain(AXES[i], p[i], pos)?;
+            }
+        } else {
+            for &i in &axes {
+                if !self.machine_frame(i) {
+                    let kind = ParseErrorKind::MachineMoveRotated {
+                        code: value,
+                        axis: AXES[i],
+                    };
+                    return Err(kind.at(pos));
+                }
+                let l = if i == 2 { length } else { 0.0 };
+                end[i] = check_domain(AXES[i], target[i] - l, pos)?;
+            }
+        }
+        let feed = if rapid {
+            0.0
+        } else {
+            self.move_feed(line, Motion::G01, pos, distance(here, end))?
+        };
+        let o = self.orientation;
+        self.push_linear(line, pos, rapid, end, o, feed);
+        Ok(())
+    }
+
+    /// Whether machine coordinate `axis` equals the workpiece's here: always before any
+    /// orientation is programmed and with both angles 0; only Z with a vertical tool (the
+    /// table may be turned about Z).
+    fn machine_frame(&self, axis: usize) -> bool {
+        if !self.orientation_given {
+            return true;
+        }
+        match self.orientation {
+            Orientation::Angles { r1_deg, r2_deg } => r1_deg == 0.0 && (r2_deg == 0.0 || axis == 2),
+            Orientation::Vector(v) => axis == 2 && v[0] == 0.0 && v[1] == 0.0,
+        }
+    }
+
+    /// The orientation at the end of a linear move (modal values resolved).
+    fn orientation(&mut self, line: &Line<'_>) -> Result<Orientation, ParseError> {
+        let angle = line.first_of("ABC");
+        let vector = line.first_of("IJK");
+        match (angle, vector) {
+            (Some(a), Some(v)) => {
+                let later = if a.pos > v.pos { a.pos } else { v.pos };
+                let kind = ParseErrorKind::MixedOrientation {
+                    angle: a.letter,
+                    vector: v.letter,
+                };
+                Err(kind.at(later))
+            }
+            (None, Some(given)) => {
+                let mut ijk = [0.0; 3];
+                for (slot, letter) in ijk.iter_mut().zip(['I', 'J', 'K']) {
+                    let missing = ParseErrorKind::IncompleteVector {
+                        given: given.letter,
+                        missing: letter,
+                    };
+                    *slot = line.value(letter).ok_or(missing.at(given.pos))?;
+                }
+                let zero = ParseErrorKind::ZeroVector { ijk }.at(given.pos);
+                Ok(Orientation::Vector(normalise(ijk).ok_or(zero)?))
+            }
+            (Some(_), None) => self
+                .angles(line)
+                .map(|(r1_deg, r2_deg)| Orientation::Angles { r1_deg, r2_deg }),
+            (None, None) => Ok(self.orientation),
+        }
+    }
+
+    /// The rotary angles of a line with angle words (`G91`: added to the previous ones).
+    fn angles(&mut self, line: &Line<'_>) -> Result<(f64, f64), ParseError> {
+        let r1 = match (line.get('A'), line.get('B')) {
+            (Some(a), Some(b)) => {
+                let kind = ParseErrorKind::MixedRotaryAxes {
+                    letter: 'B',
+                    first: 'A',
+                    first_pos: a.pos,
+                };
+                return Err(kind.at(b.pos));
+            }
+            (r1, None) | (None, r1) => r1,
+        };
+        if let Some(w) = r1 {
+            match self.rotary {
+                Some((first, first_pos)) if first != w.letter => {
+                    let kind = ParseErrorKind::MixedRotaryAxes {
+                        letter: w.letter,
+                        first,
+                        first_pos,
+                    };
+                    return Err(kind.at(w.pos));
+                }
+                Some(_) => {}
+                None => self.rotary = Some((w.letter, w.pos)),
+            }
+        }
+        let r2 = line.get('C');
+        let (prev1, prev2) = match self.orientation {
+            Orientation::Angles { r1_deg, r2_deg } => (r1_deg, r2_deg),
+            // The implicit vertical tool is A0 C0 (B0 C0) on the machines dnurbs drives.
+            Orientation::Vector(_) if !self.orientation_given => (0.0, 0.0),
+            Orientation::Vector(_) => match (r1, r2) {
+                (Some(given), None) | (None, Some(given)) => {
+                    let kind = ParseErrorKind::PartialAngles {
+                        given: given.letter,
+                    };
+                    return Err(kind.at(given.pos));
+                }
+                _ => (0.0, 0.0),
+            },
+        };
+        let inc = self.modal.incremental;
+        let resolve = |w: Option<super::lexer::Word>, prev: f64| -> Result<f64, ParseError> {
+            match w {
+                None => Ok(prev),
+                Some(w) if inc => check_domain(w.letter, prev + w.value, w.pos),
+                Some(w) => Ok(w.value),
+            }
+        };
+        Ok((resolve(r1, prev1)?, resolve(r2, prev2)?))
+    }
+}
+
+/// A resolved coordinate must stay within the word's domain (offsets and G91 can push a
+/// valid word outside it).
+fn check_domain(letter: char, value: f64, pos: SrcPos) -> Result<f64, ParseError> {
+    let max = word_limit(letter);
+    if value.abs() <= max {
+        Ok(value)
+    } else {
+        Err(ParseErrorKind::OutsideDomain { letter, value, max }.at(pos))
+    }
+}
+
+/// The change of the normal axis along an arc.
+fn rise(start: [f64; 3], end: [f64; 3], plane: Plane) -> f64 {
+    let (_, _, n) = plane.axes();
+    end.get(n).copied().unwrap_or(0.0) - start.get(n).copied().unwrap_or(0.0)
+}
+
+/// Degrees the tool turns between two orientations (for G93 on moves that only turn it):
+/// the angle between vectors, or the larger angle change.
+fn turn_deg(from: Orientation, to: Orientation) -> f64 {
+    match (from, to) {
+        (Orientation::Vector(a), Orientation::Vector(b)) => {
+            let dot = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+            dot.clamp(-1.0, 1.0).acos().to_degrees()
+        }
+        (
+            Orientation::Angles {
+                r1_deg: a1,
+                r2_deg: a2,
+            },
+            Orientation::Angles {
+                r1_deg: b1,
+                r2_deg: b2,
+            },
+        ) => (b1 - a1).abs().max((b2 - a2).abs()),
+        _ => 0.0,
+    }
+}

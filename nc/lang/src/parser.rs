@@ -1,0 +1,483 @@
+//! The modal state machine: classified lines in, resolved [`Block`]s and [`Action`]s out.
+//!
+//! Per line, in the order the words take effect (LinuxCNC's order of execution): the modes
+//! (plane, units, distance, feed mode, work offset, tool length, path control), `F`, `S`,
+//! `T`, `M06`, spindle, coolant, `G04`, the motion (`moves.rs`), then `M00`/`M01` and the
+//! program end.
+
+use super::codes::{Code, LengthComp, StopCode};
+use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::line::{Line, MOVE_WORDS};
+use super::modal::{Modal, Setup, MAX_DWELL_S};
+use super::nurbs::{Frame, OpenNurbs};
+use nc_geom::program::{
+    Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation, SrcPos,
+    Wait,
+};
+
+/// Tool-vector length below which `I J K` is rejected (it has no direction).
+pub(super) const MIN_VECTOR_LENGTH: f64 = 1e-9;
+/// Slowest programmable feed, mm/min (0.06 mm/min was measured to run a 27 mm move for
+/// hours; the planner refuses any plan over 24 h at 1 ms in any case).
+pub const MIN_FEED_MM_MIN: f64 = 0.001;
+/// Smallest NURBS weight (the largest is the `R` word's bound, 1e6).
+pub const MIN_WEIGHT: f64 = 1e-6;
+/// The tool orientation until a program gives one: vertical.
+pub(super) const VERTICAL: Orientation = Orientation::Vector([0.0, 0.0, 1.0]);
+/// Largest tool or spindle-speed word.
+const MAX_RPM: f64 = 1e6;
+
+pub(super) struct Parser<'s> {
+    pub setup: &'s Setup,
+    pub modal: Modal,
+    /// Blocks and actions not yet taken by [`super::stream::Entries`].
+    pub blocks: Vec<Block>,
+    pub actions: Vec<Action>,
+    /// Blocks taken out of `blocks` so far.
+    pub drained: usize,
+    /// Modal motion mode (G00 G01 G02 G03; NURBS modes are not modal).
+    pub mode: Option<Motion>,
+    /// Modal feed, mm/min (`G94`).
+    pub feed: Option<f64>,
+    /// End of the last move (tool tip, workpiece frame, mm); `None` until the start pose.
+    pub here: Option<[f64; 3]>,
+    pub orientation: Orientation,
+    /// `false` while `orientation` is the implicit vertical default.
+    pub orientation_given: bool,
+    /// The first `A` or `B` word of the program: the machine's first rotary axis.
+    pub rotary: Option<(char, SrcPos)>,
+    /// What the next motion block waits for.
+    pub wait: Wait,
+    open: Option<OpenNurbs>,
+    /// The NURBS block that ended on the previous line (for a helpful extra-knot error).
+    just_closed: Option<(SrcPos, usize)>,
+    /// After an error inside a NURBS block: skip its remaining control-point and knot lines.
+    skipping: bool,
+    end: Option<SrcPos>,
+}
+
+impl<'s> Parser<'s> {
+    pub fn new(setup: &'s Setup) -> Self {
+        let modal = Modal {
+            offset: setup.work_offsets[0].unwrap_or([0.0; 3]),
+            ..Modal::default()
+        };
+        Parser {
+            setup,
+            modal,
+            blocks: Vec::new(),
+            actions: Vec::new(),
+            drained: 0,
+            mode: None,
+            feed: None,
+            here: None,
+            orientation: VERTICAL,
+            orientation_given: false,
+            rotary: None,
+            wait: Wait::default(),
+            open: None,
+            just_closed: None,
+            skipping: false,
+            end: None,
+        }
+    }
+
+    /// After an error on a line: drop an open NURBS block and skip the rest of its lines.
+    pub fn recover(&mut self) {
+        if self.open.take().is_some() {
+            self.skipping = true;
+        }
+    }
+
+    /// Takes one logical line (its words from the lexer).
+    pub fn line(&mut self, words: &[super::lexer::Word]) -> Result<(), ParseError> {
+        let Some(first) = words.first() else {
+            return Ok(());
+        };
+        if let Some(end) = self.end {
+            let kind = ParseErrorKind::AfterProgramEnd {
+                letter: first.letter,
+                end,
+            };
+            return Err(kind.at(first.pos));
+        }
+        let line = Line::classify(words)?;
+        if self.skipping {
+            if line.knots_only || (!line.has_codes && line.first_of("KRUVW").is_some()) {
+                return Ok(());
+            }
+            self.skipping = false;
+        }
+        if let Some(open) = &mut self.open {
+            if open.take_line(&line)? {
+                if let Some(open) = self.open.take() {
+                    self.close(open.finish()?);
+                }
+            }
+            return Ok(());
+        }
+        if let (true, Some((opened, need)), Some(k)) =
+            (line.knots_only, self.just_closed, line.body.first())
+        {
+            let kind = ParseErrorKind::TooManyKnots {
+                value: k.value,
+                opened,
+                need,
+            };
+            return Err(kind.at(k.pos));
+        }
+        self.just_closed = None;
+        if let Some(o) = line.get('O') {
+            if line.body.len() != 1 {
+                return Err(ParseErrorKind::MisplacedProgramNumber { value: o.value }.at(o.pos));
+            }
+            return Ok(());
+        }
+        let motion = line.motion.map(|(m, _)| m).or_else(|| {
+            line.first_of(MOVE_WORDS)
+                .and_then(|_| self.mode.filter(|_| !self.is_dwell(&line)))
+        });
+        self.modes(&line, motion)?;
+        self.feed_word(&line)?;
+        self.machine_words(&line)?;
+        if self.is_dwell(&line) {
+            self.dwell(&line)?;
+        } else {
+            self.motion(&line)?;
+        }
+        if let Some((Code::Stop(stop), pos)) = line.code_of_group(11) {
+            match stop {
+                StopCode::Stop => self.stop(pos, ActionKind::Stop, true),
+                StopCode::Optional => {
+                    let taken = self.setup.optional_stop;
+                    self.stop(pos, ActionKind::OptionalStop { taken }, taken);
+                }
+                StopCode::ToolChange | StopCode::End => {}
+            }
+        }
+        self.end = line.end;
+        Ok(())
+    }
+
+    fn is_dwell(&self, line: &Line<'_>) -> bool {
+        matches!(line.code_of_group(1), Some((Code::Dwell, _)))
+    }
+
+    /// At the end of the source: fails if a NURBS block is still open at `eof`.
+    pub fn check_end(&self, eof: SrcPos) -> Result<(), ParseError> {
+        match &self.open {
+            Some(open) => Err(open.incomplete(eof)),
+            None => Ok(()),
+        }
+    }
+
+    /// Where `M02`/`M30` stood, if read.
+    pub fn end(&self) -> Option<SrcPos> {
+        self.end
+    }
+
+    /// The modal codes of a line other than motion and stops. `motion` is the line's
+    /// effective motion (its code, or the modal one when it has coordinates).
+    fn modes(&mut self, line: &Line<'_>, motion: Option<Motion>) -> Result<(), ParseError> {
+        for (code, pos) in line.codes() {
+            match code {
+                Code::Plane(p) => self.modal.plane = p,
+                Code::Inch(inch) => self.modal.inch = inch,
+                Code::Incremental(inc) => self.modal.incremental = inc,
+                Code::InverseTime(it) => self.modal.inverse_time = it,
+                Code::Blend(b) => self.modal.blend = b,
+                Code::WorkOffset(i) => {
+                    let defined = self
+                        .setup
+                        .work_offsets
+                        .get(usize::from(i))
+                        .copied()
+                        .flatten();
+                    self.modal.offset = match (defined, i) {
+                        (Some(o), _) => o,
+                        (None, 0) => [0.0; 3],
+                        (None, _) => {
+                            let code = 54.0 + f64::from(i);
+                            return Err(ParseErrorKind::UnknownWorkOffset { code }.at(pos));
+                        }
+                    };
+                    self.modal.work = i;
+                }
+                Code::LengthComp(comp) => self.length_comp(line, comp, pos, motion)?,
+                _ => {}
+            }
+        }
+        if let Some(h) = line.get('H') {
+            if !matches!(line.code_of_group(7), Some((Code::LengthComp(c), _)) if c != LengthComp::Off)
+            {
+                let kind = ParseErrorKind::WordNotAllowed {
+                    letter: 'H',
+                    context: Context::NoMotion,
+                };
+                return Err(kind.at(h.pos));
+            }
+        }
+        Ok(())
+    }
+
+    /// `G43 H` / `G43.4 H` / `G49`: the new tool length. On a line without X Y Z the tool
+    /// tip's coordinates change so that the machine stays where it is.
+    fn length_comp(
+        &mut self,
+        line: &Line<'_>,
+        comp: LengthComp,
+        pos: SrcPos,
+        motion: Option<Motion>,
+    ) -> Result<(), ParseError> {
+        let length = match comp {
+            LengthComp::Off => 0.0,
+            LengthComp::Length | LengthComp::Rtcp => {
+                let tool = match (line.get('H'), self.modal.loaded) {
+                    (Some(h), _) => tool_number(h)?,
+                    (None, Some(t)) => t,
+                    (None, None) => {
+                        let kind = ParseErrorKind::MissingWord {
+                            letter: 'H',
+                            context: Context::LengthComp,
+                        };
+                        return Err(kind.at(pos));
+                    }
+                };
+                match (tool, self.setup.tools.get(&tool)) {
+                    (0, _) => 0.0,
+                    (_, Some(l)) => *l,
+                    (_, None) => return Err(ParseErrorKind::UnknownTool { tool }.at(pos)),
+                }
+            }
+        };
+        self.modal.comp = comp;
+        let from = self.modal.tool_length;
+        if length == from {
+            return Ok(());
+        }
+        if let Some(m @ (Motion::G02 | Motion::G03 | Motion::G062 | Motion::G065)) = motion {
+            let kind = ParseErrorKind::LengthChangeOnCurve {
+                motion: m,
+                from,
+                to: length,
+            };
+            return Err(kind.at(pos));
+        }
+        if let Some(here) = &mut self.here {
+            let t = match self.orientation {
+                Orientation::Vector(v) => v,
+                Orientation::Angles { r1_deg, r2_deg } if r1_deg == 0.0 && r2_deg == 0.0 => {
+                    [0.0, 0.0, 1.0]
+                }
+                Orientation::Angles { r1_deg, r2_deg } => match &self.setup.kinematics {
+                    Some(kin) => {
+                        use nc_geom::kinematics::Kinematics;
+                        let t = kin.tool_axis(r1_deg.to_radians(), r2_deg.to_radians());
+                        [t.x, t.y, t.z]
+                    }
+                    None => return Err(ParseErrorKind::LengthChangeTilted.at(pos)),
+                },
+            };
+            for (h, t) in here.iter_mut().zip(t) {
+                *h += (from - length) * t;
+            }
+        }
+        self.modal.tool_length = length;
+        Ok(())
+    }
+
+    /// `F`: mm/min (inch/min under G20); under G93 it belongs to its line only.
+    fn feed_word(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        let Some(f) = line.get('F') else {
+            return Ok(());
+        };
+        if f.value < MIN_FEED_MM_MIN {
+            return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
+        }
+        if !self.modal.inverse_time {
+            self.feed = Some(f.value * self.modal.scale());
+        }
+        Ok(())
+    }
+
+    /// `S`, `T`, `M06`, spindle and coolant codes: recorded as actions.
+    fn machine_words(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if let Some(s) = line.get('S') {
+            if !(0.0..=MAX_RPM).contains(&s.value) {
+                return Err(ParseErrorKind::BadSpeed { value: s.value }.at(s.pos));
+            }
+            if let Some(max) = self.setup.max_rpm.filter(|&m| s.value > m) {
+                return Err(ParseErrorKind::SpeedAboveMax {
+                    value: s.value,
+                    max,
+                }
+                .at(s.pos));
+            }
+            self.modal.rpm = s.value;
+            if line.code_of_group(12).is_none() {
+                self.act(s.pos, ActionKind::Speed { rpm: s.value });
+            }
+        }
+        if let Some(t) = line.get('T') {
+            let tool = tool_number(t)?;
+            self.modal.selected = Some(tool);
+            self.act(t.pos, ActionKind::SelectTool { tool });
+        }
+        for (code, pos) in line.codes() {
+            match code {
+                Code::Stop(StopCode::ToolChange) => {
+                    let tool = self.modal.selected;
+                    self.modal.loaded = tool;
+                    self.stop(pos, ActionKind::ChangeTool { tool }, true);
+                }
+                Code::Spindle(dir) => {
+                    let rpm = self.modal.rpm;
+                    self.act(pos, ActionKind::Spindle { dir, rpm });
+                }
+                Code::Coolant(c) => self.act(pos, ActionKind::Coolant(c)),
+                _ => {}
+            }
+        }
+        Ok(())
+    }
+
+    /// `G04 P<s>` / `G04 X<s>`.
+    fn dwell(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        line.only("GMFSTPX", Context::Dwell)?;
+        if let Some((m, pos)) = line.motion {
+            let kind = ParseErrorKind::ConflictingCodes {
+                letter: 'G',
+                first: 4.0,
+                second: motion_value(m),
+            };
+            return Err(kind.at(pos));
+        }
+        let pos = line.first_of("G").map_or(line.first, |w| w.pos);
+        let t = match (line.get('P'), line.get('X')) {
+            (Some(p), Some(x)) => {
+                let kind = ParseErrorKind::RepeatedWord {
+                    letter: 'X',
+                    first: p.pos,
+                };
+                return Err(kind.at(x.pos));
+            }
+            (Some(w), None) | (None, Some(w)) => w,
+            (None, None) => return Err(ParseErrorKind::DwellWithoutTime.at(pos)),
+        };
+        if !(0.0..=MAX_DWELL_S).contains(&t.value) {
+            return Err(ParseErrorKind::BadDwell { value: t.value }.at(t.pos));
+        }
+        self.wait.dwell_s += t.value;
+        self.act(pos, ActionKind::Dwell { seconds: t.value });
+        Ok(())
+    }
+
+    /// Records an action before the next motion block.
+    pub(super) fn act(&mut self, pos: SrcPos, kind: ActionKind) {
+        self.actions.push(Action {
+            pos,
+            before_block: self.drained + self.blocks.len(),
+            kind,
+        });
+    }
+
+    /// Records a stop; `wait` makes the next motion block wait for the operator.
+    fn stop(&mut self, pos: SrcPos, kind: ActionKind, wait: bool) {
+        self.act(pos, kind);
+        if wait && self.wait.operator.is_none() {
+            self.wait.operator = Some(pos);
+        }
+    }
+
+    /// The next block's tooling: the tool length, RTCP and the pending wait (taken).
+    pub(super) fn tooling(&mut self) -> MoveTooling {
+        MoveTooling {
+            tool_length: self.modal.tool_length,
+            mode: match self.modal.comp {
+                LengthComp::Off => LengthMode::None,
+                LengthComp::Length => LengthMode::Length,
+                LengthComp::Rtcp => LengthMode::Rtcp,
+            },
+            wait: core::mem::take(&mut self.wait),
+        }
+    }
+
+    /// Opens a `G06.2` / `G06.5` block on its first line.
+    pub(super) fn open_nurbs(
+        &mut self,
+        line: &Line<'_>,
+        motion: Motion,
+        pos: SrcPos,
+    ) -> Result<(), ParseError> {
+        if self.modal.incremental {
+            return Err(ParseErrorKind::NurbsIncremental { motion }.at(pos));
+        }
+        let Some(here) = self.here else {
+            return Err(ParseErrorKind::NurbsBeforeStart { motion }.at(pos));
+        };
+        let frame = Frame {
+            scale: self.modal.scale(),
+            offset: self.modal.offset,
+        };
+        let tooling = self.tooling();
+        self.open = Some(OpenNurbs::open(
+            line,
+            (motion, pos),
+            here,
+            self.feed,
+            frame,
+            tooling,
+        )?);
+        Ok(())
+    }
+
+    fn close(&mut self, block: NurbsBlock) {
+        self.here = block.ctrl.last().copied().or(self.here);
+        if block.kind == NurbsKind::G065 {
+            if let (Some(xyz), Some(uvw)) = (block.ctrl.last(), block.tool_ctrl.last()) {
+                // Never zero: control points keep at least MIN_TOOL_OFFSET_MM from their tool point.
+                if let Some(v) = normalise([uvw[0] - xyz[0], uvw[1] - xyz[1], uvw[2] - xyz[2]]) {
+                    self.orientation = Orientation::Vector(v);
+                    self.orientation_given = true;
+                }
+            }
+        }
+        self.just_closed = Some((block.pos, block.knots.len()));
+        self.blocks.push(Block::Nurbs(block));
+    }
+}
+
+/// A `T` or `H` word as a tool number.
+fn tool_number(w: super::lexer::Word) -> Result<u32, ParseError> {
+    match w.uint {
+        Some(t) if t <= 99_999 => Ok(t),
+        _ => Err(ParseErrorKind::BadNumber {
+            letter: w.letter,
+            value: w.value,
+        }
+        .at(w.pos)),
+    }
+}
+
+fn motion_value(m: Motion) -> f64 {
+    match m {
+        Motion::G00 => 0.0,
+        Motion::G01 => 1.0,
+        Motion::G02 => 2.0,
+        Motion::G03 => 3.0,
+        Motion::G062 => 6.2,
+        Motion::G065 => 6.5,
+    }
+}
+
+/// `v / |v|`, or `None` when `|v|` is not above [`MIN_VECTOR_LENGTH`]. Scaled first so that
+/// squaring cannot overflow for any finite input.
+pub(super) fn normalise(v: [f64; 3]) -> Option<[f64; 3]> {
+    let scale = v.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    if scale == 0.0 {
+        return None;
+    }
+    let s = v.map(|c| c / scale);
+    let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+    (len * scale > MIN_VECTOR_LENGTH).then(|| s.map(|c| c / len))
+}

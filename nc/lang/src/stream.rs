@@ -1,0 +1,146 @@
+//! The program as it is read: [`Entries`] yields each motion block and action in the order
+//! they take effect, a line at a time, holding nothing of the lines behind it but the modal
+//! state. [`super::parse_with`] collects them into a [`Program`]; a streaming planner takes
+//! them one by one.
+
+use super::error::ParseError;
+use super::lexer::{Lexer, Word};
+use super::modal::Setup;
+use super::parser::Parser;
+use super::source::LineSource;
+use nc_geom::program::{Action, Block, SrcPos};
+use std::collections::VecDeque;
+
+/// One thing a program says: a motion block with its index among the program's motion
+/// blocks (from 0, as in [`nc_geom::program::Program::blocks`]), or an action. An action
+/// comes before the block its `before_block` names.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Entry {
+    Block(usize, Block),
+    Action(Action),
+}
+
+/// A program's entries, read as they are needed. After an error the parse goes on from the
+/// next line (an open NURBS block is dropped), as [`super::parse_with`] does; a caller that
+/// stops at the first error simply stops.
+pub struct Entries<'s, S> {
+    lexer: Lexer<S>,
+    parser: Parser<'s>,
+    words: Vec<Word>,
+    pending: VecDeque<Entry>,
+    finished: bool,
+}
+
+impl<'s, S: LineSource> Entries<'s, S> {
+    pub fn new(lines: S, setup: &'s Setup) -> Self {
+        Entries {
+            lexer: Lexer::new(lines, setup.block_delete),
+            parser: Parser::new(setup),
+            words: Vec::new(),
+            pending: VecDeque::new(),
+            finished: false,
+        }
+    }
+
+    /// True once the source is read to its end.
+    pub fn is_finished(&self) -> bool {
+        self.finished
+    }
+
+    /// Where `M02`/`M30` stood, once read.
+    pub fn end(&self) -> Option<SrcPos> {
+        self.parser.end()
+    }
+
+    /// The tilting-axis letter the program's angle words use and where it first stood, once
+    /// read (see [`nc_geom::program::Program::tilt_word`]).
+    pub fn tilt_word(&self) -> Option<(char, SrcPos)> {
+        self.parser.rotary
+    }
+
+    /// Just past the last character of the source, once it is read to its end.
+    pub fn eof(&self) -> SrcPos {
+        self.lexer.eof()
+    }
+
+    /// Motion blocks read so far.
+    pub fn blocks(&self) -> usize {
+        self.parser.drained
+    }
+
+    /// Moves what the parser produced into `pending`, each action before the block its
+    /// `before_block` names.
+    fn drain(&mut self) {
+        let base = self.parser.drained;
+        let parser = &mut self.parser;
+        let mut actions = parser.actions.drain(..).peekable();
+        let mut n = 0;
+        for (k, block) in parser.blocks.drain(..).enumerate() {
+            let index = base + k;
+            while let Some(a) = actions.next_if(|a| a.before_block <= index) {
+                self.pending.push_back(Entry::Action(a));
+            }
+            self.pending.push_back(Entry::Block(index, block));
+            n = k + 1;
+        }
+        self.pending.extend(actions.map(Entry::Action));
+        parser.drained = base + n;
+    }
+}
+
+impl<S: LineSource> Entries<'_, S> {
+    /// Reads one line, if the source has one now, and keeps what it produced for
+    /// [`Self::take_read`]; `None` when the source has no line yet (nothing is finished: a
+    /// source fed as it goes can be read again). The iterator reads through it; a reader
+    /// that must parse each line as soon as it is written (`dnurbs fit`'s check of its own
+    /// output) calls it directly.
+    pub fn read_line(&mut self) -> Option<Result<(), ParseError>> {
+        if self.finished {
+            return None;
+        }
+        let result = match self.lexer.next_line(&mut self.words) {
+            Ok(true) => self.parser.line(&self.words),
+            Ok(false) => return None,
+            Err(e) => Err(e),
+        };
+        self.drain();
+        if let Err(e) = result {
+            self.parser.recover();
+            return Some(Err(e));
+        }
+        Some(Ok(()))
+    }
+
+    /// What the lines read so far produced, in order.
+    pub fn take_read(&mut self) -> Option<Entry> {
+        self.pending.pop_front()
+    }
+}
+
+impl<S: LineSource> Iterator for Entries<'_, S> {
+    type Item = Result<Entry, ParseError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        loop {
+            if let Some(entry) = self.pending.pop_front() {
+                return Some(Ok(entry));
+            }
+            if self.finished {
+                return None;
+            }
+            match self.read_line() {
+                Some(Ok(())) => {}
+                Some(Err(e)) => return Some(Err(e)),
+                None => {
+                    self.finished = true;
+                    let result = self.parser.check_end(self.lexer.eof());
+                    self.drain();
+                    if let Err(e) = result {
+                        self.parser.recover();
+                        return Some(Err(e));
+                    }
+                }
+            }
+        }
+    }
+}
