@@ -5,7 +5,7 @@
 //! 1. **Raw** (`raw.rs`): serde structs that mirror the TOML exactly, one struct per table,
 //!    with `#[serde(deny_unknown_fields)]` everywhere, so a misspelt key is an error instead of
 //!    a silently used default. Syntax, unknown/missing keys and wrong value types fail here.
-//! 2. **Validated** ([`Machine`] and the types in `machine.rs`): built once from the raw
+//! 2. **Validated** ([`Machine`] and the types of the `machine` crate): built once from the raw
 //!    structs by `validate.rs`, which checks every range. The rest of the program (and all
 //!    real-time code) sees only these types, whose invariants it may rely on: every number
 //!    finite (except `±inf` travel of a continuous C table), `min < max`, rates `> 0`.
@@ -101,24 +101,22 @@
 //!
 //! Example files: `config/machines/*.toml`.
 
-pub mod bus;
 mod error;
-mod machine;
 pub mod offsets;
 mod raw;
 mod source;
-pub mod spindle;
+mod spindle_coolant;
 pub mod tools;
 mod validate;
 
 use std::path::Path;
 
 pub use error::{ConfigError, LineCol, Location};
+// The types a machine file is read into, defined below the file's parsing (crate `machine`).
 pub use machine::{
-    Axes, AxisLimits, Compress, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
-    UnknownMethod,
+    bus, Axes, AxisLimits, Compress, Coolant, Interpolation, Kinematics, Machine, Method, Realtime,
+    RotaryName, Spindle, UnknownMethod,
 };
-pub use spindle::{Coolant, Spindle};
 
 /// Reads and validates the machine configuration file at `path`.
 pub fn load(path: &Path) -> Result<Machine, ConfigError> {

@@ -4,15 +4,15 @@
 //! the unit. The first violation is returned as [`ConfigError::Invalid`] with the key path,
 //! the value as written and its line:col (looked up in [`Source`]).
 
-use crate::bus::{self, Bus, Drive};
 use crate::error::ConfigError;
-use crate::machine::{
-    Axes, AxisLimits, Compress, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
-};
 use crate::raw::{
     RawAxes, RawAxis, RawBus, RawFile, RawInterpolation, RawKinematics, RawMachine, RawRealtime,
 };
 use crate::source::Source;
+use machine::bus::{self, Bus, Drive};
+use machine::{
+    Axes, AxisLimits, Compress, Interpolation, Kinematics, Machine, Method, Realtime, RotaryName,
+};
 
 /// Smallest and largest value of any rate, limit or scale (velocity, acceleration, jerk,
 /// feed, counts per unit): outside them the planner's arithmetic under- or overflows.
@@ -31,11 +31,11 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
     let buses = check.buses(&raw.bus)?;
     let drives = check.drives(&raw.axes, &axes, &buses)?;
     let spindle = match &raw.spindle {
-        Some(r) => Some(crate::spindle::spindle(&check, r, &buses, &drives)?),
+        Some(r) => Some(crate::spindle_coolant::spindle(&check, r, &buses, &drives)?),
         None => None,
     };
     let coolant = match &raw.coolant {
-        Some(r) => Some(crate::spindle::coolant(
+        Some(r) => Some(crate::spindle_coolant::coolant(
             &check,
             r,
             &buses,

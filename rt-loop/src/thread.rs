@@ -8,11 +8,10 @@
 
 use crate::latency::{RtSettings, STACK_PREFAULT};
 use crate::os::{self, RtError};
-use serde::Serialize;
 use std::thread::{Scope, ScopedJoinHandle};
 
 /// How the real-time thread runs.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct RtMode {
     pub sched_fifo: bool,
     /// SCHED_FIFO priority, when it runs with it.

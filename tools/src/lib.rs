@@ -8,6 +8,7 @@ pub mod control;
 pub mod exit;
 pub mod feed;
 pub mod report;
+mod rt_serde;
 pub mod run;
 pub mod setup;
 pub mod shop;

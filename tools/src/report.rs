@@ -42,6 +42,7 @@ pub struct Report {
     pub stop_node: Option<u8>,
     /// The program line being machined when the stop began.
     pub stop_line: Option<usize>,
+    #[serde(with = "crate::rt_serde::RtModeDef")]
     pub realtime: RtMode,
     pub overruns: u64,
     pub max_consecutive_overruns: u64,
@@ -50,6 +51,7 @@ pub struct Report {
     /// Periods where the path ran out before a hold had stopped the tool (should be 0).
     pub hard_stops: u64,
     pub drives: Vec<DriveEnd>,
+    #[serde(with = "crate::rt_serde::SummaryDef")]
     pub latency: rt_loop::stats::Summary,
     /// Spindle, coolant, tool, stop and dwell words of the program, one line each.
     #[serde(skip_serializing_if = "Vec::is_empty")]

@@ -41,12 +41,12 @@ use crate::control::{Command, Consumer};
 use crate::os;
 use approach::Approach;
 pub use approach::ApproachLimits;
-use config::bus::Drive;
 pub use drive_loop::{drive_loop, GAP_NS};
 use drives::cia402::{Goal, State, Statusword};
 use drives::link::CanLink;
 use drives::master::{DriveFault, Master, NodeKind, NodeStatus, MAX_NODES};
 use heapless::Vec as HVec;
+use machine::bus::Drive;
 use nc_follow::Follower;
 use nc_geom::kinematics::Joints;
 use nc_geom::program::Aux;
@@ -125,9 +125,9 @@ pub struct BusDrives<L: CanLink> {
     /// The axes' drives, first in the master's node order.
     pub drives: HVec<Drive, MAX_NODES>,
     /// The spindle drive and its index in the master's node order (after the axes).
-    pub spindle: Option<(usize, config::Spindle)>,
+    pub spindle: Option<(usize, machine::Spindle)>,
     /// The coolant I/O module and its index in the master's node order (last).
-    pub coolant: Option<(usize, config::Coolant)>,
+    pub coolant: Option<(usize, machine::Coolant)>,
     targets: [i32; MAX_NODES],
 }
 
@@ -152,13 +152,13 @@ impl<L: CanLink> BusDrives<L> {
     }
 
     /// The spindle drive is the master's node after the axes' drives.
-    pub fn with_spindle(mut self, spindle: config::Spindle) -> Self {
+    pub fn with_spindle(mut self, spindle: machine::Spindle) -> Self {
         self.spindle = Some((self.drives.len(), spindle));
         self
     }
 
     /// The coolant I/O module is the master's node after the drives (and the spindle).
-    pub fn with_coolant(mut self, coolant: config::Coolant) -> Self {
+    pub fn with_coolant(mut self, coolant: machine::Coolant) -> Self {
         let i = self.drives.len() + usize::from(self.spindle.is_some());
         self.coolant = Some((i, coolant));
         self
@@ -505,7 +505,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     }
 
     /// The spindle drive's status and configuration, if the machine has one.
-    fn spindle(&self) -> Option<(&NodeStatus, &config::Spindle)> {
+    fn spindle(&self) -> Option<(&NodeStatus, &machine::Spindle)> {
         self.buses.iter().find_map(|b| {
             let (i, s) = b.spindle.as_ref()?;
             Some((b.master.status().get(*i)?, s))

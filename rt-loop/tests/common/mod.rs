@@ -2,11 +2,11 @@
 //! simulated on the far end of a link, configured and taken over by a master.
 #![allow(dead_code)]
 
-use config::bus::Drive;
 use drives::link::{CanLink, MemLink};
 use drives::master::{configure, Master, SetupOptions, Supervision};
 use drives::sim::{Record, SimNodeConfig, SimThread};
 use drives::wire::NodeId;
+use machine::bus::Drive;
 use nc_follow::{Follower, Queues};
 use nc_geom::kinematics::MachineKinematics;
 use nc_plan::stream::chunks;

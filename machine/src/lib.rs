@@ -1,12 +1,19 @@
-//! Stage 2: the validated machine description the rest of the program uses.
+//! The validated machine description the rest of the program uses: what the `config` crate
+//! reads a machine file into (its stage 2), without serde or TOML, so that the real-time
+//! crates can take these types and nothing of the file's parsing.
 //!
-//! A value of these types has passed every check in `validate.rs`: all numbers are finite
+//! A value of these types has passed every check of `config`'s validation: all numbers are finite
 //! (except the `±inf` travel of a continuous C table), `min < max`, and every rate limit is
 //! `> 0`. Units are the machine's: linear axes in mm, mm/s, mm/s^2, mm/s^3; rotary axes in
 //! deg, deg/s, deg/s^2, deg/s^3; the period in seconds.
 
 use std::fmt;
 use std::str::FromStr;
+
+pub mod bus;
+pub mod spindle;
+
+pub use spindle::{Coolant, Spindle};
 
 /// A validated machine configuration.
 #[derive(Clone, Debug, PartialEq)]
