@@ -99,7 +99,7 @@ fn every_post_is_fitted_as_the_whole_text_fit_fits_it() {
     let mut parse = parse_setup(&m, &shop());
     parse.work_offsets = [Some([0.0; 3]); 6];
     let setup = MachineSetup::new(&m);
-    let opts = nc_fit::runs::Options::default();
+    let opts = nc_fit::options::Options::default();
     let mut fitted = 0;
     for name in POSTS {
         let src = std::fs::read_to_string(posts(name)).expect("the post");

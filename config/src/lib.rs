@@ -101,11 +101,12 @@
 //!
 //! Example files: `config/machines/*.toml`.
 
+mod check;
 mod error;
 pub mod offsets;
 mod raw;
 mod source;
-mod spindle_coolant;
+
 pub mod tools;
 mod validate;
 

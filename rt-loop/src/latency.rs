@@ -11,36 +11,11 @@ use crate::interval::{Interval, Queues, Recorder};
 use crate::os::{self, RtError};
 use crate::report::HlogFile;
 use crate::stats::Stats;
+use crate::thread::RtSettings;
 use heapless::spsc::{Consumer, Producer};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// How the loop thread is set up.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RtSettings {
-    /// SCHED_FIFO priority; `None` runs the same loop without real-time privileges (--no-rt).
-    pub priority: Option<i32>,
-    /// Pin the loop to this CPU.
-    pub cpu: Option<usize>,
-    /// Keep `cpu` busy between periods with an [`os::IdlePoller`] (needs `cpu`).
-    pub idle_poll: bool,
-}
-
-impl RtSettings {
-    /// Start the idle poller these settings ask for, if any; it polls until dropped.
-    pub fn idle_poller(&self) -> Result<Option<os::IdlePoller>, RtError> {
-        match (self.idle_poll, self.cpu) {
-            (false, _) => Ok(None),
-            (true, Some(cpu)) => os::IdlePoller::start(cpu).map(Some),
-            (true, None) => Err(RtError::Thread(
-                "needs a CPU to poll on: idle polling is only for a pinned loop (set the CPU)",
-            )),
-        }
-    }
-}
-
-/// Stack the loop may use, touched before the first period.
-pub const STACK_PREFAULT: usize = 256 * 1024;
 /// Length of one interval of the `.hlog`, ns.
 pub const INTERVAL_NS: u64 = 1_000_000_000;
 

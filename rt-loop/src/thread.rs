@@ -6,9 +6,35 @@
 //! [`STACK_PREFAULT`] of stack so the loop never faults it in. What it got is the
 //! [`RtMode`] handed to the body, also for the report.
 
-use crate::latency::{RtSettings, STACK_PREFAULT};
 use crate::os::{self, RtError};
 use std::thread::{Scope, ScopedJoinHandle};
+
+/// How the loop thread is set up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RtSettings {
+    /// SCHED_FIFO priority; `None` runs the same loop without real-time privileges (--no-rt).
+    pub priority: Option<i32>,
+    /// Pin the loop to this CPU.
+    pub cpu: Option<usize>,
+    /// Keep `cpu` busy between periods with an [`os::IdlePoller`] (needs `cpu`).
+    pub idle_poll: bool,
+}
+
+impl RtSettings {
+    /// Start the idle poller these settings ask for, if any; it polls until dropped.
+    pub fn idle_poller(&self) -> Result<Option<os::IdlePoller>, RtError> {
+        match (self.idle_poll, self.cpu) {
+            (false, _) => Ok(None),
+            (true, Some(cpu)) => os::IdlePoller::start(cpu).map(Some),
+            (true, None) => Err(RtError::Thread(
+                "needs a CPU to poll on: idle polling is only for a pinned loop (set the CPU)",
+            )),
+        }
+    }
+}
+
+/// Stack the loop may use, touched before the first period.
+pub const STACK_PREFAULT: usize = 256 * 1024;
 
 /// How the real-time thread runs.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -268,7 +268,7 @@ pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::R
     dnurbs_tools::run::RunOptions {
         name: name.into(),
         approach: true,
-        rt: rt_loop::latency::RtSettings {
+        rt: rt_loop::thread::RtSettings {
             priority: Some(80),
             cpu: None,
             idle_poll: false,

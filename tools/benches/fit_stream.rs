@@ -12,7 +12,7 @@
 mod common;
 
 use nc_fit::online::Compressing;
-use nc_fit::runs::Options;
+use nc_fit::options::Options;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, SrcPos};
 use nc_lang::{Entries, Entry, LineSource, ParseError, Setup};

@@ -351,8 +351,8 @@ pub struct CpuArgs {
 }
 
 impl CpuArgs {
-    pub fn settings(&self, priority: Option<i32>) -> rt_loop::latency::RtSettings {
-        rt_loop::latency::RtSettings {
+    pub fn settings(&self, priority: Option<i32>) -> rt_loop::thread::RtSettings {
+        rt_loop::thread::RtSettings {
             priority,
             cpu: self.cpu,
             idle_poll: self.idle_poll,

@@ -64,7 +64,7 @@ pub struct Report {
     pub refusal: Option<String>,
     /// How the planner streamed the program.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub stream: Option<crate::run::StreamNotes>,
+    pub stream: Option<StreamNotes>,
 }
 
 /// Axis names in joint order.
@@ -209,4 +209,16 @@ mod tests {
         assert_eq!(rfc3339(1_795_430_096), "2026-11-23T10:34:56Z");
         assert_eq!(rfc3339(951_782_400), "2000-02-29T00:00:00Z");
     }
+}
+
+/// How the planner streamed the program, for the report.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct StreamNotes {
+    /// Seconds from the planner thread's start to its first window (the pre-pass included
+    /// when the program was checked whole before motion).
+    pub first_window_s: f64,
+    /// The whole program went through the pre-pass before anything moved.
+    pub checked_whole: bool,
+    /// The program's lines, once the pre-pass has read it to its end.
+    pub lines: Option<u32>,
 }

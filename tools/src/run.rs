@@ -12,7 +12,7 @@
 
 use crate::exit::StoppedBeforeMotion;
 use crate::feed::{Input, Learned, Ready};
-use crate::report::{DriveEnd, Report, AXES};
+use crate::report::{DriveEnd, Report, StreamNotes, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
@@ -24,11 +24,12 @@ use drives::wire::NodeId;
 use nc_follow::{Follower, Queues};
 use rt_loop::control::{Command, Commands, Producer};
 use rt_loop::interval::{Interval, Queues as IntervalQueues, Recorder};
-use rt_loop::latency::{RtSettings, INTERVAL_NS};
+use rt_loop::latency::INTERVAL_NS;
 use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, ApproachLimits, BusDrives, Pipeline, Progress, StopReason};
 use rt_loop::stats::Stats;
 use rt_loop::thread::RtMode;
+use rt_loop::thread::RtSettings;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -84,18 +85,6 @@ pub struct RunResult {
     pub refusal: Option<String>,
     /// How the planner streamed the program.
     pub stream: Option<StreamNotes>,
-}
-
-/// How the planner streamed the program, for the report.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct StreamNotes {
-    /// Seconds from the planner thread's start to its first window (the pre-pass included
-    /// when the program was checked whole before motion).
-    pub first_window_s: f64,
-    /// The whole program went through the pre-pass before anything moved.
-    pub checked_whole: bool,
-    /// The program's lines, once the pre-pass has read it to its end.
-    pub lines: Option<u32>,
 }
 
 impl RunResult {

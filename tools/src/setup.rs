@@ -27,9 +27,9 @@ pub struct MachineSetup {
     pub limits: [config::AxisLimits; 5],
     /// On-line compression (`[interpolation] compress`): runs of G01 moves fitted into
     /// G06.5 blocks before the program is built and planned; `None` when off.
-    pub compress: Option<nc_fit::runs::Options>,
+    pub compress: Option<nc_fit::options::Options>,
     /// The compressor's settings from the machine file, for `--compress`.
-    compression: nc_fit::runs::Options,
+    compression: nc_fit::options::Options,
 }
 
 pub fn method_of(m: config::Method) -> Method {
@@ -83,13 +83,13 @@ impl MachineSetup {
         });
         let ip = &m.interpolation;
         let c = ip.compression;
-        let compression = nc_fit::runs::Options {
+        let compression = nc_fit::options::Options {
             tol: nc_fit::Tolerance {
                 mm: c.tol_mm,
                 rad: c.tol_deg.to_radians(),
             },
             corner_deg: c.corner_deg,
-            ..nc_fit::runs::Options::default()
+            ..nc_fit::options::Options::default()
         };
         MachineSetup {
             name: m.name.clone(),

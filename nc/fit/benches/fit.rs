@@ -3,7 +3,8 @@
 //! (the cost should grow linearly). Run: `cargo bench -p nc --bench fit`.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use nc_fit::runs::{fit_program, Options};
+use nc_fit::options::Options;
+use nc_fit::runs::fit_program;
 use nc_geom::kinematics::MachineKinematics;
 use nc_plan::fixtures::{blade, g01_program, resample};
 

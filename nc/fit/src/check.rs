@@ -7,7 +7,7 @@
 //! each side are held at most: the one being built, two waiting, one being measured.
 
 use super::deviation::{measure, Deviation};
-use super::rewrite::RewriteError;
+use crate::error::RewriteError;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Action, Block, SrcPos};
 use nc_geom::segment::{BuildError, BuildLimits, Builder, Path, Pose, Segment};

@@ -6,8 +6,8 @@
 //! dwell) between its moves ([`super::find`] has the rest of the rules).
 
 use super::find::{find_runs, moves_in};
-use super::runs::{Options, TOOL_MM};
 use super::Fitted;
+use crate::options::{Options, TOOL_MM};
 use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Program};
 
 /// What the compressor did.

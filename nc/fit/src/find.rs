@@ -11,8 +11,8 @@
 //! the caller adds its own conditions for a run's first move and for each move that joins
 //! it.
 
-use super::runs::Options;
 use super::{fit, Fitted, Point};
+use crate::options::Options;
 use nalgebra::Vector3;
 use nc_geom::kinematics::{is_vertical, Kinematics, MachineKinematics};
 use nc_geom::program::{Block, LinearMove, Orientation, Program};

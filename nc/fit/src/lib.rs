@@ -28,8 +28,10 @@
 mod check;
 pub mod compress;
 pub mod deviation;
+mod error;
 pub mod find;
 pub mod online;
+pub mod options;
 pub mod rewrite;
 pub mod runs;
 mod spline;

@@ -8,8 +8,8 @@
 
 use super::compress::{fitted_block, Compressed};
 use super::find::{is_corner, keeps_vertical, may_follow, point, run_feed, same_run};
-use super::runs::Options;
 use super::{fit, Point};
+use crate::options::Options;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, LinearMove, SrcPos};
 use nc_lang::{Entry, ParseError};

@@ -18,11 +18,13 @@ use super::find::{find_open_runs, Found};
 use super::online::MAX_RUN;
 use super::runs::{
     in_angles, n_word, pure_move_line, restorable, sets_angles, tilt_of, with_angles, write_block,
-    Modes, Options, Summary,
+    Modes, Summary,
 };
+pub use crate::error::RewriteError;
+use crate::options::Options;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, Program, SrcPos};
-use nc_geom::segment::{BuildError, BuildLimits};
+use nc_geom::segment::BuildLimits;
 use nc_lang::{Entries, Entry, LineSource, ParseError, ReadLines, Setup};
 use std::cell::RefCell;
 use std::collections::VecDeque;
@@ -35,23 +37,6 @@ use std::time::Instant;
 /// padded), the window is cut there.
 const MAX_HELD_LINES: usize = 2 * MAX_RUN + 16;
 const MAX_HELD_BYTES: usize = 64 << 20;
-
-/// Why the rewrite stopped. Nothing it wrote should be kept.
-#[derive(Debug, thiserror::Error)]
-pub enum RewriteError {
-    #[error("{0}")]
-    Parse(ParseError),
-    #[error("{0}")]
-    Build(BuildError),
-    #[error("the fitted program does not parse: {0}")]
-    OutputParse(ParseError),
-    #[error("the fitted program does not build: {0}")]
-    OutputBuild(BuildError),
-    #[error("the fitted program has more or fewer motion blocks than were written ({read} read where {expected} were written)")]
-    OutputBlocks { expected: usize, read: usize },
-    #[error("cannot write the fitted program: {0}")]
-    Write(#[from] std::io::Error),
-}
 
 /// What the rewrite did and what the check measured.
 #[derive(Clone, Debug, PartialEq)]

@@ -21,41 +21,12 @@
 //! are written back, and the offsets apply to them at run time as they did to the moves).
 
 use super::find::{find_runs, moves_in, Found};
-use super::{Fitted, Tolerance};
+use super::Fitted;
+use crate::options::{Options, TOOL_MM};
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, Orientation, Program};
 use nc_lang::MM_PER_INCH;
 use std::fmt::Write;
-
-/// Length the orientation points stand off the cutter points (mm): `U V W` = `X Y Z` +
-/// this times the tool vector, so the six decimals written give the axis to 1e-7 rad.
-pub const TOOL_MM: f64 = 10.0;
-
-/// How to fit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Options {
-    pub tol: Tolerance,
-    /// A turn of the path between two moves above this (degrees) is a corner: runs end there.
-    pub corner_deg: f64,
-    /// Degree of the curves written (`G06.5 P`).
-    pub degree: usize,
-    /// Shortest run fitted, in moves.
-    pub min_moves: usize,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options {
-            tol: Tolerance {
-                mm: 0.001,
-                rad: 0.01f64.to_radians(),
-            },
-            corner_deg: 10.0,
-            degree: 3,
-            min_moves: 4,
-        }
-    }
-}
 
 /// One run, where it stands in the text, and what became of it.
 #[derive(Clone, Debug, PartialEq)]

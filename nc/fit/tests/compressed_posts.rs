@@ -31,7 +31,7 @@ use nalgebra::Vector3;
 use nc_fit::compress::compress;
 use nc_fit::deviation::measure;
 use nc_fit::find::point;
-use nc_fit::runs::Options;
+use nc_fit::options::Options;
 use nc_geom::kinematics::{Kinematics, MachineKinematics};
 use nc_geom::program::Block;
 use nc_geom::segment::{build, BuildLimits, Path};

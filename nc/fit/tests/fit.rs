@@ -6,7 +6,8 @@
 
 use nalgebra::Vector3;
 use nc_fit::deviation::{measure, Deviation};
-use nc_fit::runs::{fit_program, FitOutput, Options};
+use nc_fit::options::Options;
+use nc_fit::runs::{fit_program, FitOutput};
 use nc_fit::Tolerance;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::nurbs::DoubleNurbs;

@@ -7,8 +7,9 @@
 use nalgebra::Vector3;
 use nc_fit::deviation::measure;
 use nc_fit::online::MAX_RUN;
+use nc_fit::options::Options;
 use nc_fit::rewrite::{rewrite, Rewritten};
-use nc_fit::runs::{fit_program, Options};
+use nc_fit::runs::fit_program;
 use nc_geom::kinematics::{MachineKinematics, Tilt};
 use nc_geom::program::{Block, NurbsKind};
 use nc_geom::segment::build;

@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use nc_fit::compress::{compress, Compressed};
 use nc_fit::deviation::measure;
 use nc_fit::online::{Compressing, MAX_RUN};
-use nc_fit::runs::Options;
+use nc_fit::options::Options;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Action, Block, Program};
 use nc_geom::segment::build;

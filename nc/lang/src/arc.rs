@@ -27,16 +27,11 @@
 //! accepted, and the centre is moved onto the bisector of start and end (the nearest point to
 //! the programmed centre), so the arc runs exactly from the start to the programmed end.
 
-use super::codes::Plane;
 use super::error::ParseErrorKind;
+use crate::rules::{ARC_RADIUS_TOL_MM, HELIX_TOL_MM, MIN_ARC_RADIUS_MM};
+use crate::vocab::Plane;
 use core::f64::consts::{FRAC_PI_2, TAU};
 
-/// Largest accepted difference between the start and end radius, mm.
-pub const ARC_RADIUS_TOL_MM: f64 = 0.002;
-/// Smallest arc radius, mm.
-pub const MIN_ARC_RADIUS_MM: f64 = 1e-3;
-/// Largest distance of a helix's points from the true helix, mm (along its axis).
-pub const HELIX_TOL_MM: f64 = 1e-9;
 /// `e <= HELIX_ERR * k * alpha^5`: the largest normal error of a degree-4 helix piece of
 /// half-sweep `alpha <= 45 deg` rising `k` mm a radian (measured 0.00259 at 45 deg).
 const HELIX_ERR: f64 = 0.0027;

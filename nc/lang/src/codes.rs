@@ -4,54 +4,9 @@
 //! is six groups). Codes of real posts that dnurbs cannot honour have their own error, never
 //! a silent skip: cutter compensation (`G41`/`G42`), canned cycles (`G73`..`G89`).
 
-use super::error::{Motion, ParseErrorKind};
+use crate::error::ParseErrorKind;
+use crate::vocab::{Motion, Plane};
 use nc_geom::program::{Coolant, Spindle};
-
-/// Working plane of arcs (`G17` XY, `G18` ZX, `G19` YZ).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Plane {
-    Xy,
-    Zx,
-    Yz,
-}
-
-impl Plane {
-    pub fn name(self) -> &'static str {
-        match self {
-            Plane::Xy => "G17 (XY)",
-            Plane::Zx => "G18 (ZX)",
-            Plane::Yz => "G19 (YZ)",
-        }
-    }
-
-    /// The centre-offset words of the plane's two axes.
-    pub fn offset_letters(self) -> &'static str {
-        match self {
-            Plane::Xy => "I J",
-            Plane::Zx => "K I",
-            Plane::Yz => "J K",
-        }
-    }
-
-    /// The offset letters by axis index (X Y Z -> I J K).
-    pub fn offset_letter(axis: usize) -> char {
-        match axis {
-            0 => 'I',
-            1 => 'J',
-            _ => 'K',
-        }
-    }
-
-    /// Axis indices (first, second, normal) of the plane, right-handed: a counter-clockwise
-    /// arc (`G03`) turns from the first axis toward the second, seen from +normal.
-    pub fn axes(self) -> (usize, usize, usize) {
-        match self {
-            Plane::Xy => (0, 1, 2),
-            Plane::Zx => (2, 0, 1),
-            Plane::Yz => (1, 2, 0),
-        }
-    }
-}
 
 /// Tool-length compensation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,11 +121,6 @@ const G_CODES: [(f64, Code); 30] = [
     (91.0, Code::Incremental(true)),
     (93.0, Code::InverseTime(true)),
 ];
-
-/// The list the unsupported-code error names.
-pub const G_LIST: &str =
-    "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G80 G90 G91 G93 G94";
-pub const M_LIST: &str = "M00 M01 M02 M03 M04 M05 M06 M07 M08 M09 M30";
 
 pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
     if value == 94.0 {

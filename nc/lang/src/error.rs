@@ -7,11 +7,11 @@
 
 use core::fmt;
 
-use super::arc::{ARC_RADIUS_TOL_MM, HELIX_TOL_MM, MIN_ARC_RADIUS_MM};
-use super::codes::{Plane, G_LIST, M_LIST};
-use super::modal::MAX_DWELL_S;
-use super::nurbs::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
-use super::parser::{MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH, MIN_WEIGHT};
+use crate::rules::{
+    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_DWELL_S, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN,
+    MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
+};
+use crate::vocab::{Motion, Plane};
 use nc_geom::program::SrcPos;
 use nc_geom::program::MAX_BLOCK_CTRL;
 
@@ -25,30 +25,6 @@ pub struct ParseError {
     /// line numbers).
     pub pos: SrcPos,
     pub kind: ParseErrorKind,
-}
-
-/// The motion word of a block, as named in messages.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Motion {
-    G00,
-    G01,
-    G02,
-    G03,
-    G062,
-    G065,
-}
-
-impl fmt::Display for Motion {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Motion::G00 => "G00",
-            Motion::G01 => "G01",
-            Motion::G02 => "G02",
-            Motion::G03 => "G03",
-            Motion::G062 => "G06.2",
-            Motion::G065 => "G06.5",
-        })
-    }
 }
 
 /// The kind of line a word was found on, for [`ParseErrorKind::WordNotAllowed`] and

@@ -82,19 +82,24 @@ mod modal;
 mod moves;
 mod nurbs;
 mod parser;
+mod rules;
 mod source;
 mod stream;
 #[cfg(test)]
 mod tests;
+mod vocab;
 
-pub use arc::{arc, ArcNet, Centre, ARC_RADIUS_TOL_MM, HELIX_TOL_MM};
-pub use codes::Plane;
-pub use error::{Context, Motion, ParseError, ParseErrorKind};
+pub use arc::{arc, ArcNet, Centre};
+pub use error::{Context, ParseError, ParseErrorKind};
 pub use lexer::word_limit;
-pub use modal::{Setup, MAX_DWELL_S, MAX_ERRORS, MM_PER_INCH};
-pub use parser::{MIN_FEED_MM_MIN, MIN_WEIGHT};
+pub use modal::{Setup, MAX_ERRORS, MM_PER_INCH};
+pub use rules::{
+    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_DWELL_S, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN,
+    MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
+};
 pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
 pub use stream::{Entries, Entry};
+pub use vocab::{Motion, Plane};
 
 use nc_geom::program::Program;
 

@@ -5,8 +5,9 @@
 //! two codes of one group, a misplaced or malformed `N`, a word repeated on a line.
 
 use super::codes::{g_code, m_code, Code, StopCode, GROUPS};
-use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::error::{Context, ParseError, ParseErrorKind};
 use super::lexer::Word;
+use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].

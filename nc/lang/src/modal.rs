@@ -1,13 +1,10 @@
 //! What the program does not say: the machine's work offsets, reference position and tool
 //! table ([`Setup`]), and the modal state the parser keeps between lines ([`Modal`]).
 
-use super::codes::{LengthComp, Plane};
+use super::codes::LengthComp;
+use crate::vocab::Plane;
 use std::collections::BTreeMap;
 
-/// Longest dwell (`G04`), seconds. `P` and `X` are seconds (LinuxCNC's reading); Fanuc
-/// posts that write `P` in milliseconds would ask for 1000 times the dwell, and most such
-/// values land above this bound and are refused.
-pub const MAX_DWELL_S: f64 = 100.0;
 /// Most errors one parse reports.
 pub const MAX_ERRORS: usize = 50;
 /// Millimetres per inch (`G20`).

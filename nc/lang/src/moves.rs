@@ -7,12 +7,14 @@
 //! in [`MoveTooling`](nc_geom::program::MoveTooling) and is added by the machine's Z axis).
 
 use super::arc::{self, Centre};
-use super::codes::{Code, Plane};
-use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::codes::Code;
+use super::error::{Context, ParseError, ParseErrorKind};
 use super::lexer::word_limit;
 use super::line::{Line, MOVE_WORDS};
 use super::nurbs::distance;
 use super::parser::{normalise, Parser};
+use crate::vocab::Motion;
+use crate::vocab::Plane;
 use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, SrcPos};
 
 const AXES: [char; 3] = ['X', 'Y', 'Z'];

@@ -6,16 +6,13 @@
 //! remaining degree + 1 knots. The first `K`-only line fixes the control-point count and so the
 //! knot count; the block is complete when that many knots have arrived.
 
-use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::error::{Context, ParseError, ParseErrorKind};
 use super::lexer::Word;
 use super::line::Line;
+use crate::rules::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
+use crate::vocab::Motion;
 use nc_geom::program::MAX_BLOCK_CTRL;
 use nc_geom::program::{MoveTooling, NurbsBlock, NurbsKind, SrcPos, MAX_DEGREE};
-
-/// Tolerance of the first control point against the current position, mm per axis.
-pub(super) const START_TOLERANCE_MM: f64 = 1e-3;
-/// Least distance between a cutter control point and its orientation control point, mm.
-pub(super) const MIN_TOOL_OFFSET_MM: f64 = 1e-3;
 
 /// Program coordinates to the workpiece frame: `mm = value * scale + offset`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -152,7 +149,7 @@ impl OpenNurbs {
         };
         let knot = need('K')?;
         let weight = match line.get('R') {
-            Some(r) if r.value < super::parser::MIN_WEIGHT => {
+            Some(r) if r.value < crate::rules::MIN_WEIGHT => {
                 return Err(ParseErrorKind::BadWeight { value: r.value }.at(r.pos));
             }
             Some(r) => r.value,

@@ -6,22 +6,17 @@
 //! program end.
 
 use super::codes::{Code, LengthComp, StopCode};
-use super::error::{Context, Motion, ParseError, ParseErrorKind};
+use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
-use super::modal::{Modal, Setup, MAX_DWELL_S};
+use super::modal::{Modal, Setup};
 use super::nurbs::{Frame, OpenNurbs};
+use crate::rules::{MAX_DWELL_S, MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH};
+use crate::vocab::Motion;
 use nc_geom::program::{
     Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation, SrcPos,
     Wait,
 };
 
-/// Tool-vector length below which `I J K` is rejected (it has no direction).
-pub(super) const MIN_VECTOR_LENGTH: f64 = 1e-9;
-/// Slowest programmable feed, mm/min (0.06 mm/min was measured to run a 27 mm move for
-/// hours; the planner refuses any plan over 24 h at 1 ms in any case).
-pub const MIN_FEED_MM_MIN: f64 = 0.001;
-/// Smallest NURBS weight (the largest is the `R` word's bound, 1e6).
-pub const MIN_WEIGHT: f64 = 1e-6;
 /// The tool orientation until a program gives one: vertical.
 pub(super) const VERTICAL: Orientation = Orientation::Vector([0.0, 0.0, 1.0]);
 /// Largest tool or spindle-speed word.

@@ -59,7 +59,7 @@ mod remedy;
 mod stations;
 mod window;
 
-use limits::{section_ramps, AXIS_SHARE, AXIS_SHARE_LEAST};
+use limits::section_ramps;
 use stations::{Rates, Station};
 
 pub use window::{Finished, Planner, Sink};

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 pub fn latency(
     period: u64,
     duration: u64,
-    rt: rt_loop::latency::RtSettings,
+    rt: rt_loop::thread::RtSettings,
     report: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
     if period > duration {

@@ -27,7 +27,7 @@ fn finish(
 pub fn demo(
     report: Option<PathBuf>,
     link: DemoLink,
-    rt: rt_loop::latency::RtSettings,
+    rt: rt_loop::thread::RtSettings,
     lead_ns: u64,
     control: Option<PathBuf>,
     program: Option<PathBuf>,
@@ -116,7 +116,7 @@ pub fn run(
     let opts = RunOptions {
         name: program.display().to_string(),
         approach,
-        rt: rt_loop::latency::RtSettings {
+        rt: rt_loop::thread::RtSettings {
             priority: (!no_rt).then_some(m.realtime.priority),
             cpu: m.realtime.cpu,
             idle_poll: m.realtime.idle_poll,

@@ -167,7 +167,7 @@ fn steep_helices_are_on_the_true_helix_or_an_error() {
         super::super::arc(
             [0.01, 0.0, -rise / 2.0],
             [0.01, 0.0, rise / 2.0],
-            super::super::codes::Plane::Xy,
+            super::super::vocab::Plane::Xy,
             false,
             super::super::Centre::Offsets(-0.01, 0.0),
         )

@@ -8,24 +8,12 @@
 //! jerk's term `3 q_ss s' s''` is taken at the most `s' s''` an S-curve ramp can reach
 //! there ([`speed_times_acc`]), not at the highest speed and acceleration at once.
 
-use super::stations::{Rates, Station};
+use super::stations::{Rates, Station, AXIS_SHARE_LEAST};
 use super::A_FLOOR;
 use crate::config::PlanConfig;
 use nc_geom::limits::AxisLimit;
 use nc_geom::scurve::{change_time, Ramps};
 
-/// Of each axis's acceleration and jerk, the share a section plans to. The rest is left
-/// for what the stations do not see: the path between them, and the parameter update's
-/// drift from the planned feed, which the setpoint check would otherwise catch and cap.
-pub(super) const AXIS_SHARE: f64 = 0.9;
-/// The least share of an axis's acceleration and jerk the path terms get, however much of
-/// it the curvature terms would take (the setpoint check lowers the ceilings where that is
-/// too much), unless the check lowered the station's own share below it.
-pub(super) const AXIS_SHARE_LEAST: f64 = 0.5;
-/// The lowest a station's share goes where an axis's jerk stays over its limit at the
-/// slowest feed ([`super::window`]): a path jerk and acceleration of a thousandth of what
-/// the axes allow at their rates there.
-pub(super) const AXIS_SHARE_FLOOR: f64 = 1e-3;
 /// Rounds of [`section_ramps`]: each narrows the stretch a ramp is limited over.
 const RAMP_ROUNDS: usize = 3;
 
@@ -245,6 +233,7 @@ pub(super) fn section_ramps(
 mod tests {
     use super::super::state_at;
     use super::*;
+    use crate::plan::stations::AXIS_SHARE;
     use nc_geom::scurve::{change_dist, push_section, reachable};
     use proptest::prelude::*;
 

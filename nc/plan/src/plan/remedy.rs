@@ -4,8 +4,8 @@
 //! share of the axes' limits lowered ([`lower_share`]), or the ceilings lowered from where
 //! they are ([`Remedy`]).
 
-use super::limits::AXIS_SHARE_FLOOR;
-use super::{Station, AXIS_SHARE_LEAST, CAP_MARGIN, V_JOINT_FLOOR};
+use super::stations::{Station, AXIS_SHARE_FLOOR, AXIS_SHARE_LEAST};
+use super::{CAP_MARGIN, V_JOINT_FLOOR};
 use crate::verify::{Quantity, Violation};
 use nc_geom::limits::V_FLOOR;
 

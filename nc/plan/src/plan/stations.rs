@@ -2,12 +2,27 @@
 //! [`super`]), made one segment at a time as segments arrive ([`Sampler`]), so that a
 //! program can be planned while it is read.
 
-use super::{AXIS_SHARE, CAP_MARGIN, V_JOINT_FLOOR};
+use super::{CAP_MARGIN, V_JOINT_FLOOR};
 use crate::config::PlanConfig;
 use nalgebra::Vector3;
 use nc_geom::kinematics::{Joints, MachineKinematics};
 use nc_geom::limits::V_FLOOR;
 use nc_geom::segment::{Geometry, Segment, Tooling};
+
+/// Of each axis's acceleration and jerk, the share a section plans to. The rest is left
+/// for what the stations do not see: the path between them, and the parameter update's
+/// drift from the planned feed, which the setpoint check would otherwise catch and cap.
+pub(super) const AXIS_SHARE: f64 = 0.9;
+
+/// The least share of an axis's acceleration and jerk the path terms get, however much of
+/// it the curvature terms would take (the setpoint check lowers the ceilings where that is
+/// too much), unless the check lowered the station's own share below it.
+pub(super) const AXIS_SHARE_LEAST: f64 = 0.5;
+
+/// The lowest a station's share goes where an axis's jerk stays over its limit at the
+/// slowest feed ([`super::window`]): a path jerk and acceleration of a thousandth of what
+/// the axes allow at their rates there.
+pub(super) const AXIS_SHARE_FLOOR: f64 = 1e-3;
 
 /// A sample of the path used by the planner.
 #[derive(Clone, Copy, Debug)]

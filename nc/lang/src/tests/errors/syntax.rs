@@ -152,7 +152,7 @@ fn unsupported_g_code() {
         message("G90 G21\nG68 G00 X0 Y0 Z0"),
         format!(
             "2:1: unsupported G-code G68: dnurbs accepts {}",
-            crate::codes::G_LIST
+            crate::rules::G_LIST
         )
     );
     for (src, name) in [

@@ -150,7 +150,7 @@ fn method_of(m: MethodArg) -> nc_plan::interp::Method {
 }
 
 /// With a real-time CPU: this thread, and every thread it starts from now on, stays off it.
-fn keep_off_rt_cpu(rt: rt_loop::latency::RtSettings) -> anyhow::Result<()> {
+fn keep_off_rt_cpu(rt: rt_loop::thread::RtSettings) -> anyhow::Result<()> {
     if let Some(cpu) = rt.cpu {
         rt_loop::os::avoid_cpu(cpu)?;
     }
@@ -158,7 +158,7 @@ fn keep_off_rt_cpu(rt: rt_loop::latency::RtSettings) -> anyhow::Result<()> {
 }
 
 /// ", real-time thread on CPU n (idle polled)" or nothing.
-fn cpu_text(rt: rt_loop::latency::RtSettings) -> String {
+fn cpu_text(rt: rt_loop::thread::RtSettings) -> String {
     match rt.cpu {
         Some(c) if rt.idle_poll => format!(", real-time thread on CPU {c} (idle polled)"),
         Some(c) => format!(", real-time thread on CPU {c}"),

@@ -1,9 +1,9 @@
 //! Validation of `[spindle]` and `[coolant]` into [`machine::Spindle`] and
 //! [`machine::Coolant`]: each on a named `[[bus]]`, its node free on that bus.
 
+use crate::check::{Check, MAX_POSITIVE};
 use crate::error::ConfigError;
 use crate::raw::{RawCoolant, RawSpindle};
-use crate::validate::{Check, MAX_POSITIVE};
 use machine::bus::{Bus, Drive};
 use machine::{Coolant, Spindle};
 

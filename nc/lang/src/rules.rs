@@ -1,0 +1,39 @@
+//! The language's numeric rules and what it accepts, in one place: the tolerances and
+//! ranges the parser holds programs to, and the codes it knows. The error messages quote
+//! them, and the parser's stages check them.
+
+/// Largest accepted difference between the start and end radius, mm.
+pub const ARC_RADIUS_TOL_MM: f64 = 0.002;
+
+/// Smallest arc radius, mm.
+pub const MIN_ARC_RADIUS_MM: f64 = 1e-3;
+
+/// Largest distance of a helix's points from the true helix, mm (along its axis).
+pub const HELIX_TOL_MM: f64 = 1e-9;
+
+/// Longest dwell (`G04`), seconds. `P` and `X` are seconds (LinuxCNC's reading); Fanuc
+/// posts that write `P` in milliseconds would ask for 1000 times the dwell, and most such
+/// values land above this bound and are refused.
+pub const MAX_DWELL_S: f64 = 100.0;
+
+/// Slowest programmable feed, mm/min (0.06 mm/min was measured to run a 27 mm move for
+/// hours; the planner refuses any plan over 24 h at 1 ms in any case).
+pub const MIN_FEED_MM_MIN: f64 = 0.001;
+
+/// Smallest NURBS weight (the largest is the `R` word's bound, 1e6).
+pub const MIN_WEIGHT: f64 = 1e-6;
+
+/// Tool-vector length below which `I J K` is rejected (it has no direction).
+pub const MIN_VECTOR_LENGTH: f64 = 1e-9;
+
+/// Least distance between a cutter control point and its orientation control point, mm.
+pub const MIN_TOOL_OFFSET_MM: f64 = 1e-3;
+
+/// Tolerance of the first control point against the current position, mm per axis.
+pub const START_TOLERANCE_MM: f64 = 1e-3;
+
+/// The list the unsupported-code error names.
+pub const G_LIST: &str =
+    "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G80 G90 G91 G93 G94";
+
+pub const M_LIST: &str = "M00 M01 M02 M03 M04 M05 M06 M07 M08 M09 M30";

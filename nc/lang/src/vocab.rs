@@ -1,0 +1,74 @@
+//! The words the language's stages and its error messages share: the motion word of a block
+//! and the working plane of arcs.
+
+use core::fmt;
+
+/// Working plane of arcs (`G17` XY, `G18` ZX, `G19` YZ).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Plane {
+    Xy,
+    Zx,
+    Yz,
+}
+
+impl Plane {
+    pub fn name(self) -> &'static str {
+        match self {
+            Plane::Xy => "G17 (XY)",
+            Plane::Zx => "G18 (ZX)",
+            Plane::Yz => "G19 (YZ)",
+        }
+    }
+
+    /// The centre-offset words of the plane's two axes.
+    pub fn offset_letters(self) -> &'static str {
+        match self {
+            Plane::Xy => "I J",
+            Plane::Zx => "K I",
+            Plane::Yz => "J K",
+        }
+    }
+
+    /// The offset letters by axis index (X Y Z -> I J K).
+    pub fn offset_letter(axis: usize) -> char {
+        match axis {
+            0 => 'I',
+            1 => 'J',
+            _ => 'K',
+        }
+    }
+
+    /// Axis indices (first, second, normal) of the plane, right-handed: a counter-clockwise
+    /// arc (`G03`) turns from the first axis toward the second, seen from +normal.
+    pub fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Plane::Xy => (0, 1, 2),
+            Plane::Zx => (2, 0, 1),
+            Plane::Yz => (1, 2, 0),
+        }
+    }
+}
+
+/// The motion word of a block, as named in messages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Motion {
+    G00,
+    G01,
+    G02,
+    G03,
+    G062,
+    G065,
+}
+
+impl fmt::Display for Motion {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Motion::G00 => "G00",
+            Motion::G01 => "G01",
+            Motion::G02 => "G02",
+            Motion::G03 => "G03",
+            Motion::G062 => "G06.2",
+            Motion::G065 => "G06.5",
+        })
+    }
+}
