@@ -1,25 +1,47 @@
 //! `dnurbs demo` and `dnurbs run` through the real binary: the demo runs the paper example
-//! against simulated drives on each in-process link and ends on the program's end point;
-//! `run` reports a bad program or machine before touching a bus.
+//! against simulated drives and ends on the program's end point, and a short program on
+//! each other in-process link and thread set-up; `run` reports a bad program or machine
+//! before touching a bus.
+//!
+//! **Real time.** These demos run in real time (the rest of the run tests are on simulated
+//! time: `tests/posts.rs`, `tests/run_outcomes.rs`, `rt-loop/tests/`). The paper example's
+//! demo is the real-time smoke test of the suite: it passes on a loaded machine (exit 5
+//! with overruns counts as completed; a simulated drive starved while the controller's own
+//! thread overran is run once more, [`stalled`]), and nothing here measures speed.
 
 mod common;
 
 use common::{data, dnurbs, machine, temp};
 
+/// The real-time smoke test: `dnurbs demo` as the README runs it.
 #[test]
 fn demo_runs_the_paper_example_to_its_end_and_writes_the_report() {
     check_demo(&[], "an in-memory CAN link, 2 ms period, 60 µs lead");
 }
 
+/// A 2 s program: what is checked is the link, not the program.
+const SHORT: &str = "tests/data/two-blocks-g2.nc";
+
 #[test]
-fn demo_over_a_socketpair_runs_the_paper_example_to_its_end() {
-    check_demo(&["--link", "socketpair"], "a socketpair CAN link");
+fn demo_over_a_socketpair_runs_a_program_to_its_end() {
+    check_demo(
+        &["--link", "socketpair", "--program", SHORT],
+        "a socketpair CAN link",
+    );
 }
 
 #[test]
-fn demo_pinned_with_its_cpu_idle_polled_runs_the_paper_example_to_its_end() {
+fn demo_pinned_with_its_cpu_idle_polled_runs_a_program_to_its_end() {
     check_demo(
-        &["--cpu", "0", "--idle-poll", "--lead", "0"],
+        &[
+            "--cpu",
+            "0",
+            "--idle-poll",
+            "--lead",
+            "0",
+            "--program",
+            SHORT,
+        ],
         "2 ms period, real-time thread on CPU 0 (idle polled)",
     );
 }
@@ -70,14 +92,21 @@ fn check_demo(extra: &[&str], banner: &str) {
         assert_eq!(n[1], n[3], "target is not the program end: {line}");
         assert!((n[2] - n[3]).abs() <= 1, "actual is off the end: {line}");
     }
+    let paper = !extra.contains(&"--program");
     // X Y Z of the paper's end point, 10000 counts/mm.
-    assert!(stdout.contains("-16963") && stdout.contains("1636796") && stdout.contains("58369"));
+    assert!(
+        !paper
+            || (stdout.contains("-16963")
+                && stdout.contains("1636796")
+                && stdout.contains("58369"))
+    );
     for f in ["summary.txt", "summary.json", "latency.hlog", "latency.svg"] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(json["program"], "paper-example.nc");
+    let name = if paper { "paper-example.nc" } else { SHORT };
+    assert_eq!(json["program"], name);
     assert_eq!(json["machine"], "paper-ac-table");
     assert!(
         json["outcome"].as_str().unwrap().starts_with("completed"),
@@ -87,8 +116,8 @@ fn check_demo(extra: &[&str], banner: &str) {
     assert_eq!(json["drives"].as_array().unwrap().len(), 5, "{json}");
     assert!(json["started"].as_str().unwrap().ends_with('Z'), "{json}");
     let cycles = json["latency"]["cycles"].as_u64().unwrap();
-    // 17.87 s of program at 2 ms, plus the approach and the enable/disable cycles.
-    assert!(cycles > 8938, "{cycles}");
+    // 17.87 s of program at 2 ms (2.01 s), plus the approach and the enable/disable cycles.
+    assert!(cycles > if paper { 8938 } else { 1005 }, "{cycles}");
     assert_eq!(json["feed_holds"], 0);
     assert_eq!(json["hard_stops"], 0);
     for h in ["wakeup_latency_ns", "compute_ns", "cycle_ns"] {

@@ -1,8 +1,8 @@
 //! Programs as CAM post-processors write them (`tests/data/posts`, see its README): each is
 //! accepted unchanged, plans within every limit of the machine, and reports its spindle,
 //! coolant and tool words. All five run against simulated CiA-402 drives, spindle drive and
-//! coolant I/O module on the in-memory link (the code path of `dnurbs run`, in real time, at
-//! once); an operator resumes their tool-change stops through the control socket, and what
+//! coolant I/O module on the in-memory link (the code path of `dnurbs run`, on simulated
+//! time); an operator resumes their tool-change stops, and what
 //! the nodes received is checked: the axes' targets follow the path `dnurbs simulate`
 //! interpolates to the drives' rounding, within the velocity and acceleration limits by
 //! finite differences at the period, ending at the program's end; the spindle drive at its
@@ -12,14 +12,11 @@
 
 mod common;
 
-use dnurbs_tools::control::{Connection, Request};
-use dnurbs_tools::run::{run, RunOptions};
+use dnurbs_tools::run::RunOptions;
 use dnurbs_tools::setup::MachineSetup;
 use dnurbs_tools::shop::{parse_setup, ShopArgs};
-use drives::link::MemLink;
 
-use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::path::PathBuf;
 
 const POSTS: [&str; 5] = [
     "fusion-fanuc-3axis.nc",
@@ -132,28 +129,27 @@ fn every_post_is_fitted_as_the_whole_text_fit_fits_it() {
 /// What each simulated node recorded, per SYNC, indexed by node id.
 type PerNode = Vec<Vec<drives::sim::Record>>;
 
-/// Runs `name` on simulated drives; a client thread resumes every operator stop. Returns the
-/// lines it resumed at, the run's report and the records of every node (per node, in order).
+/// Runs `name` on simulated drives on simulated time; the operator resumes every stop.
+/// Returns the lines it resumed at, the run's report and the records of every node (per
+/// node, in order).
 fn run_post(
     name: &str,
     m: &config::Machine,
     compress: Option<bool>,
 ) -> (Vec<u32>, dnurbs_tools::report::Report, PerNode) {
-    let mut m = m.clone();
-    m.realtime.feedback_timeout_s = 2.0;
-    m.realtime.heartbeat_timeout_s = 5.0;
-    m.realtime.max_consecutive_overruns = 100_000;
-    let (links, sim) = common::sim_drives(&m, |_| Default::default());
-    let sock = common::temp(&format!("{name}.sock"));
     let opts = RunOptions {
         shop: dnurbs_tools::shop::ShopOptions { compress, ..shop() },
-        ..common::run_options(name, Some(sock.clone()))
+        ..common::run_options(name, None)
     };
     let src = std::fs::read(posts(name)).unwrap();
-    let operator = std::thread::spawn(move || resume_every_stop(&sock));
-    let r = run(&src, &m, move || Ok(links), &opts).expect("the run starts");
-    let records = sim.finish();
-    let resumed = operator.join().unwrap();
+    let mut resumed = Vec::new();
+    let (r, records) = common::run_simulated(
+        &src,
+        m,
+        |_| Default::default(),
+        &opts,
+        common::resume_every_stop(&mut resumed),
+    );
     let mut per_node = vec![Vec::new(); 8];
     for rec in records {
         per_node[usize::from(rec.node)].push(rec);
@@ -161,35 +157,11 @@ fn run_post(
     (resumed, r.report(name, &m.name), per_node)
 }
 
-/// The operator: poll the status, resume whenever the path waits for them.
-fn resume_every_stop(sock: &Path) -> Vec<u32> {
-    let mut resumed = Vec::new();
-    let t0 = std::time::Instant::now();
-    let mut conn = loop {
-        match Connection::connect(sock) {
-            Ok(c) => break c,
-            Err(_) if t0.elapsed() < Duration::from_secs(60) => {
-                std::thread::sleep(Duration::from_millis(20))
-            }
-            Err(e) => panic!("{e}"),
-        }
-    };
-    while let Ok(Some(answer)) = conn.ask(Request::Status) {
-        if let Some(line) = answer.status.and_then(|s| s.awaiting_operator) {
-            resumed.push(line);
-            conn.ask(Request::Resume).unwrap();
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    resumed
-}
-
 #[test]
 fn every_post_runs_on_simulated_drives_as_simulated_with_the_spindle_and_coolant_it_commands() {
     let m = slow_spindle_machine();
-    // The five run at once (each in real time: the longest takes its 158 s of machining);
-    // every failure is reported, post by post. `DNURBS_POSTS=nx` runs only the posts whose
-    // file name starts with it.
+    // The five run at once, each on simulated time; every failure is reported, post by post.
+    // `DNURBS_POSTS=nx` runs only the posts whose file name starts with it.
     let only = std::env::var("DNURBS_POSTS").unwrap_or_default();
     let runs: Vec<_> = POSTS
         .into_iter()
@@ -607,13 +579,13 @@ fn coolant_on_for_the_cut_and_off_at_the_end(
 #[test]
 fn a_stop_for_the_operator_without_a_control_socket_is_refused_before_motion() {
     let m = machine();
-    let (master_end, _drive_end) = MemLink::pair(16);
+    let (master_end, _drive_end) = drives::link::MemLink::pair(16);
     let opts = RunOptions {
         shop: shop(),
         ..common::run_options("nx-5axis-g43-4.nc", None)
     };
     let src = std::fs::read(posts("nx-5axis-g43-4.nc")).unwrap();
-    let e = run(&src, &m, move || Ok(vec![master_end]), &opts).unwrap_err();
+    let e = dnurbs_tools::run::run(&src, &m, move || Ok(vec![master_end]), &opts).unwrap_err();
     let msg = format!("{e:#}");
     assert!(msg.starts_with("nx-5axis-g43-4.nc:9:"), "{msg}");
     assert!(

@@ -1,32 +1,23 @@
 //! How a run ends, as the operator reads it: the outcome, its exit code, the reason with
 //! the node and the program line, in the report. Against simulated drives on the in-memory
-//! link (`dnurbs_tools::run::run`, the code path of `dnurbs run`), and through the binary
-//! for SIGTERM.
+//! link on simulated time (`dnurbs_tools::run::simulated`, the stages of `dnurbs run`), and
+//! through the binary, in real time, for SIGTERM.
 
 mod common;
 
+use dnurbs_tools::demo::{DEMO_MACHINE, DEMO_PROGRAM};
 use dnurbs_tools::exit;
-use dnurbs_tools::run::{run, DEMO_MACHINE, DEMO_PROGRAM};
+use dnurbs_tools::run::run;
 use drives::sim::Faults;
 use std::time::Duration;
 
-/// The paper example on the paper's machine, its drives simulated with `faults(node)`.
-/// Real time where the privileges allow (the controller SCHED_FIFO 80, the simulated drives
-/// 79, as in `dnurbs demo`), so a loaded machine cannot starve the drives into a feedback
-/// fault; the supervision is relaxed too: these tests are about how a run ends, and the
-/// fault they inject is a drive's own.
+/// The paper example on the paper's machine, its drives simulated with `faults(node)`, on
+/// simulated time.
 fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
-    let mut machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
+    let machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
         .expect("the demo machine");
-    machine.realtime.feedback_timeout_s = 2.0;
-    machine.realtime.heartbeat_timeout_s = 5.0;
-    machine.realtime.max_consecutive_overruns = 100_000;
-    let (links, sim) = common::sim_drives(&machine, faults);
     let opts = common::run_options("paper-example.nc", None);
-    let r =
-        run(DEMO_PROGRAM.as_bytes(), &machine, move || Ok(links), &opts).expect("the run starts");
-    sim.finish();
-    r
+    common::run_simulated(DEMO_PROGRAM.as_bytes(), &machine, faults, &opts, |_, _| {}).0
 }
 
 #[test]
@@ -50,12 +41,9 @@ fn a_drive_fault_ends_the_run_with_exit_3_naming_node_and_line() {
 fn a_run_that_completes_says_so_with_exit_0_or_5() {
     let r = run_with(|_| Faults::default());
     let rep = r.report("paper-example.nc", "paper-ac-table");
-    let expected = if rep.overruns == 0 {
-        exit::COMPLETED
-    } else {
-        exit::COMPLETED_OVERRUNS
-    };
-    assert_eq!(rep.exit_code, expected, "{}", rep.text());
+    // On simulated time no period overruns: the clean exit.
+    assert_eq!(rep.overruns, 0, "{}", rep.text());
+    assert_eq!(rep.exit_code, exit::COMPLETED, "{}", rep.text());
     assert_eq!(rep.stop_reason, None);
     assert_eq!(rep.stop_line, None);
     for d in &rep.drives {
@@ -181,8 +169,8 @@ fn dense_run(compress: bool) {
     assert_eq!((rep.feed_holds, rep.hard_stops), (0, 0), "{}", rep.text());
 }
 
-/// `program` on the demo machine's simulated drives (in-memory link, the code path of `dnurbs
-/// run`); the report and every target the drives received, SYNC by SYNC.
+/// `program` on the demo machine's simulated drives (in-memory link, the stages of `dnurbs
+/// run`, simulated time); the report and every target the drives received, SYNC by SYNC.
 fn run_program(program: &str, name: &str) -> (dnurbs_tools::report::Report, Vec<Vec<i32>>) {
     try_run_program(program, name).expect("the run starts")
 }
@@ -192,16 +180,18 @@ fn try_run_program(
     program: &str,
     name: &str,
 ) -> anyhow::Result<(dnurbs_tools::report::Report, Vec<Vec<i32>>)> {
-    let mut machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
+    let machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
         .expect("the demo machine");
-    machine.realtime.feedback_timeout_s = 2.0;
-    machine.realtime.heartbeat_timeout_s = 5.0;
-    machine.realtime.max_consecutive_overruns = 100_000;
-    let (links, sim) = common::sim_drives(&machine, |_| Faults::default());
     let opts = common::run_options(name, None);
-    let r = run(program.as_bytes(), &machine, move || Ok(links), &opts)?;
+    let (r, records) = dnurbs_tools::run::simulated::run_simulated(
+        dnurbs_tools::feed::Input::Text(program.as_bytes().into()),
+        &machine,
+        common::simulated_buses(&machine, |_| Faults::default()),
+        &opts,
+        |_, _| {},
+    )?;
     let mut per_node = vec![Vec::new(); 8];
-    for rec in sim.finish() {
+    for rec in records {
         per_node[usize::from(rec.node)].push(rec);
     }
     let targets = common::drive_targets(&machine, &per_node);

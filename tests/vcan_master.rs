@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use drives::cia402::{Goal, State};
 use drives::link::SocketLink;
-use drives::master::{configure, Master, SetupOptions, Supervision};
+use drives::master::{configure, Master, SetupOptions, Supervision, WallClock};
 use drives::wire::NodeId;
 use std::time::{Duration, Instant};
 
@@ -48,7 +48,13 @@ fn vcan_master_sets_up_and_drives_sim_drives_process() {
     let mut opts = SetupOptions::new(period);
     opts.boot_timeout = Duration::from_secs(5);
     opts.sdo_timeout = Duration::from_millis(500);
-    let setup = configure(&mut link, &nodes, &opts, &mut |_| {});
+    let setup = configure(
+        &mut link,
+        &nodes,
+        &opts,
+        &mut WallClock::default(),
+        &mut |_| {},
+    );
     let initial = match setup {
         Ok(i) => i,
         Err(e) => panic!("set-up failed: {e}"),
@@ -197,7 +203,13 @@ fn vcan_master_configures_python_canopen_local_node() {
     opts.boot_timeout = Duration::from_secs(10);
     opts.sdo_timeout = Duration::from_secs(2);
     let node = NodeId::new(7).unwrap();
-    let result = configure(&mut link, &[node], &opts, &mut |_| {});
+    let result = configure(
+        &mut link,
+        &[node],
+        &opts,
+        &mut WallClock::default(),
+        &mut |_| {},
+    );
     let status = device.wait().expect("device exits after NMT start");
     let initial =
         result.unwrap_or_else(|e| panic!("set-up of the python-canopen node failed: {e}"));

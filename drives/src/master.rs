@@ -9,5 +9,6 @@ pub mod setup;
 
 pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
 pub use setup::{
-    configure, configure_nodes, NodeSetup, SetupError, SetupErrorKind, SetupOptions, VelocitySetup,
+    configure, configure_nodes, Clock, NodeSetup, SetupError, SetupErrorKind, SetupOptions,
+    VelocitySetup, WallClock,
 };

@@ -176,6 +176,7 @@
 mod dictionary;
 mod drive;
 mod io;
+mod lockstep;
 mod motor;
 mod node;
 mod tables;
@@ -192,6 +193,7 @@ use crate::wire::nmt::{self, Target};
 use crate::wire::{cob, sync, NodeId};
 
 pub use io::IO_FAULT_ERROR_CODE;
+pub use lockstep::Lockstep;
 pub use tables::{DEVICE_TYPE_IO, DEVICE_TYPE_SERVO};
 pub use thread::SimThread;
 

@@ -2,23 +2,43 @@
 //! code path as a real bus): full set-up, enable, >= 1000 cycles, disable; and every fault
 //! injection, each ending with the drives quick-stopped or disabled and an error that names
 //! the node and the cause.
+//!
+//! Master and drives are stepped in turn on a virtual clock (`Lockstep`): the master's
+//! cycle sends its frames, the drives answer them, the clock moves on a period. No test
+//! sleeps or reads the system clock, so none depends on how busy the machine is.
 
 use drives::cia402::{Goal, State};
 use drives::link::{CanLink, SocketLink};
 use drives::master::{
-    configure, DriveFault, FaultCause, Master, SetupErrorKind, SetupOptions, Supervision,
+    configure, Clock, DriveFault, FaultCause, Master, SetupErrorKind, SetupOptions, Supervision,
 };
-use drives::sim::{Faults, Record, SimBus, SimNodeConfig, SimThread};
+use drives::sim::{Faults, Lockstep, Record, SimBus, SimNodeConfig};
 use drives::wire::NodeId;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const PERIOD: f64 = 0.002;
 
-/// The simulated drives in a thread of their own, serving one end of the link.
-fn sim_thread(link: SocketLink, nodes: Vec<SimNodeConfig>) -> SimThread {
-    SimThread::start(link, nodes, PERIOD, Duration::from_micros(50)).expect("sim thread")
+/// The simulated drives on the far end of the link, on a virtual clock.
+fn sim(link: SocketLink, nodes: Vec<SimNodeConfig>) -> Lockstep<SocketLink> {
+    Lockstep::new(link, nodes, PERIOD)
+}
+
+/// A master and its drives, stepped a period at a time.
+struct Rig {
+    m: Master<SocketLink>,
+    drives: Lockstep<SocketLink>,
+}
+
+impl Rig {
+    /// One period: the master's cycle at the present time, the drives' answer, then the
+    /// clock a period on.
+    fn cycle(&mut self, targets: &[i32]) {
+        let now = self.drives.now();
+        self.m.cycle(targets, now.as_secs_f64());
+        self.drives.advance_to(now);
+        self.drives
+            .advance_to(now + Duration::from_secs_f64(PERIOD));
+    }
 }
 
 fn nodes(n: u8) -> Vec<NodeId> {
@@ -55,43 +75,44 @@ const SUPERVISION: Supervision = Supervision {
 };
 
 /// Set up, enable and return a running master.
-fn start(
-    n: u8,
-    faults: impl Fn(u8) -> Faults,
-) -> (Master<SocketLink>, SimThread, Instant, Vec<i32>) {
+fn start(n: u8, faults: impl Fn(u8) -> Faults) -> (Rig, Vec<i32>) {
     start_nodes(n, sim_nodes(n, faults))
 }
 
-fn start_nodes(
-    n: u8,
-    sims: Vec<SimNodeConfig>,
-) -> (Master<SocketLink>, SimThread, Instant, Vec<i32>) {
+fn start_nodes(n: u8, sims: Vec<SimNodeConfig>) -> (Rig, Vec<i32>) {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
-    let drives = sim_thread(drive_end, sims);
-    let initial =
-        configure(&mut link, &nodes(n), &options(), &mut |_| {}).expect("set-up succeeds");
-    let t0 = Instant::now();
-    let mut m = Master::new(link, &nodes(n), &initial, SUPERVISION, 0.0).unwrap();
-    m.set_goal(Goal::Enabled);
+    let mut drives = sim(drive_end, sims);
+    let initial = configure(&mut link, &nodes(n), &options(), &mut drives, &mut |_| {})
+        .expect("set-up succeeds");
+    let m = Master::new(
+        link,
+        &nodes(n),
+        &initial,
+        SUPERVISION,
+        drives.now().as_secs_f64(),
+    );
+    let mut rig = Rig {
+        m: m.unwrap(),
+        drives,
+    };
+    rig.m.set_goal(Goal::Enabled);
     for _ in 0..200 {
-        m.cycle(&initial, t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD));
-        if m.all_in(State::OperationEnabled) {
+        rig.cycle(&initial);
+        if rig.m.all_in(State::OperationEnabled) {
             break;
         }
     }
     assert!(
-        m.all_in(State::OperationEnabled),
+        rig.m.all_in(State::OperationEnabled),
         "not enabled: {:?}",
-        m.status()
+        rig.m.status()
     );
-    (m, drives, t0, initial)
+    (rig, initial)
 }
 
 /// Cycle until `done` (at most `max` cycles), with a ramp on every axis.
 fn run(
-    m: &mut Master<SocketLink>,
-    t0: Instant,
+    rig: &mut Rig,
     initial: &[i32],
     max: usize,
     done: impl Fn(&Master<SocketLink>) -> bool,
@@ -101,9 +122,8 @@ fn run(
         for (t, i) in targets.iter_mut().zip(initial) {
             *t = i + 10 * k as i32;
         }
-        m.cycle(&targets, t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD / 2.0));
-        if done(m) {
+        rig.cycle(&targets);
+        if done(&rig.m) {
             return k + 1;
         }
     }
@@ -112,23 +132,26 @@ fn run(
 
 #[test]
 fn set_up_enable_1000_cycles_and_disable() {
-    let (mut m, drives, t0, initial) = start(5, |_| Faults::default());
+    let (mut rig, initial) = start(5, |_| Faults::default());
     // Set-up read each drive's actual position: the first targets equal it.
     assert_eq!(initial, vec![1000, 2000, 3000, 4000, 5000]);
-    let cycles = run(&mut m, t0, &initial, 1000, |_| false);
+    let cycles = run(&mut rig, &initial, 1000, |_| false);
     assert_eq!(cycles, 1000);
-    assert_eq!(m.fault(), None, "{:?}", m.fault());
-    let last_targets: Vec<i32> = m.status().iter().map(|n| n.target).collect();
-    m.set_goal(Goal::Disabled);
+    assert_eq!(rig.m.fault(), None, "{:?}", rig.m.fault());
+    let last_targets: Vec<i32> = rig.m.status().iter().map(|n| n.target).collect();
+    rig.m.set_goal(Goal::Disabled);
     for _ in 0..50 {
-        m.cycle(&last_targets, t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD));
-        if m.all_in(State::SwitchOnDisabled) {
+        rig.cycle(&last_targets);
+        if rig.m.all_in(State::SwitchOnDisabled) {
             break;
         }
     }
-    assert!(m.all_in(State::SwitchOnDisabled), "{:?}", m.status());
-    let records = drives.finish();
+    assert!(
+        rig.m.all_in(State::SwitchOnDisabled),
+        "{:?}",
+        rig.m.status()
+    );
+    let records = rig.drives.take_records();
     for (i, node) in (1u8..=5).enumerate() {
         let mine: Vec<&Record> = records.iter().filter(|r| r.node == node).collect();
         assert!(mine.len() >= 1000, "node {node}: {} records", mine.len());
@@ -186,19 +209,18 @@ fn stopped(m: &Master<SocketLink>) -> bool {
 
 #[test]
 fn drive_fault_stops_every_drive_and_names_the_node() {
-    let (mut m, drives, t0, initial) = start(5, |i| Faults {
+    let (mut rig, initial) = start(5, |i| Faults {
         fault_at_sync: (i == 3).then_some(300),
         ..Faults::default()
     });
-    run(&mut m, t0, &initial, 2000, stopped);
-    let f = expect_fault(m.fault(), 3);
+    run(&mut rig, &initial, 2000, stopped);
+    let f = expect_fault(rig.m.fault(), 3);
     assert!(
         matches!(f.cause, FaultCause::Emcy(_) | FaultCause::DriveFault { .. }),
         "{f}"
     );
-    assert_stopped(&m, None);
-    assert_eq!(m.status()[2].state, Some(State::Fault));
-    drives.finish();
+    assert_stopped(&rig.m, None);
+    assert_eq!(rig.m.status()[2].state, Some(State::Fault));
 }
 
 #[test]
@@ -206,16 +228,16 @@ fn after_a_fault_no_target_steps_back_to_a_lagging_drive() {
     // Drives 50 ms behind a ramp of 10 counts per cycle (5000 counts/s) are 250 counts
     // behind their targets. Measured before the fix: on the fault every target stepped back
     // to the actual position: node 1 by 255 counts in one period (25x the ramp step).
-    let (mut m, drives, t0, initial) = start_nodes(
+    let (mut rig, initial) = start_nodes(
         3,
         lagging_nodes(3, 0.05, |i| Faults {
             fault_at_sync: (i == 2).then_some(300),
             ..Faults::default()
         }),
     );
-    run(&mut m, t0, &initial, 2000, stopped);
-    expect_fault(m.fault(), 2);
-    let records = drives.finish();
+    run(&mut rig, &initial, 2000, stopped);
+    expect_fault(rig.m.fault(), 2);
+    let records = rig.drives.take_records();
     for node in 1u8..=3 {
         let mine: Vec<&Record> = records.iter().filter(|r| r.node == node).collect();
         let lagging = mine
@@ -240,26 +262,25 @@ fn after_a_fault_no_target_steps_back_to_a_lagging_drive() {
 
 #[test]
 fn lost_heartbeat_stops_every_drive_and_names_the_node() {
-    let (mut m, drives, t0, initial) = start(3, |i| Faults {
+    let (mut rig, initial) = start(3, |i| Faults {
         heartbeat_stops_at: (i == 2).then_some(100),
         ..Faults::default()
     });
-    run(&mut m, t0, &initial, 3000, stopped);
-    let f = expect_fault(m.fault(), 2);
+    run(&mut rig, &initial, 3000, stopped);
+    let f = expect_fault(rig.m.fault(), 2);
     assert!(matches!(f.cause, FaultCause::HeartbeatLost { .. }), "{f}");
     assert!(f.to_string().contains("heartbeat lost"), "{f}");
-    assert_stopped(&m, None);
-    drives.finish();
+    assert_stopped(&rig.m, None);
 }
 
 #[test]
 fn a_node_that_goes_silent_is_a_fault_and_the_others_stop() {
-    let (mut m, drives, t0, initial) = start(3, |i| Faults {
+    let (mut rig, initial) = start(3, |i| Faults {
         silent_from_sync: (i == 1).then_some(200),
         ..Faults::default()
     });
-    run(&mut m, t0, &initial, 3000, stopped);
-    let f = expect_fault(m.fault(), 1);
+    run(&mut rig, &initial, 3000, stopped);
+    let f = expect_fault(rig.m.fault(), 1);
     assert!(
         matches!(
             f.cause,
@@ -267,34 +288,32 @@ fn a_node_that_goes_silent_is_a_fault_and_the_others_stop() {
         ),
         "{f}"
     );
-    assert_stopped(&m, Some(1));
-    drives.finish();
+    assert_stopped(&rig.m, Some(1));
 }
 
 #[test]
 fn occasional_lost_frames_are_retried_and_tolerated() {
     // Every 7th frame of node 2 is lost: SDO retries carry the set-up through and the cycle
     // holds the last feedback for a missed TPDO; no fault.
-    let (mut m, drives, t0, initial) = start(3, |i| Faults {
+    let (mut rig, initial) = start(3, |i| Faults {
         drop_every: (i == 2).then_some(7),
         ..Faults::default()
     });
-    run(&mut m, t0, &initial, 500, |_| false);
-    assert_eq!(m.fault(), None, "{:?}", m.fault());
-    drives.finish();
+    run(&mut rig, &initial, 500, |_| false);
+    assert_eq!(rig.m.fault(), None, "{:?}", rig.m.fault());
 }
 
 #[test]
 fn a_node_that_never_boots_is_a_set_up_error_naming_it() {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
-    let drives = sim_thread(
+    let mut drives = sim(
         drive_end,
         sim_nodes(4, |i| Faults {
             never_boots: i == 4,
             ..Faults::default()
         }),
     );
-    let err = configure(&mut link, &nodes(4), &options(), &mut |_| {}).unwrap_err();
+    let err = configure(&mut link, &nodes(4), &options(), &mut drives, &mut |_| {}).unwrap_err();
     assert_eq!(err.node, 4);
     assert!(
         matches!(err.kind, SetupErrorKind::NoBootUp { cob: 0x704, .. }),
@@ -305,37 +324,44 @@ fn a_node_that_never_boots_is_a_set_up_error_naming_it() {
             .starts_with("node 4: no boot-up message (0x704)"),
         "{err}"
     );
-    drives.finish();
 }
 
 #[test]
 fn an_sdo_abort_is_reported_with_node_object_and_meaning() {
     // A drive that does not know 0x60C2 answers with abort 0x06020000.
-    let (mut link, mut drive_end) = SocketLink::pair().unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = stop.clone();
-    let t = std::thread::spawn(move || {
-        let mut bus = SimBus::new(sim_nodes(1, |_| Faults::default()), PERIOD);
-        let mut out = Vec::new();
-        while !flag.load(Ordering::Relaxed) {
-            while let Ok(Some(f)) = drive_end.recv() {
+    struct Intercepting {
+        bus: SimBus,
+        link: SocketLink,
+        now: Duration,
+    }
+    impl Clock for Intercepting {
+        fn now(&self) -> Duration {
+            self.now
+        }
+        fn idle(&mut self) {
+            let mut out = Vec::new();
+            while let Ok(Some(f)) = self.link.recv() {
                 // Intercept the SDO download to 0x60C2 sub 1 and abort it as unknown.
                 if f.id() == 0x601 && f.data().get(1..4) == Some(&[0xC2, 0x60, 0x01][..]) {
                     out.push("581#80C2600100000206".parse().unwrap());
                     continue;
                 }
-                bus.on_frame(&f, 0.0, &mut |o| out.push(o));
+                self.bus.on_frame(&f, 0.0, &mut |o| out.push(o));
             }
-            bus.poll(0.0, &mut |o| out.push(o));
-            for f in out.drain(..) {
-                let _ = drive_end.send(&f);
+            self.bus.poll(0.0, &mut |o| out.push(o));
+            for f in out {
+                let _ = self.link.send(&f);
             }
-            std::thread::sleep(Duration::from_micros(50));
+            self.now += Duration::from_micros(100);
         }
-    });
-    let err = configure(&mut link, &nodes(1), &options(), &mut |_| {}).unwrap_err();
-    stop.store(true, Ordering::Relaxed);
-    t.join().unwrap();
+    }
+    let (mut link, drive_end) = SocketLink::pair().unwrap();
+    let mut drives = Intercepting {
+        bus: SimBus::new(sim_nodes(1, |_| Faults::default()), PERIOD),
+        link: drive_end,
+        now: Duration::ZERO,
+    };
+    let err = configure(&mut link, &nodes(1), &options(), &mut drives, &mut |_| {}).unwrap_err();
     assert_eq!((err.node, err.object), (1, Some((0x60C2, 1))));
     let text = err.to_string();
     assert!(

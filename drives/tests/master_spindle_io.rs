@@ -2,16 +2,16 @@
 //! against the simulated nodes over the in-process socket link: set-up by SDO as each kind
 //! needs, the spindle ramping to its target with the target-reached bit, the module's
 //! outputs echoed by its inputs, and on a fault of the axis the spindle commanded to 0 and
-//! the outputs switched off.
+//! the outputs switched off. Master and nodes are stepped in turn on a virtual clock.
 
 use drives::cia402::{Goal, State, Statusword};
 use drives::link::SocketLink;
 use drives::master::{
     configure_nodes, Master, NodeKind, NodeSetup, SetupOptions, Supervision, VelocitySetup,
 };
-use drives::sim::{Faults, Record, SimNodeConfig, SimThread};
+use drives::sim::{Faults, Lockstep, Record, SimNodeConfig};
 use drives::wire::NodeId;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 const PERIOD: f64 = 0.002;
 const AXIS: u8 = 1;
@@ -30,8 +30,24 @@ const VELOCITY: VelocitySetup = VelocitySetup {
     window_ms: 10,
 };
 
+/// A master and its nodes, stepped a period at a time.
+struct Rig {
+    m: Master<SocketLink>,
+    sim: Lockstep<SocketLink>,
+}
+
+impl Rig {
+    /// One period: the master's cycle, the nodes' answer, the clock a period on.
+    fn cycle(&mut self, targets: &[i32]) {
+        let now = self.sim.now();
+        self.m.cycle(targets, now.as_secs_f64());
+        self.sim.advance_to(now);
+        self.sim.advance_to(now + Duration::from_secs_f64(PERIOD));
+    }
+}
+
 /// An axis, the spindle and the module, set up and enabled; the axis faults at `fault_at`.
-fn start(fault_at: Option<u64>) -> (Master<SocketLink>, SimThread, Instant) {
+fn start(fault_at: Option<u64>) -> Rig {
     let (mut link, drive_end) = SocketLink::pair().unwrap();
     let mut axis = SimNodeConfig::new(id(AXIS));
     axis.faults = Faults {
@@ -43,7 +59,7 @@ fn start(fault_at: Option<u64>) -> (Master<SocketLink>, SimThread, Instant) {
         SimNodeConfig::new(id(SPINDLE)),
         SimNodeConfig::io(id(IO)),
     ];
-    let sim = SimThread::start(drive_end, sims, PERIOD, Duration::from_micros(50)).unwrap();
+    let mut sim = Lockstep::new(drive_end, sims, PERIOD);
     let setups = [
         NodeSetup::Position(id(AXIS)),
         NodeSetup::Velocity(id(SPINDLE), VELOCITY),
@@ -51,7 +67,8 @@ fn start(fault_at: Option<u64>) -> (Master<SocketLink>, SimThread, Instant) {
     ];
     let mut opts = SetupOptions::new(PERIOD);
     opts.boot_timeout = Duration::from_millis(500);
-    let initial = configure_nodes(&mut link, &setups, &opts, &mut |_| {}).expect("set-up");
+    let initial =
+        configure_nodes(&mut link, &setups, &opts, &mut sim, &mut |_| {}).expect("set-up");
     assert_eq!(initial, [0, 0, 0], "position, velocity actual, inputs");
     let kinds: Vec<_> = setups.iter().map(|s| (s.node(), s.kind())).collect();
     assert_eq!(
@@ -62,18 +79,22 @@ fn start(fault_at: Option<u64>) -> (Master<SocketLink>, SimThread, Instant) {
         heartbeat_timeout_s: 0.35,
         feedback_timeout_cycles: 25,
     };
-    let mut m = Master::with_kinds(link, &kinds, &initial, sup, 0.0).unwrap();
-    let t0 = Instant::now();
-    m.set_goal(Goal::Enabled);
+    let now = sim.now().as_secs_f64();
+    let m = Master::with_kinds(link, &kinds, &initial, sup, now).unwrap();
+    let mut rig = Rig { m, sim };
+    rig.m.set_goal(Goal::Enabled);
     for _ in 0..200 {
-        m.cycle(&[0, 0, 0], t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD));
-        if m.all_in(State::OperationEnabled) {
+        rig.cycle(&[0, 0, 0]);
+        if rig.m.all_in(State::OperationEnabled) {
             break;
         }
     }
-    assert!(m.all_in(State::OperationEnabled), "{:?}", m.status());
-    (m, sim, t0)
+    assert!(
+        rig.m.all_in(State::OperationEnabled),
+        "{:?}",
+        rig.m.status()
+    );
+    rig
 }
 
 fn records_of(records: &[Record], node: u8) -> Vec<Record> {
@@ -82,25 +103,24 @@ fn records_of(records: &[Record], node: u8) -> Vec<Record> {
 
 #[test]
 fn the_spindle_ramps_to_speed_and_the_outputs_are_echoed() {
-    let (mut m, sim, t0) = start(None);
+    let mut rig = start(None);
     let mut at_speed = None;
     for k in 0..400 {
-        m.cycle(&[0, 1200, 0x02], t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD));
-        let s = m.status()[1];
+        rig.cycle(&[0, 1200, 0x02]);
+        let s = rig.m.status()[1];
         if at_speed.is_none() && Statusword(s.statusword).target_reached() && s.actual == 1200 {
             at_speed = Some(k);
         }
     }
-    let io = m.status()[2];
+    let io = rig.m.status()[2];
     assert_eq!(
         (io.target, io.actual),
         (0x02, 0x02),
         "outputs and the inputs echoing them"
     );
     assert_eq!(io.state, None, "an I/O module has no CiA-402 state");
-    assert!(m.fault().is_none(), "{:?}", m.fault());
-    let records = sim.finish();
+    assert!(rig.m.fault().is_none(), "{:?}", rig.m.fault());
+    let records = rig.sim.take_records();
     let spindle = records_of(&records, SPINDLE);
     // The drive ramps at 0x6083: 12 units per 2 ms SYNC, so 1200 takes 100 SYNCs.
     let first = spindle
@@ -127,17 +147,16 @@ fn the_spindle_ramps_to_speed_and_the_outputs_are_echoed() {
 
 #[test]
 fn a_fault_stops_the_spindle_and_switches_the_outputs_off() {
-    let (mut m, sim, t0) = start(Some(150));
+    let mut rig = start(Some(150));
     for _ in 0..400 {
-        m.cycle(&[0, 1200, 0x03], t0.elapsed().as_secs_f64());
-        std::thread::sleep(Duration::from_secs_f64(PERIOD));
+        rig.cycle(&[0, 1200, 0x03]);
     }
-    let f = m.fault().copied().expect("the axis faulted");
+    let f = rig.m.fault().copied().expect("the axis faulted");
     assert_eq!(f.node, AXIS);
-    assert_ne!(m.goal(), Goal::Enabled);
-    assert_eq!(m.status()[1].target, 0, "spindle commanded to 0");
-    assert_eq!(m.status()[2].target, 0, "outputs off");
-    let records = sim.finish();
+    assert_ne!(rig.m.goal(), Goal::Enabled);
+    assert_eq!(rig.m.status()[1].target, 0, "spindle commanded to 0");
+    assert_eq!(rig.m.status()[2].target, 0, "outputs off");
+    let records = rig.sim.take_records();
     let io = records_of(&records, IO);
     assert!(
         io.iter().any(|r| r.target_counts == 0x03),

@@ -16,6 +16,7 @@
 //! `tests/pipeline_no_alloc.rs` count allocations and page faults over >= 100 000 periods).
 //! Everything else (set-up, planner, reporter, control socket) runs in ordinary threads.
 
+pub mod clock;
 pub mod control;
 pub mod interval;
 pub mod latency;

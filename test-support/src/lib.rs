@@ -78,6 +78,17 @@ pub fn disarm_this_thread() -> u64 {
     THIS_EVENTS.with(Cell::get)
 }
 
+/// Stop counting this thread's for a while, keeping its count (work beside the proof that
+/// runs in the same thread: simulated drives stepped between two periods).
+pub fn pause_this_thread() {
+    THIS_ARMED.with(|a| a.set(false));
+}
+
+/// Count this thread's again, on from where [`pause_this_thread`] left the count.
+pub fn resume_this_thread() {
+    THIS_ARMED.with(|a| a.set(true));
+}
+
 #[cfg(test)]
 #[global_allocator]
 static ALLOC: CountingAlloc = CountingAlloc;
@@ -99,5 +110,13 @@ mod tests {
         arm_this_thread();
         let idle = disarm_this_thread();
         assert_eq!(idle, 0);
+        // Paused, nothing is counted; resumed, counting goes on from the count kept.
+        arm_this_thread();
+        drop(std::hint::black_box(Box::new(1u8)));
+        pause_this_thread();
+        drop(std::hint::black_box(Box::new(2u8)));
+        resume_this_thread();
+        drop(std::hint::black_box(Box::new(3u8)));
+        assert_eq!(disarm_this_thread(), 4);
     }
 }

@@ -262,6 +262,71 @@ impl Sims {
     }
 }
 
+/// [`sim_drives`] on a virtual clock: per bus, the master's end of an in-memory link and
+/// the drives on the other, stepped in turn with the loop (`dnurbs_tools::run::simulated`).
+pub fn simulated_buses(
+    machine: &config::Machine,
+    faults: impl Fn(u8) -> drives::sim::Faults,
+) -> Vec<(
+    drives::link::MemLink,
+    drives::sim::Lockstep<drives::link::MemLink>,
+)> {
+    (0..machine.buses.len())
+        .map(|bus| {
+            let (master_end, drive_end) = drives::link::MemLink::pair(1024);
+            let mut nodes =
+                dnurbs_tools::simdrives::sim_nodes(machine, bus, 0.0, &Default::default());
+            for n in nodes.iter_mut() {
+                n.faults = faults(n.node.get());
+            }
+            let sim = drives::sim::Lockstep::new(drive_end, nodes, machine.period_s);
+            (master_end, sim)
+        })
+        .collect()
+}
+
+/// Run `src` on `machine`'s drives simulated with `faults(node)`, on simulated time;
+/// `operator` acts once a period on what the loop published. The result and every target
+/// the drives took.
+pub fn run_simulated(
+    src: &[u8],
+    machine: &config::Machine,
+    faults: impl Fn(u8) -> drives::sim::Faults,
+    opts: &dnurbs_tools::run::RunOptions,
+    operator: impl FnMut(
+        &rt_loop::pipeline::Progress,
+        &mut rt_loop::control::Producer<'_, rt_loop::control::Command>,
+    ),
+) -> (dnurbs_tools::run::RunResult, Vec<drives::sim::Record>) {
+    dnurbs_tools::run::simulated::run_simulated(
+        dnurbs_tools::feed::Input::Text(src.into()),
+        machine,
+        simulated_buses(machine, faults),
+        opts,
+        operator,
+    )
+    .expect("the run starts")
+}
+
+/// The operator of a simulated run who resumes every operator stop (`M00`, `M01`, `M06`)
+/// the path waits at, noting its line.
+pub fn resume_every_stop(
+    resumed: &mut Vec<u32>,
+) -> impl FnMut(
+    &rt_loop::pipeline::Progress,
+    &mut rt_loop::control::Producer<'_, rt_loop::control::Command>,
+) + '_ {
+    let mut at = None;
+    move |p, tx| {
+        let now = p.snapshot().awaiting;
+        if now.is_some() && now != at {
+            resumed.extend(now);
+            let _ = tx.enqueue(rt_loop::control::Command::Resume);
+        }
+        at = now;
+    }
+}
+
 /// Run options of the tests: approach, the controller at SCHED_FIFO 80 where allowed, no
 /// report, no progress line.
 pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::RunOptions {

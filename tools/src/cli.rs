@@ -2,7 +2,7 @@
 //! ([`duration`]: a number and a unit, `500us`, `10ms`, `5s`, `2min`) and ranges stated in
 //! every range error.
 
-use crate::run::DemoLink;
+use crate::demo::DemoLink;
 use crate::simdrives;
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;

@@ -23,8 +23,42 @@ use nc_plan::stream::{ProgramSource, Source, StreamError};
 use std::collections::VecDeque;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::mpsc::{Receiver, SyncSender};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::{Duration, Instant};
+
+/// When the planner thread takes its next round (free what came back, push what fits).
+pub enum Pace {
+    /// Every millisecond, until the run is over (`finished`).
+    Wall(Arc<AtomicBool>),
+    /// When the simulated machine asks, once a period: a round per message on `go`,
+    /// answered on `done`, until the machine hangs up. The planner and the loop then take
+    /// turns as the loop and the drives do ([`crate::run::simulated`]).
+    Lockstep {
+        go: Receiver<()>,
+        done: SyncSender<()>,
+    },
+}
+
+impl Pace {
+    /// Wait for the next round; `false` once the run is over.
+    fn next_round(&mut self) -> bool {
+        match self {
+            Pace::Wall(finished) => !finished.load(Ordering::Acquire),
+            Pace::Lockstep { go, .. } => go.recv().is_ok(),
+        }
+    }
+
+    /// The round is done.
+    fn round_done(&mut self) {
+        match self {
+            Pace::Wall(_) => std::thread::sleep(Duration::from_millis(1)),
+            Pace::Lockstep { done, .. } => {
+                let _ = done.send(());
+            }
+        }
+    }
+}
 
 /// Programs up to this size are checked whole before anything moves (about 130 000 lines
 /// of a CAM post, read in 0.1 to 0.2 s at the pre-pass's 0.6 to 1.25 M lines a second).
@@ -227,11 +261,11 @@ impl Job {
 }
 
 /// The planner thread's body: check, plan the first window, say `ready`, then plan and push
-/// chunks into `feeder` until `finished` (the run is over) or the program's end.
+/// chunks into `feeder`, a round at the `pace` asked, until the run is over.
 pub fn plan_and_feed(
     job: &Job,
     mut feeder: Feeder,
-    finished: &AtomicBool,
+    mut pace: Pace,
     ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
     learned: &Arc<Learned>,
 ) {
@@ -239,7 +273,7 @@ pub fn plan_and_feed(
     // refused at the line being planned, and stops along the path. (Before the first
     // window the dropped sender ends the run: "the planner thread ended without a result".)
     let body =
-        std::panic::AssertUnwindSafe(|| feed_program(job, &mut feeder, finished, ready, learned));
+        std::panic::AssertUnwindSafe(|| feed_program(job, &mut feeder, &mut pace, ready, learned));
     if let Err(panic) = std::panic::catch_unwind(body) {
         let what = panic
             .downcast_ref::<&str>()
@@ -252,9 +286,9 @@ pub fn plan_and_feed(
             format!("{}:{line}: internal error in the planner: {what}", job.name),
         );
         feeder.refuse(line);
-        while !finished.load(Ordering::Acquire) {
+        while pace.next_round() {
             feeder.feed(&mut std::iter::empty());
-            std::thread::sleep(Duration::from_millis(1));
+            pace.round_done();
         }
     }
     // Free what the interpolator handed back.
@@ -264,7 +298,7 @@ pub fn plan_and_feed(
 fn feed_program(
     job: &Job,
     feeder: &mut Feeder,
-    finished: &AtomicBool,
+    pace: &mut Pace,
     ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
     learned: &Arc<Learned>,
 ) {
@@ -314,7 +348,7 @@ fn feed_program(
         inner: entries,
         learned,
     };
-    run.go(Source::new(entries, m, job.depth), feeder, finished, ready);
+    run.go(Source::new(entries, m, job.depth), feeder, pace, ready);
 }
 
 /// The program's lines, ready to stream, and whether it was checked whole.
@@ -375,7 +409,7 @@ impl Feed<'_> {
         self,
         mut source: Source<'_, Noting<'_, Compressing<'_, E>>>,
         feeder: &mut Feeder,
-        finished: &AtomicBool,
+        pace: &mut Pace,
         ready: std::sync::mpsc::SyncSender<Result<Ready, InputError>>,
     ) {
         if let Some(&n) = self.learned.lines.get() {
@@ -412,7 +446,7 @@ impl Feed<'_> {
             return;
         }
         let mut stopped = false;
-        while !finished.load(Ordering::Acquire) {
+        while pace.next_round() {
             if !stopped {
                 if let Some((line, _)) = self.learned.refusal() {
                     feeder.refuse(line);
@@ -458,7 +492,7 @@ impl Feed<'_> {
                     .lock()
                     .unwrap_or_else(|e| e.into_inner()) = Some(c.into());
             }
-            std::thread::sleep(Duration::from_millis(1));
+            pace.round_done();
         }
     }
 }

@@ -5,6 +5,7 @@
 pub mod cli;
 pub mod commands;
 pub mod control;
+pub mod demo;
 pub mod exit;
 pub mod feed;
 pub mod report;

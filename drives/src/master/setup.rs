@@ -19,6 +19,11 @@
 //!
 //! Every SDO transfer has a timeout and a bounded number of retries. Frames that arrive in
 //! between (heartbeats, EMCY) are not lost: they are handed to an observer.
+//!
+//! Time is the caller's ([`Clock`]): the set-up measures its timeouts on it and hands it the
+//! waits, never reading the system clock or sleeping itself. [`WallClock`] is the real one;
+//! a bus of simulated drives on a virtual clock (`crate::sim::Lockstep`) steps its nodes
+//! instead, so a test of the whole set-up takes no time and does not depend on the machine.
 
 use crate::link::{CanLink, LinkError};
 use crate::master::NodeKind;
@@ -33,6 +38,49 @@ use crate::wire::sdo::{self, SdoResponse, SdoValue};
 use crate::wire::{classify, AbortCode, NodeId, Received};
 use crate::CanFrame;
 use std::time::{Duration, Instant};
+
+/// The set-up's sense of time.
+pub trait Clock {
+    /// Time since an arbitrary origin.
+    fn now(&self) -> Duration;
+    /// Nothing has arrived that the set-up waits for (or the link's queue is full): let time
+    /// pass. A wall clock sleeps briefly; simulated drives answer and the clock moves on.
+    fn idle(&mut self);
+}
+
+/// Wall time: [`Instant`], and a short sleep while idle.
+#[derive(Clone, Copy, Debug)]
+pub struct WallClock {
+    t0: Instant,
+    pause: Duration,
+}
+
+impl WallClock {
+    /// A clock that sleeps `pause` while the set-up waits (100 to 200 µs answer a drive
+    /// within a small share of an SDO timeout without spinning a CPU).
+    pub fn new(pause: Duration) -> Self {
+        WallClock {
+            t0: Instant::now(),
+            pause,
+        }
+    }
+}
+
+impl Default for WallClock {
+    fn default() -> Self {
+        WallClock::new(Duration::from_micros(100))
+    }
+}
+
+impl Clock for WallClock {
+    fn now(&self) -> Duration {
+        self.t0.elapsed()
+    }
+
+    fn idle(&mut self) {
+        std::thread::sleep(self.pause);
+    }
+}
 
 /// Timeouts and retries of the set-up.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -150,19 +198,20 @@ pub fn interpolation_period(period_s: f64) -> Option<(u8, i8)> {
     })
 }
 
-struct Session<'a, L: CanLink> {
+struct Session<'a, L: CanLink, C: Clock> {
     link: &'a mut L,
+    clock: &'a mut C,
     opts: SetupOptions,
     observe: &'a mut dyn FnMut(&CanFrame),
 }
 
-impl<L: CanLink> Session<'_, L> {
+impl<L: CanLink, C: Clock> Session<'_, L, C> {
     fn send(&mut self, node: NodeId, frame: &CanFrame) -> Result<(), SetupError> {
         // Outside the RT thread a full queue is waited out briefly, not dropped.
         for _ in 0..100 {
             match self.link.send(frame) {
                 Ok(crate::link::Sent::Queued) => return Ok(()),
-                Ok(crate::link::Sent::Dropped) => std::thread::sleep(Duration::from_micros(200)),
+                Ok(crate::link::Sent::Dropped) => self.clock.idle(),
                 Err(e) => {
                     return Err(SetupError {
                         node: node.get(),
@@ -195,8 +244,8 @@ impl<L: CanLink> Session<'_, L> {
         let attempts = self.opts.sdo_retries + 1;
         for _ in 0..attempts {
             self.send(node, &request)?;
-            let deadline = Instant::now() + self.opts.sdo_timeout;
-            while Instant::now() < deadline {
+            let deadline = self.clock.now() + self.opts.sdo_timeout;
+            while self.clock.now() < deadline {
                 match self.link.recv().map_err(|e| err(SetupErrorKind::Link(e)))? {
                     Some(f) if classify(&f) == (Received::SdoResponse { node }) => {
                         let response = sdo::decode_response(node, &f)
@@ -209,7 +258,7 @@ impl<L: CanLink> Session<'_, L> {
                         };
                     }
                     Some(f) => (self.observe)(&f),
-                    None => std::thread::sleep(Duration::from_micros(100)),
+                    None => self.clock.idle(),
                 }
             }
         }
@@ -359,10 +408,11 @@ pub fn configure<L: CanLink>(
     link: &mut L,
     nodes: &[NodeId],
     opts: &SetupOptions,
+    clock: &mut impl Clock,
     observe: &mut dyn FnMut(&CanFrame),
 ) -> Result<Vec<i32>, SetupError> {
     let setups: Vec<NodeSetup> = nodes.iter().map(|&n| NodeSetup::Position(n)).collect();
-    configure_nodes(link, &setups, opts, observe)
+    configure_nodes(link, &setups, opts, clock, observe)
 }
 
 /// As [`configure`], each node as what it is (axis, spindle, I/O module). Returns what each
@@ -371,6 +421,7 @@ pub fn configure_nodes<L: CanLink>(
     link: &mut L,
     setups: &[NodeSetup],
     opts: &SetupOptions,
+    clock: &mut impl Clock,
     observe: &mut dyn FnMut(&CanFrame),
 ) -> Result<Vec<i32>, SetupError> {
     let nodes: Vec<NodeId> = setups.iter().map(NodeSetup::node).collect();
@@ -378,6 +429,7 @@ pub fn configure_nodes<L: CanLink>(
     let first = nodes.first().map_or(0, |n| n.get());
     let mut s = Session {
         link,
+        clock,
         opts: *opts,
         observe,
     };
@@ -395,8 +447,8 @@ pub fn configure_nodes<L: CanLink>(
         )?;
     }
     let mut booted = vec![false; nodes.len()];
-    let deadline = Instant::now() + opts.boot_timeout;
-    while booted.iter().any(|b| !b) && Instant::now() < deadline {
+    let deadline = s.clock.now() + opts.boot_timeout;
+    while booted.iter().any(|b| !b) && s.clock.now() < deadline {
         match s.link.recv().map_err(|e| SetupError {
             node: first,
             object: None,
@@ -410,7 +462,7 @@ pub fn configure_nodes<L: CanLink>(
                 }
                 _ => (s.observe)(&f),
             },
-            None => std::thread::sleep(Duration::from_micros(200)),
+            None => s.clock.idle(),
         }
     }
     if let Some(i) = booted.iter().position(|b| !b) {

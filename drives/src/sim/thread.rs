@@ -46,16 +46,7 @@ impl SimThread {
                 let mut out = Vec::new();
                 while !flag.load(Ordering::Relaxed) {
                     let now = t0.elapsed().as_secs_f64();
-                    let mut idle = true;
-                    while let Ok(Some(f)) = link.recv() {
-                        bus.on_frame(&f, now, &mut |o| out.push(o));
-                        idle = false;
-                    }
-                    bus.poll(now, &mut |o| out.push(o));
-                    for f in out.drain(..) {
-                        let _ = link.send(&f);
-                    }
-                    if idle {
+                    if !super::lockstep::serve(&mut bus, &mut link, now, &mut out) {
                         std::thread::sleep(poll);
                     }
                 }

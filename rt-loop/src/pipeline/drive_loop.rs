@@ -3,7 +3,7 @@
 //! thread.
 
 use super::{Pipeline, Progress};
-use crate::os;
+use crate::clock::LoopClock;
 use drives::link::CanLink;
 
 /// With a lead: a pause between two clock reads longer than this, ns, means something else
@@ -56,6 +56,9 @@ impl Slots {
 /// record wake-up latency, compute time and whole-cycle time, publish progress. Ends when
 /// the pipeline has finished, or after `max_cycles` (a bound for tests and a last resort).
 /// Allocation-free; overruns are counted and the missed deadlines skipped, never caught up.
+/// Time is `clock`'s: the monotonic clock in the real-time thread
+/// ([`OsClock`](crate::clock::OsClock)), or a virtual one that steps the rest of the machine
+/// while the loop sleeps ([`VirtualClock`](crate::clock::VirtualClock)).
 ///
 /// With a `lead_ns` above zero (at most half the period: more is cut to that; the machine
 /// file and the command line refuse it) the thread wakes that much before each deadline,
@@ -70,9 +73,11 @@ impl Slots {
 /// lead costs its length in CPU time per period.
 ///
 /// Real-time thread.
+#[allow(clippy::too_many_arguments)]
 pub fn drive_loop<L: CanLink>(
     rec: &mut crate::interval::Recorder<'_>,
     pipeline: &mut Pipeline<'_, L>,
+    clock: &mut impl LoopClock,
     period_ns: u64,
     lead_ns: u64,
     stop: &std::sync::atomic::AtomicBool,
@@ -83,34 +88,36 @@ pub fn drive_loop<L: CanLink>(
     let period = period_ns.max(1);
     let lead = lead_ns.min(period / 2);
     let mut slots = Slots::new(lead);
-    let mut next = os::now().saturating_add(period);
+    let mut next = clock.now().saturating_add(period);
     let (mut underruns, mut total_overruns) = (0, 0);
     let mut run = crate::stats::OverrunRun::default();
     for _ in 0..max_cycles {
         let wake_at = next.saturating_sub(lead);
-        os::sleep_until(wake_at);
-        let woke = os::now();
+        clock.sleep_until(wake_at);
+        let woke = clock.now();
         let start = if lead > 0 {
             // Rehearsing only right before the step gave a compute p99.9 of 0.69-0.73 us in
             // pinned demo runs here; also at the wake-up and after each pause, 0.47-0.63 us.
             pipeline.rehearse();
             let slot = next.saturating_sub(slots.before[slots.choose(woke)]);
-            os::spin_until(slot, lead, GAP_NS, |at| {
+            clock.spin_until(slot, lead, GAP_NS, |at| {
                 slots.disturbed(at, next);
                 pipeline.rehearse();
             });
             pipeline.rehearse();
-            let t0 = os::now();
+            let t0 = clock.now();
             pipeline.prepare();
-            if os::now().saturating_sub(t0) > GAP_NS {
+            if clock.now().saturating_sub(t0) > GAP_NS {
                 slots.disturbed(t0, next);
             }
-            os::spin_until(next, lead, GAP_NS, |at| slots.disturbed(at, next)).max(woke)
+            clock
+                .spin_until(next, lead, GAP_NS, |at| slots.disturbed(at, next))
+                .max(woke)
         } else {
             woke
         };
         let info = pipeline.cycle(start, stop.load(Relaxed));
-        let done = os::now();
+        let done = clock.now();
         let stats = rec.stats();
         let (late, busy) = (woke.saturating_sub(wake_at), done.saturating_sub(start));
         if info.compute_ns > 0 {

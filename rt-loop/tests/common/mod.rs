@@ -1,15 +1,18 @@
 //! What the pipeline tests stand on: five CiA-402 drives (nodes 1..=5 for X Y Z A C),
-//! simulated on the far end of a link, configured and taken over by a master.
+//! simulated on the far end of a link, configured and taken over by a master; and the whole
+//! pipeline run on a virtual clock ([`run_pipeline`]): the loop, the planner's pushes and the
+//! drives' answers take turns, a period at a time, as fast as the machine computes them.
 #![allow(dead_code)]
 
 use drives::link::{CanLink, MemLink};
-use drives::master::{configure, Master, SetupOptions, Supervision};
-use drives::sim::{Record, SimNodeConfig, SimThread};
+use drives::master::{configure, Master, SetupOptions, Supervision, WallClock};
+use drives::sim::{Lockstep, Record, SimNodeConfig, SimThread};
 use drives::wire::NodeId;
 use machine::bus::Drive;
 use nc_follow::{Follower, Queues};
 use nc_geom::kinematics::MachineKinematics;
 use nc_plan::stream::chunks;
+use rt_loop::clock::VirtualClock;
 use rt_loop::interval::{Queues as IntervalQueues, Recorder};
 use rt_loop::os;
 use rt_loop::pipeline::{
@@ -33,10 +36,14 @@ pub fn sim_bus<L: CanLink, D: CanLink + Send + 'static>(
     period: f64,
     counts_per_unit: [f64; 5],
 ) -> (BusDrives<L>, SimThread) {
-    let sims = (1..=5)
-        .map(|n| SimNodeConfig::new(NodeId::new(n).unwrap()))
-        .collect();
-    sim_bus_with(link, drive_end, period, counts_per_unit, sims, LENIENT)
+    sim_bus_with(
+        link,
+        drive_end,
+        period,
+        counts_per_unit,
+        five_drives(),
+        LENIENT,
+    )
 }
 
 /// [`sim_bus`] with the simulated nodes (1..=5, with their faults) and supervision given.
@@ -48,16 +55,7 @@ pub fn sim_bus_with<L: CanLink, D: CanLink + Send + 'static>(
     sims: Vec<SimNodeConfig>,
     sup: Supervision,
 ) -> (BusDrives<L>, SimThread) {
-    let drives: Vec<Drive> = (0..5)
-        .map(|axis| Drive {
-            axis,
-            bus: 0,
-            node: axis as u8 + 1,
-            counts_per_unit: counts_per_unit[axis],
-            sign: 1,
-            offset: 0,
-        })
-        .collect();
+    let drives = axis_drives(counts_per_unit);
     let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
     // SCHED_FIFO where allowed (one below the loop's): on a loaded machine a starved drive
     // thread would miss its feedback deadline, a fault these tests did not inject.
@@ -67,9 +65,44 @@ pub fn sim_bus_with<L: CanLink, D: CanLink + Send + 'static>(
     .unwrap();
     let mut opts = SetupOptions::new(period);
     opts.boot_timeout = Duration::from_secs(5);
-    let initial = configure(&mut link, &nodes, &opts, &mut |_| {}).unwrap();
+    let initial = configure(
+        &mut link,
+        &nodes,
+        &opts,
+        &mut WallClock::default(),
+        &mut |_| {},
+    )
+    .unwrap();
     let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9).unwrap();
     (BusDrives::new(master, &drives).unwrap(), sim)
+}
+
+/// Drives for X Y Z A C on nodes 1..=5, as simulated nodes.
+pub fn five_drives() -> Vec<SimNodeConfig> {
+    (1..=5)
+        .map(|n| SimNodeConfig::new(NodeId::new(n).unwrap()))
+        .collect()
+}
+
+/// [`sim_bus_with`] on a virtual clock: the drives `sims` on `drive_end`, set up by the
+/// master on `link` with their waits on the drives' clock.
+pub fn lockstep_bus<L: CanLink, D: CanLink>(
+    mut link: L,
+    drive_end: D,
+    period: f64,
+    counts_per_unit: [f64; 5],
+    sims: Vec<SimNodeConfig>,
+    sup: Supervision,
+) -> (BusDrives<L>, Lockstep<D>) {
+    let mut sim = Lockstep::new(drive_end, sims, period);
+    let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
+    let mut opts = SetupOptions::new(period);
+    opts.boot_timeout = Duration::from_secs(5);
+    let initial = configure(&mut link, &nodes, &opts, &mut sim, &mut |_| {}).unwrap();
+    let now = sim.now().as_secs_f64();
+    let master = Master::new(link, &nodes, &initial, sup, now).unwrap();
+    let bus = BusDrives::new(master, &axis_drives(counts_per_unit)).unwrap();
+    (bus, sim)
 }
 
 /// A program run through the whole `run` pipeline on the in-memory link.
@@ -93,14 +126,29 @@ pub struct Rig {
     pub enable_cycles: u64,
     /// A bound on the loop, a last resort.
     pub max_cycles: u64,
-    /// The loop's period when it is not the plan's (a period no cycle can meet), ns.
+    /// The loop's period when it is not the plan's (a period no cycle can meet), ns; every
+    /// read of the clock then takes 1 us of it.
     pub loop_period_ns: Option<u64>,
     /// `[realtime] max_consecutive_overruns`.
     pub max_overruns: u64,
 }
 
-/// Plan `src` on the small mill at the rig's period and run it: planner feeding the
-/// segment queue from this thread, `drive_loop` in another, to the simulated drives.
+fn axis_drives(counts_per_unit: [f64; 5]) -> Vec<Drive> {
+    (0..5)
+        .map(|axis| Drive {
+            axis,
+            bus: 0,
+            node: axis as u8 + 1,
+            counts_per_unit: counts_per_unit[axis],
+            sign: 1,
+            offset: 0,
+        })
+        .collect()
+}
+
+/// Plan `src` on the small mill at the rig's period and run it through the whole pipeline on
+/// a virtual clock: set-up, then `drive_loop`, the planner feeding the segment queue and
+/// the drives answering while the loop sleeps.
 pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc_plan::fixtures::small_mill(rig.period);
@@ -110,7 +158,7 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     let (start, list) = chunks(path, &profile, &cfg.hold(), 64);
     let mut source = list.into_iter();
     let (link, drive_end) = MemLink::pair(1024);
-    let (bus, sim) = sim_bus_with(
+    let (bus, mut sim) = lockstep_bus(
         link,
         drive_end,
         rig.period,
@@ -118,6 +166,7 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
         rig.sims,
         rig.sup,
     );
+    let t0 = sim.now().as_nanos() as u64;
     let mut queues = Queues::new();
     let (mut feeder, inlet) = queues.split(64);
     feeder.feed(&mut source);
@@ -134,42 +183,42 @@ pub fn run_pipeline(src: &str, rig: Rig) -> PipelineRun {
     .unwrap();
     pipeline.set_max_consecutive_overruns(rig.max_overruns);
     let (mut iq, first) = IntervalQueues::new();
-    let (full, _full_c) = iq.full.split();
-    let (_free_p, free) = iq.free.split();
+    let (full, mut full_c) = iq.full.split();
+    let (mut free_p, free) = iq.free.split();
     let progress = Progress::default();
-    let finished = AtomicBool::new(false);
     let stop = AtomicBool::new(false);
-    std::thread::scope(|s| {
-        let (progress, finished, stop, pl) = (&progress, &finished, &stop, &mut pipeline);
-        let rt = s.spawn(move || {
-            let _ = os::set_fifo(80);
-            let mut rec = Recorder::new(first, full, free, 100_000_000, os::now());
-            drive_loop(
-                &mut rec,
-                pl,
-                rig.loop_period_ns.unwrap_or((rig.period * 1e9) as u64),
-                if rig.loop_period_ns.is_some() {
-                    0
-                } else {
-                    50_000
-                },
-                stop,
-                progress,
-                rig.max_cycles,
-            );
-            finished.store(true, Ordering::SeqCst);
-        });
-        while !finished.load(Ordering::SeqCst) {
+    {
+        let world = |t: u64| {
+            // What the other threads do while the loop sleeps: the drives answer the
+            // period's frames, the reporter hands the intervals back, the planner pushes.
+            sim.advance_to(std::time::Duration::from_nanos(t));
+            while let Some(mut iv) = full_c.dequeue() {
+                iv.stats.clear();
+                let _ = free_p.enqueue(iv);
+            }
             feeder.feed(&mut source);
-            std::thread::sleep(Duration::from_millis(1));
+        };
+        let mut clock = VirtualClock::new(t0, world);
+        if rig.loop_period_ns.is_some() {
+            clock = clock.reads_take(1_000);
         }
-        rt.join().unwrap();
-    });
+        let mut rec = Recorder::new(first, full, free, 100_000_000, t0);
+        drive_loop(
+            &mut rec,
+            &mut pipeline,
+            &mut clock,
+            rig.loop_period_ns.unwrap_or((rig.period * 1e9) as u64),
+            0,
+            &stop,
+            &progress,
+            rig.max_cycles,
+        );
+    }
     feeder.feed(&mut std::iter::empty());
     PipelineRun {
         stage: pipeline.stage(),
         reason: pipeline.reason(),
-        records: sim.finish(),
+        records: sim.take_records(),
         cycles: progress.cycles.load(Ordering::SeqCst),
     }
 }

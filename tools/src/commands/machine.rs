@@ -1,8 +1,9 @@
 //! `run` and `demo`: the drives, the real-time thread, the report.
 
 use super::{cpu_text, keep_off_rt_cpu, report_dir};
+use crate::demo::DemoLink;
 use crate::exit::{InputError, Outcome};
-use crate::run::{DemoLink, RunOptions, RunResult};
+use crate::run::{RunOptions, RunResult};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 
@@ -70,9 +71,9 @@ pub fn demo(
     );
     let input = match program {
         Some(p) => crate::feed::Input::File(p),
-        None => crate::feed::Input::Text(crate::run::DEMO_PROGRAM.as_bytes().into()),
+        None => crate::feed::Input::Text(crate::demo::DEMO_PROGRAM.as_bytes().into()),
     };
-    let (r, records) = crate::run::demo(&opts, link, input)?;
+    let (r, records) = crate::demo::demo(&opts, link, input)?;
     println!("simulated drives received {} targets", records.len());
     let title = if name == "paper-example.nc" {
         "dnurbs demo: paper example, 2 ms".to_string()

@@ -1,0 +1,78 @@
+//! `dnurbs demo`: the paper's example on the paper's machine, its five drives simulated in
+//! a thread on the other end of an in-process link, in real time.
+
+use crate::feed::Input;
+use crate::run::{run_input, RunOptions, RunResult};
+use config::Machine;
+use drives::link::{CanLink, MemLink, SocketLink};
+use rt_loop::os;
+use std::time::Duration;
+
+/// The demo's machine: the paper's machine (its drives on an in-process bus).
+pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-table.toml");
+/// The demo's program: the paper's example.
+pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
+
+/// The in-process bus of `dnurbs demo` (`--link`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoLink {
+    /// Lock-free queues in memory (`MemLink`): the cycle makes no system call for the bus.
+    Memory,
+    /// A kernel socketpair (`SocketLink::pair`) carrying `can_frame` structs through the
+    /// same system calls as a CAN interface (`sendmmsg`/`recvmmsg` per cycle).
+    Socketpair,
+}
+
+/// Frames each direction of the demo's memory bus holds (a few hundred periods' worth).
+pub const DEMO_QUEUE_FRAMES: usize = 1024;
+
+/// `dnurbs demo`: the paper's example on the paper's machine, its five drives simulated in a
+/// thread on the other end of an in-process link.
+pub fn demo(
+    opts: &RunOptions,
+    link: DemoLink,
+    input: Input,
+) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
+    let machine = config::from_str(
+        DEMO_MACHINE,
+        std::path::Path::new("config/machines/paper-ac-table.toml"),
+    )?;
+    match link {
+        DemoLink::Memory => demo_on(&machine, opts, input, || {
+            Ok(MemLink::pair(DEMO_QUEUE_FRAMES))
+        }),
+        DemoLink::Socketpair => demo_on(&machine, opts, input, SocketLink::pair),
+    }
+}
+
+fn demo_on<L: CanLink + Send + 'static>(
+    machine: &Machine,
+    opts: &RunOptions,
+    input: Input,
+    pair: impl Fn() -> std::io::Result<(L, L)>,
+) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
+    let mut links = Vec::new();
+    let mut sims = Vec::new();
+    for bi in 0..machine.buses.len() {
+        let (master_end, drive_end) = pair()?;
+        let nodes = crate::simdrives::sim_nodes(machine, bi, 0.0, &Default::default());
+        // The drives answer within their cycle: with real-time privileges their thread runs
+        // SCHED_FIFO one priority below the controller's, so a loaded host cannot starve it.
+        let below = opts.rt.priority.map(|p| (p - 1).max(1));
+        sims.push(drives::sim::SimThread::start_with(
+            drive_end,
+            nodes,
+            machine.period_s,
+            Duration::from_micros(200),
+            move || {
+                if let Some(p) = below {
+                    let _ = os::set_fifo(p);
+                }
+            },
+        )?);
+        links.push(master_end);
+    }
+    let result = run_input(input, machine, move || Ok(links), opts);
+    let records = sims.into_iter().flat_map(|s| s.finish()).collect();
+    Ok((result?, records))
+}
