@@ -1,8 +1,12 @@
 //! The approach: one jerk-limited straight move in axis space from where the drives are to
 //! the program's start, every axis within its limits, all arriving together; planned before
-//! the loop, stepped in it.
+//! the loop, stepped in it. Its phases are held in place (a rest-to-rest S-curve has at most
+//! seven), so the move can pass from stage to stage in the loop without the heap.
 
 use nc_geom::scurve::{push_section, Phase, Ramps};
+
+/// Most phases the approach holds.
+pub(super) const APPROACH_PHASES: usize = 8;
 
 /// Axis limits for the approach, in axis units (mm or degrees), joint order.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,14 +21,16 @@ pub struct ApproachLimits {
 pub(super) struct Approach {
     from: [f64; 5],
     to: [f64; 5],
-    phases: Vec<Phase>,
+    phases: heapless::Vec<Phase, APPROACH_PHASES>,
     duration: f64,
     cursor: usize,
     t: f64,
 }
 
 impl Approach {
-    pub(super) fn new(from: [f64; 5], to: [f64; 5], lim: &ApproachLimits) -> Approach {
+    /// `None` if the S-curve has more phases than [`APPROACH_PHASES`] (a rest-to-rest
+    /// section has at most seven).
+    pub(super) fn new(from: [f64; 5], to: [f64; 5], lim: &ApproachLimits) -> Option<Approach> {
         // lambda runs 0 -> 1; axis j moves by d_j * lambda.
         let (mut v, mut a, mut j) = (f64::INFINITY, f64::INFINITY, f64::INFINITY);
         for k in 0..5 {
@@ -48,14 +54,14 @@ impl Approach {
             );
         }
         let duration = phases.last().map_or(0.0, |p| p.t0 + p.dur);
-        Approach {
+        Some(Approach {
             from,
             to,
-            phases,
+            phases: heapless::Vec::from_slice(&phases).ok()?,
             duration,
             cursor: 0,
             t: 0.0,
-        }
+        })
     }
 
     /// The axis positions now, without advancing.

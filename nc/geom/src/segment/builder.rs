@@ -2,10 +2,10 @@
 //! modal state between them; [`super::build`] runs it over a whole program, a streaming
 //! planner over the blocks as they are read.
 
-use super::{
-    c_leaving_vertical, follow, linear, linear_tool, merge, nurbs, turn_c, BuildError,
-    BuildErrorKind, BuildLimits, Pose, Segment,
-};
+use super::curve::nurbs;
+use super::straight::{linear, linear_tool};
+use super::vertical::{c_leaving_vertical, follow, turn_c};
+use super::{BuildError, BuildErrorKind, BuildLimits, Pose, Segment};
 use crate::kinematics::{Joints, MachineKinematics, Tilt};
 use crate::program::{Action, Aux, Block, LengthMode, SrcPos, Wait};
 use nalgebra::Vector3;
@@ -181,5 +181,14 @@ impl<'k> Builder<'k> {
             out.push(seg);
         }
         Ok(())
+    }
+}
+
+/// Two waits in a row: the dwells add up, the first operator stop counts.
+fn merge(a: Wait, b: Wait) -> Wait {
+    Wait {
+        dwell_s: a.dwell_s + b.dwell_s,
+        operator: a.operator.or(b.operator),
+        spindle: a.spindle || b.spindle,
     }
 }
