@@ -1,9 +1,12 @@
-//! The real-time interpolator over streamed chunks: the override tracker, the operator's
-//! and the spindle's gates, and the pose at the new path position.
+//! The real-time interpolator over streamed chunks: a period is the override moved
+//! ([`Tracker`]), the plan time advanced by it and held where the path waits ([`Gates`]),
+//! the path position found in the chunk at hand, then the pose there.
 
 use crate::chunk::{Chunk, Start};
+use crate::gates::Gates;
 use crate::hold::{AxisHold, HoldConfig};
 use crate::queue::{Inlet, LOOKAHEAD};
+use crate::tracker::Tracker;
 use heapless::Deque;
 use nc_geom::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use nc_geom::program::Aux;
@@ -38,9 +41,9 @@ pub struct Follower<'q> {
     /// The program's last chunk has arrived.
     complete: bool,
     cycle: u64,
+    /// Plan time.
     tau: f64,
-    k: f64,
-    r: f64,
+    tracker: Tracker,
     phase: usize,
     motion: Motion,
     stop_requested: bool,
@@ -49,19 +52,7 @@ pub struct Follower<'q> {
     /// data suffices.
     feed_override: f64,
     paused: bool,
-    /// Source line of the operator stop (`M00`, `M01`, `M06`) the path waits at.
-    awaiting: Option<u32>,
-    /// Chunks from this index on may still hold an operator stop not yet reached.
-    gate_from: usize,
-    /// Hold at the spindle waits ([`Wait::spindle`](nc_geom::program::Wait)) until the
-    /// spindle is at speed; off without a spindle (dry runs).
-    spindle_gates: bool,
-    /// The speed (rpm, signed) the spindle has reached, as last reported.
-    spindle_at: Option<f64>,
-    /// Chunks from this index on may still hold a spindle wait not yet passed.
-    spindle_gate_from: usize,
-    /// Source line of the move that waits for the spindle, while it waits.
-    awaiting_spindle: Option<u32>,
+    gates: Gates,
     /// Spindle and coolant commanded now.
     aux: Aux,
     done: bool,
@@ -99,8 +90,7 @@ impl<'q> Follower<'q> {
             complete: start.empty,
             cycle: 0,
             tau: 0.0,
-            k: 1.0,
-            r: 0.0,
+            tracker: Tracker::new(),
             phase: 0,
             pending: Pending::Fixed(0, 0.0),
             motion: Motion::default(),
@@ -108,12 +98,7 @@ impl<'q> Follower<'q> {
             holding: false,
             feed_override: 1.0,
             paused: false,
-            awaiting: None,
-            gate_from: 0,
-            spindle_gates: false,
-            spindle_at: None,
-            spindle_gate_from: 0,
-            awaiting_spindle: None,
+            gates: Gates::default(),
             aux: Aux::default(),
             done: start.empty,
             pose: start.pose,
@@ -157,32 +142,32 @@ impl<'q> Follower<'q> {
 
     pub fn resume(&mut self) {
         self.paused = false;
-        self.awaiting = None;
+        self.gates.awaiting = None;
     }
 
     /// The line of the operator stop (`M00`, `M01`, `M06`) the path stands at, waiting for
     /// [`Self::resume`].
     pub fn awaiting(&self) -> Option<u32> {
-        self.awaiting
+        self.gates.awaiting
     }
 
     /// Hold at every move that needs the spindle at speed until [`Self::spindle_at_speed`]
     /// reports that speed (a machine with a spindle drive). Off by default: the spindle
     /// words then change [`Setpoint::aux`] and nothing waits.
     pub fn wait_for_spindle(&mut self, on: bool) {
-        self.spindle_gates = on;
+        self.gates.spindle_on = on;
     }
 
     /// The speed (rpm, signed as [`Aux::spindle_rpm`]) the spindle drive reports it has
     /// reached, or `None` while it is not at the speed it was sent. Every period, before
     /// [`Self::advance`].
     pub fn spindle_at_speed(&mut self, rpm: Option<f64>) {
-        self.spindle_at = rpm;
+        self.gates.spindle_at = rpm;
     }
 
     /// The line of the move that waits for the spindle to reach its speed, while it waits.
     pub fn awaiting_spindle(&self) -> Option<u32> {
-        self.awaiting_spindle
+        self.gates.awaiting_spindle
     }
 
     /// Spindle and coolant as commanded now: those of the segment being machined, or of
@@ -197,7 +182,7 @@ impl<'q> Follower<'q> {
 
     /// At rest after [`Self::request_stop`], or at the end of the program.
     pub fn is_stopped(&self) -> bool {
-        self.done || (self.stop_requested && self.k == 0.0 && self.r == 0.0)
+        self.done || (self.stop_requested && self.tracker.at_rest())
     }
 
     pub fn is_done(&self) -> bool {
@@ -210,7 +195,7 @@ impl<'q> Follower<'q> {
 
     /// Path position, plan time and override of the last step.
     pub fn state(&self) -> (f64, f64, f64) {
-        (self.motion.s, self.tau, self.k)
+        (self.motion.s, self.tau, self.tracker.k)
     }
 
     /// The last setpoint (the start pose before the first step).
@@ -265,45 +250,6 @@ impl<'q> Follower<'q> {
         self.phase = 0;
     }
 
-    /// Distance needed to bring the override to 0 from its current state, travelling at
-    /// most `v` (a bound, not the exact figure).
-    ///
-    /// The check runs before this period's step, which may still raise the override (by at
-    /// most `r Ts + jmax Ts^2`, its rate by `jmax Ts`); the stop is bounded from there, so
-    /// that a hold that begins next period still fits. At rest the distance is next to
-    /// nothing, so a hold creeps on toward the end of the data it has rather than wait for
-    /// data that cannot come (the queue full of what it holds).
-    fn stop_distance(&self, v: f64, rmax: f64, jmax: f64) -> f64 {
-        let ts = self.hold.period;
-        let rise = self.r.max(0.0) + jmax * ts;
-        let k_next = (self.k + self.r.max(0.0) * ts + jmax * ts * ts).min(1.0);
-        let kpk = (k_next + rise * rise / (2.0 * jmax)).min(1.0);
-        // The rate's ramps: up to rmax and back, or a triangle if it never gets there.
-        let ramps = (2.0 * rmax / jmax).min(2.0 * (kpk / jmax).sqrt());
-        let t = rise / jmax + self.axis_hold.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
-        v * kpk * t
-    }
-
-    /// Move the override one period toward `target` with rate <= rmax, rate change <= jmax.
-    /// Where rmax has fallen below the present rate (it tightens as k nears 1), the rate
-    /// drops to it at once: the axes' acceleration comes before the override's smoothness.
-    fn track(&mut self, target: f64, rmax: f64, jmax: f64) {
-        let ts = self.hold.period;
-        let d = target - self.k;
-        let want = d.signum() * rmax.min((2.0 * jmax * d.abs()).sqrt());
-        let dr = (want - self.r).clamp(-jmax * ts, jmax * ts);
-        let r_new = (self.r + dr).clamp(-rmax, rmax);
-        let mut k = self.k + 0.5 * (self.r + r_new) * ts;
-        let mut r = r_new;
-        if (target - k) * d <= 0.0 || d.abs() < 1e-12 {
-            // Reached (or passed) the target this period.
-            k = target;
-            r = 0.0;
-        }
-        self.k = k.clamp(0.0, 1.0);
-        self.r = r;
-    }
-
     fn motion_in(c: &Chunk, tau: f64, cursor: &mut usize) -> Motion {
         let n = c.phases.len();
         if n == 0 {
@@ -338,7 +284,6 @@ impl<'q> Follower<'q> {
         if self.refused().is_some() {
             self.stop_requested = true;
         }
-        let ts = self.hold.period;
         let cycle = self.cycle;
         self.cycle += 1;
         if cycle == 0 || self.done {
@@ -347,14 +292,21 @@ impl<'q> Follower<'q> {
         }
         // Nothing arrived yet: stay at the start (the plan starts from rest at tau = 0).
         if self.local.is_empty() {
-            self.k = 0.0;
-            self.r = 0.0;
+            self.tracker.rest();
             if !self.complete && !self.stop_requested {
                 self.counters.hold_periods += 1;
             }
             self.pending = Pending::Fixed(cycle, 0.0);
             return;
         }
+        let tau = self.plan_time();
+        let (tau, gate_aux) = self.gate(tau);
+        self.move_to(tau, cycle, gate_aux);
+    }
+
+    /// The override moved one period toward its target, and the plan time it reaches.
+    fn plan_time(&mut self) -> f64 {
+        let ts = self.hold.period;
         // The hold's scale: the highest planned speed from here to the end, not only over
         // the chunks at hand. A faster chunk arriving mid-hold would otherwise lower the
         // hold's jerk under a rate built with the old one, which could then not be undone
@@ -367,21 +319,41 @@ impl<'q> Follower<'q> {
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
         let mut jmax = self.hold.jerk / vb;
-        let complete = self.complete;
         let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
         let room = avail_end - self.motion.s;
+        let stop = |t: &Tracker, jmax: f64| t.stop_distance(vb, rmax, jmax, ts, &self.axis_hold);
         // Held at rest for data, closer to its end than the least stop distance: creep on
         // with a gentler jerk whose stop fits in half the room. The planner may be unable to
         // push more (the queue's depth is in the chunks held here) until the first is left.
-        if !complete && self.k == 0.0 && self.r == 0.0 && room > 0.0 {
-            let d0 = self.stop_distance(vb, rmax, jmax);
+        if !self.complete && self.tracker.at_rest() && room > 0.0 {
+            let d0 = stop(&self.tracker, jmax);
             if d0 >= room {
                 jmax *= 0.5 * room / d0;
             }
         }
+        let underrun = !self.complete && room <= stop(&self.tracker, jmax);
+        let target = self.target(underrun);
+        // At rest (the plan at rest, or already held), the override drops to 0 at once:
+        // nothing moves. Otherwise a program whose first chunk is shorter than the distance
+        // to stop from the plan's start would begin to move, then stop short at its end.
+        if target == 0.0 && self.motion.v == 0.0 {
+            self.tracker.rest();
+        }
+        let rate = self
+            .tracker
+            .rate_bound(target, rmax, jmax, ts, &self.axis_hold);
+        let k_old = self.tracker.k;
+        self.tracker.track(target, rate, jmax, ts);
+        self.tau + 0.5 * (k_old + self.tracker.k) * ts
+    }
+
+    /// The override's target: 0 for a stop, for an underrun (the path that has arrived ends
+    /// within the distance needed to stop: counted once per hold) and while paused; else
+    /// the operator's override.
+    fn target(&mut self, underrun: bool) -> f64 {
         let target = if self.stop_requested {
             0.0
-        } else if !complete && room <= self.stop_distance(vb, rmax, jmax) {
+        } else if underrun {
             if !self.holding {
                 self.holding = true;
                 self.counters.underruns += 1;
@@ -398,76 +370,31 @@ impl<'q> Follower<'q> {
         if self.holding {
             self.counters.hold_periods += 1;
         }
-        // At rest (the plan at rest, or already held), the override drops to 0 at once:
-        // nothing moves. Otherwise a program whose first chunk is shorter than the distance
-        // to stop from the plan's start would begin to move, then stop short at its end.
-        if target == 0.0 && self.motion.v == 0.0 {
-            self.k = 0.0;
-            self.r = 0.0;
+        target
+    }
+
+    /// Plan time `tau` held where the path waits: at an operator stop ahead (paused there
+    /// until resumed), at a move that waits for the spindle. With the spindle command that
+    /// move starts, once it is reached.
+    fn gate(&mut self, mut tau: f64) -> (f64, Option<Aux>) {
+        if let Some(held) = self.gates.operator(self.local.iter(), tau, self.tau) {
+            tau = held;
+            self.tracker.rest();
+            self.paused = true;
         }
-        // The axes' bound at the highest override this period can reach (the bound falls
-        // as k rises), so that it holds over the whole period. Within the period the rate
-        // moves linearly from r to the new rate, which is at most r toward a lower target,
-        // else at most one jerk step up, the path's bound and the axes' bound at the
-        // present k. (A bound of a whole jerk step, jmax Ts^2, would be most of the range
-        // where the plan is slow and jmax large: the rate would stay at the bound for k = 1
-        // through the whole stop, far slower than the stop distance assumes.)
-        let up = if target > self.k {
-            (self.r + jmax * ts)
-                .min(rmax)
-                .min(self.axis_hold.rate(self.k))
-        } else {
-            0.0
-        };
-        let k_hi = (self.k + ts * self.r.max(up).max(0.0)).min(1.0);
-        let rate = rmax.min(self.axis_hold.rate(k_hi));
-        let k_old = self.k;
-        self.track(target, rate, jmax);
-        let mut tau = self.tau + 0.5 * (k_old + self.k) * ts;
-        // An operator stop ahead: the plan is at rest where it arrives there; hold it there
-        // (paused) until the operator resumes. Only the next boundary can hold one.
-        let gate = self.local.iter().take(2).find(|c| {
-            c.index >= self.gate_from && c.first().is_some_and(|g| g.wait.operator.is_some())
-        });
-        if let Some(c) = gate {
-            if tau >= c.t_start {
-                tau = c.t_start.max(self.tau);
-                self.k = 0.0;
-                self.r = 0.0;
-                self.paused = true;
-                self.awaiting = c.first().and_then(|g| g.wait.operator).map(|p| p.line);
-                self.gate_from = c.index + 1;
-            }
+        let (held, aux) = self
+            .gates
+            .spindle(self.local.iter(), tau, self.tau, self.paused);
+        if let Some(held) = held {
+            tau = held;
+            self.tracker.rest();
         }
-        // A move that needs the spindle at speed ahead: the plan is at rest where it starts;
-        // command that move's speed there and hold until the drive reports it.
-        self.awaiting_spindle = None;
-        let mut gate_aux = None;
-        let spindle = self.local.iter().take(2).find(|c| {
-            c.index >= self.spindle_gate_from && c.first().is_some_and(|g| g.wait.spindle)
-        });
-        let spindle = spindle.and_then(|c| Some((c, c.first()?)));
-        // Paused (the operator's stop at the same place, or a pause on the way there) it
-        // holds there too, but the spindle keeps its command until the run resumes: it never
-        // starts while the operator changes the tool.
-        if let Some((c, g)) = spindle {
-            if tau >= c.t_start {
-                let rpm = g.aux.spindle_rpm;
-                if !self.paused {
-                    gate_aux = Some(g.aux);
-                }
-                if !self.paused && (!self.spindle_gates || self.spindle_at == Some(rpm)) {
-                    self.spindle_gate_from = c.index + 1;
-                } else {
-                    tau = c.t_start.max(self.tau);
-                    self.k = 0.0;
-                    self.r = 0.0;
-                    if !self.paused {
-                        self.awaiting_spindle = Some(g.src.line);
-                    }
-                }
-            }
-        }
+        (tau, aux)
+    }
+
+    /// The path position at plan time `tau`, in the chunk that holds it (retiring those
+    /// left behind; bounded by the look-ahead).
+    fn move_to(&mut self, mut tau: f64, cycle: u64, gate_aux: Option<Aux>) {
         // The data ends where the plan comes to rest (an exact stop at a kink): wait there,
         // at rest like the plan, for the next chunk. Nothing is cut short: no hard stop.
         let rest_end = match (self.local.len(), self.local.front()) {
@@ -480,8 +407,7 @@ impl<'q> Follower<'q> {
             m = Self::motion_in(c, tau, &mut self.phase);
             m.s = m.s.min(c.s1).max(self.motion.s);
             m.v = 0.0;
-            self.k = 0.0;
-            self.r = 0.0;
+            self.tracker.rest();
         }
         // Otherwise find the chunk that holds tau; bounded by the look-ahead.
         let walk = if rest_end { 0 } else { LOOKAHEAD + 1 };
@@ -508,8 +434,7 @@ impl<'q> Follower<'q> {
                 // The data ran out before the hold had stopped: stop at its end, on the path.
                 let s1 = c.s1;
                 self.counters.hard_stops += 1;
-                self.k = 0.0;
-                self.r = 0.0;
+                self.tracker.rest();
                 self.motion.s = self.motion.s.max(s1.min(m.s));
                 self.motion.v = 0.0;
                 self.motion.a = 0.0;
@@ -518,7 +443,7 @@ impl<'q> Follower<'q> {
             }
         }
         self.tau = tau;
-        m.v *= self.k;
+        m.v *= self.tracker.k;
         self.motion = m;
         self.aux = match (gate_aux, self.local.front()) {
             (Some(a), _) => a,

@@ -41,8 +41,10 @@
 
 mod chunk;
 mod follower;
+mod gates;
 mod hold;
 mod queue;
+mod tracker;
 
 pub use chunk::{phase_vmax, Chunk, Start, MAX_CHUNK_SEGMENTS, REST_V};
 pub use follower::{Follower, StreamCounters};

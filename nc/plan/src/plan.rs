@@ -56,6 +56,7 @@ use nc_geom::segment::{Path, Segment};
 
 mod limits;
 mod remedy;
+mod rounds;
 mod stations;
 mod window;
 

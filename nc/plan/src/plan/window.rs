@@ -26,17 +26,14 @@
 //! linear in the program.
 
 use super::limits::section_limits;
-use super::remedy::{below_floor, cap_for, cap_widened, lower_share, widening, Remedy};
+use super::rounds::{Start, WindowPlan, Windows};
 use super::stations::Sampler;
-use super::{
-    refuse, schedule, too_long, with_dwells, PlanError, Station, VERIFY_ROUNDS, V_JOINT_FLOOR,
-};
+use super::{refuse, PlanError, Station};
 use crate::config::PlanConfig;
 use crate::profile::FeedProfile;
-use crate::verify::{check_from, g2, Checked, Earlier, Quantity, Trace, MAX_CYCLES};
+use crate::verify::{check_from, g2};
 use nc_geom::kinematics::{Joints, MachineKinematics};
 use nc_geom::limits::Margins;
-use nc_geom::limits::V_FLOOR;
 use nc_geom::program::SrcPos;
 use nc_geom::scurve::{change_dist, reachable, Phase};
 use nc_geom::segment::{Path, Pose, Segment};
@@ -65,33 +62,6 @@ pub struct Finished {
     pub duration: f64,
     /// The largest fractions of the limits the setpoints reach, over the whole plan.
     pub margins: Margins,
-}
-
-/// Where a window starts: a joint station, the time the plan reaches it and its speed.
-#[derive(Clone, Copy, Debug)]
-struct Start {
-    station: usize,
-    t: f64,
-    v: f64,
-}
-
-/// A window's checked plan: its phases (from `offset` in the profile), check and trace.
-struct WindowPlan {
-    offset: usize,
-    phases: Vec<Phase>,
-    checked: Checked,
-    trace: Trace,
-}
-
-impl WindowPlan {
-    fn earlier(&self) -> Earlier<'_> {
-        Earlier {
-            offset: self.offset,
-            phases: &self.phases,
-            checked: &self.checked,
-            trace: &self.trace,
-        }
-    }
 }
 
 /// The highest ceiling and the largest linear-axis rates of the stations so far, for the
@@ -495,188 +465,6 @@ impl<'a> Planner<'a> {
         } else {
             before.phases.drain(..phases - before.offset);
             before.offset = 0;
-        }
-    }
-}
-
-/// What every window of one path shares.
-struct Windows<'a> {
-    path: &'a Path,
-    kin: &'a MachineKinematics,
-    cfg: &'a PlanConfig,
-    smooth: &'a [bool],
-    starts: &'a [usize],
-}
-
-impl Windows<'_> {
-    /// Plan and check the window from `from` to station `end` (where it stops), after the
-    /// profile's first `committed` phases. None where it cannot start at `from`'s speed
-    /// (only when that speed is not zero).
-    fn window(
-        &self,
-        st: &mut [Station],
-        from: Start,
-        end: usize,
-        profile: &mut FeedProfile,
-        committed: usize,
-        before: Option<&WindowPlan>,
-    ) -> Result<Option<WindowPlan>, PlanError> {
-        let (path, kin, cfg) = (self.path, self.kin, self.cfg);
-        let moving = from.v > 0.0;
-        let s_from = st[from.station].s;
-        let eps = 1e-9 * s_from.abs().max(1.0);
-        let segs = {
-            let seg = |i: usize| self.starts.partition_point(|&x| x <= i).saturating_sub(1);
-            let b = if end + 1 == st.len() {
-                path.segments.len()
-            } else {
-                seg(end)
-            };
-            seg(from.station)..b
-        };
-        let mut last: Option<WindowPlan> = None;
-        let mut round = 0;
-        let mut widened = false;
-        let mut remedied = false;
-        // The stations and the round as they were before the first remedy below, and the
-        // plan they gave: where the remedies end in a refusal, the window goes on from there
-        // without them.
-        let mut tried: Option<(Vec<Station>, Option<WindowPlan>, usize)> = None;
-        // False once the window has fallen back (and `tried` is None again).
-        let mut may_remedy = true;
-        'rounds: loop {
-            let failed = 'round: {
-                let Some(phases) =
-                    schedule(st, self.starts, cfg, (from.station, from.t, from.v), end)
-                else {
-                    break 'round Ok(None);
-                };
-                let phases = with_dwells(phases, path, &profile.seg_start, segs.clone());
-                if let Some(prev) = &last {
-                    if prev.phases == phases && !widened {
-                        // The caps changed nothing. A violation's stencil can reach past the
-                        // stations it holds, onto a ramp the next station's ceiling sets (an
-                        // X jerk 1.09x its limit at 11.3 mm/s past a station capped to 10.6):
-                        // once, the caps go to the stations on either side too. Where that
-                        // would hold the stretches to them to a crawl, first what the
-                        // violation itself asks for ([`Remedy`]).
-                        if may_remedy && !remedied {
-                            remedied = true;
-                            let asked: Vec<Remedy> = prev
-                                .checked
-                                .violations
-                                .iter()
-                                .filter_map(|v| Remedy::for_crawl(st, v))
-                                .collect();
-                            if !asked.is_empty() {
-                                if tried.is_none() {
-                                    tried = Some((st.to_vec(), last.take(), round));
-                                }
-                                for r in asked {
-                                    r.apply(st);
-                                }
-                                continue 'rounds;
-                            }
-                        }
-                        widened = true;
-                        for v in &prev.checked.violations {
-                            if let Some(w) = widening(st, v) {
-                                cap_widened(st, v, &w);
-                            }
-                        }
-                        continue 'rounds;
-                    }
-                    if prev.phases == phases {
-                        // The caps changed nothing: the violation lies where this window
-                        // cannot slow.
-                        break 'round match moving {
-                            true => Ok(None),
-                            false => Err(refuse(path, kin, cfg, &prev.checked.violations[0])),
-                        };
-                    }
-                }
-                let duration = phases.last().map_or(from.t, |p| p.t0 + p.dur);
-                if duration.is_nan() || duration / cfg.period > MAX_CYCLES as f64 {
-                    break 'round Err(too_long(
-                        path,
-                        &profile.seg_start,
-                        &phases,
-                        duration,
-                        cfg.period,
-                    ));
-                }
-                profile.phases.truncate(committed);
-                profile.phases.extend_from_slice(&phases);
-                profile.duration = duration;
-                // The profile ends where the window stops (its position from then on).
-                profile.length = st[end].s;
-                let earlier = last.as_ref().or(before).map(WindowPlan::earlier);
-                let (checked, trace) = check_from(path, profile, kin, cfg, self.smooth, earlier);
-                if checked.violations.is_empty() {
-                    return Ok(Some(WindowPlan {
-                        offset: committed,
-                        phases,
-                        checked,
-                        trace,
-                    }));
-                }
-                // Travel: slowing cannot help. Report the farthest excursion of the first block
-                // that leaves the travel.
-                let travel = checked
-                    .violations
-                    .iter()
-                    .filter(|v| v.quantity == Quantity::Travel);
-                if let Some(first) = travel.clone().next() {
-                    let worst =
-                        travel
-                            .filter(|v| v.segment == first.segment)
-                            .fold(first, |w, v| {
-                                if (v.value - v.limit).abs() > (w.value - w.limit).abs() {
-                                    v
-                                } else {
-                                    w
-                                }
-                            });
-                    break 'round Err(refuse(path, kin, cfg, worst));
-                }
-                for v in &checked.violations {
-                    let factor = match v.speed_factor() {
-                        Some(f)
-                            if (v.v > V_FLOOR * 1.01
-                                || below_floor(v) && v.v > V_JOINT_FLOOR * 1.01)
-                                && round + 1 < VERIFY_ROUNDS
-                                && f.is_finite() =>
-                        {
-                            f
-                        }
-                        _ if moving => break 'round Ok(None),
-                        _ if round + 1 < VERIFY_ROUNDS && lower_share(st, v) => continue,
-                        _ => break 'round Err(refuse(path, kin, cfg, v)),
-                    };
-                    if moving && v.s.1 < s_from + eps {
-                        // Behind the window's start: only a slower start would help.
-                        break 'round Ok(None);
-                    }
-                    cap_for(st, v, factor);
-                }
-                last = Some(WindowPlan {
-                    offset: committed,
-                    phases,
-                    checked,
-                    trace,
-                });
-                round += 1;
-                widened = false;
-                remedied = false;
-                continue 'rounds;
-            };
-            // The remedies ended in a refusal: back to where they began, and on without
-            // them (as the window would have gone).
-            let Some((saved, plan, r)) = tried.take() else {
-                return failed;
-            };
-            st.copy_from_slice(&saved);
-            (last, round, widened, remedied, may_remedy) = (plan, r, false, true, false);
         }
     }
 }
