@@ -29,14 +29,15 @@
 //! broken and plans again) and, where slowing cannot help, the refusal of the program.
 
 use crate::config::PlanConfig;
-use crate::interp::{Interpolator, Mark, Method};
+use crate::interp::{Interpolator, Method};
 use crate::profile::FeedProfile;
-use nalgebra::Vector3;
-use nc_geom::kinematics::{Joints, MachineKinematics};
+use nc_geom::kinematics::MachineKinematics;
 use nc_geom::limits::{reserve, Margins};
 use nc_geom::scurve::Phase;
-use nc_geom::segment::{Geometry, Path, Segment};
-use nc_geom::setpoint::Setpoint;
+use nc_geom::segment::Path;
+use sample::{sample, Ctx, Sample};
+use stencil::{check_travel, check_window};
+use trace::{TraceMark, MARK_EVERY};
 
 /// What a limit bounds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,19 +144,6 @@ pub fn ceiling(cfg: &PlanConfig) -> Margins {
 /// check nor `dnurbs simulate` ever stops short of the program's end.
 pub const MAX_CYCLES: u64 = 86_400_000;
 
-/// A setpoint with what the check needs beside it.
-#[derive(Clone, Copy, Debug)]
-struct Sample {
-    q: Joints,
-    p: Vector3<f64>,
-    u: Option<f64>,
-    seg: usize,
-    s: f64,
-    v: f64,
-    cycle: u64,
-    t: f64,
-}
-
 /// Run the interpolator over `profile` at the period and measure every limit on its
 /// setpoints. `smooth[k]` tells whether the junction at the start of segment k is
 /// G2-continuous in the joints (from [`smooth_junctions`]).
@@ -167,69 +155,6 @@ pub fn check(
     smooth: &[bool],
 ) -> Checked {
     check_from(path, profile, kin, cfg, smooth, None).0
-}
-
-/// Periods between two [`Trace`] marks.
-const MARK_EVERY: u64 = 256;
-
-/// A check's state every [`MARK_EVERY`] periods, to start the next round's check where the
-/// replanned profile first differs ([`check_from`]).
-#[derive(Clone, Debug, Default)]
-pub struct Trace {
-    marks: Vec<TraceMark>,
-}
-
-impl Trace {
-    /// Forget the marks no later check will start from: all but the last before time `t`,
-    /// when the plan before `t` is final (the planner's committed windows).
-    pub fn forget_before(&mut self, t: f64) {
-        let n = self.marks.partition_point(|m| m.win[3].t < t);
-        self.marks.drain(..n.saturating_sub(1));
-    }
-
-    /// What a check resuming from the oldest mark reads behind it: the first segment its
-    /// samples lie on, the first phase its cursors stand at, and the time of its oldest
-    /// sample. None unless that mark's newest sample comes before time `until` (without
-    /// one, a check starts from the program's start).
-    pub fn oldest(&self, until: f64) -> Option<(usize, usize, f64)> {
-        let m = self.marks.first().filter(|m| m.win[3].t < until)?;
-        let seg = m.win.iter().map(|w| w.seg).fold(m.ip.segment(), usize::min);
-        Some((seg, m.cursor.min(m.ip.phase()), m.win[0].t))
-    }
-
-    /// The segments and phases before `segments` and `phases` are gone from the planner's
-    /// buffers: every index the marks hold counts from there now. Nothing a mark points at
-    /// may lie before them ([`Trace::oldest`]).
-    pub fn rebase(&mut self, segments: usize, phases: usize) {
-        for m in &mut self.marks {
-            m.ip.rebase(segments, phases);
-            m.cursor -= phases;
-            for w in &mut m.win {
-                w.seg -= segments;
-            }
-        }
-    }
-}
-
-#[derive(Clone, Debug)]
-struct TraceMark {
-    ip: Mark,
-    win: [Sample; 4],
-    cursor: usize,
-    margins: Margins,
-    /// Violations recorded before the mark.
-    violations: usize,
-}
-
-/// A check of an earlier profile of the same path: its phases, result and trace.
-pub struct Earlier<'a> {
-    /// Phases before this index are the same in both profiles (the planner's committed
-    /// windows), so the comparison starts there.
-    pub offset: usize,
-    /// The earlier profile's phases from `offset` on.
-    pub phases: &'a [Phase],
-    pub checked: &'a Checked,
-    pub trace: &'a Trace,
 }
 
 /// As [`check`], and where `earlier` is given, start from its last mark before the first
@@ -329,290 +254,16 @@ fn check_marked(
     (out, trace)
 }
 
-fn sample(sp: &Setpoint, seg: usize, profile: &FeedProfile, cursor: &mut usize) -> Sample {
-    let m = profile.at(sp.t, cursor);
-    Sample {
-        q: sp.joints,
-        p: sp.p,
-        u: sp.u,
-        seg,
-        s: m.s,
-        v: m.v,
-        cycle: sp.cycle,
-        t: sp.t,
-    }
-}
-
-fn violation(q: Quantity, axis: usize, w: &[Sample], value: f64, limit: f64) -> Violation {
-    let last = &w[w.len() - 1];
-    Violation {
-        quantity: q,
-        axis,
-        cycle: last.cycle,
-        t: last.t,
-        segment: last.seg,
-        s: (w[0].s, last.s),
-        v: w.iter().map(|x| x.v).fold(0.0, f64::max),
-        value,
-        limit,
-        rotary: [[0.0; 2]; 2],
-        kink: false,
-    }
-}
-
-/// Keep the worst violation of a cycle: the one that needs the largest slow-down.
-fn record(out: &mut Checked, v: Violation) {
-    if let Some(last) = out.violations.last_mut() {
-        if last.cycle == v.cycle {
-            let worse = match (v.speed_factor(), last.speed_factor()) {
-                (None, _) => true,
-                (Some(_), None) => false,
-                (Some(a), Some(b)) => a < b,
-            };
-            if worse {
-                *last = v;
-            }
-            return;
-        }
-    }
-    out.violations.push(v);
-}
-
-fn check_travel(x: &Sample, cfg: &PlanConfig, out: &mut Checked) {
-    for j in 0..5 {
-        let (lo, hi) = cfg.travel[j];
-        let q = x.q[j];
-        if !(q >= lo - SLACK * lo.abs().max(1.0) && q <= hi + SLACK * hi.abs().max(1.0)) {
-            let limit = if q < lo { lo } else { hi };
-            record(out, violation(Quantity::Travel, j, &[*x], q, limit));
-        }
-    }
-}
-
-/// Does the stencil `w` cross a junction that is not G2-continuous?
-fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
-    let (a, b) = (w[0].seg, w[w.len() - 1].seg);
-    (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
-}
-
-/// What a check measures against: the path, its plan, the machine, and which junctions
-/// are G2-continuous.
-struct Ctx<'a> {
-    path: &'a Path,
-    profile: &'a FeedProfile,
-    kin: &'a MachineKinematics,
-    cfg: &'a PlanConfig,
-    smooth: &'a [bool],
-}
-
-fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
-    let cfg = ctx.cfg;
-    let (ts, m) = (cfg.period, &mut out.margins);
-    let mut found: Option<Violation> = None;
-    let keep = |v: Violation, found: &mut Option<Violation>| {
-        let worse = match (
-            found.as_ref().and_then(Violation::speed_factor),
-            v.speed_factor(),
-        ) {
-            (_, None) => true,
-            (None, Some(_)) => found.is_none(),
-            (Some(a), Some(b)) => b < a,
-        };
-        if worse {
-            *found = Some(v);
-        }
-    };
-    let jerk_ok = !crosses_corner(w, ctx.smooth);
-    let kink = if w[1].seg < w[2].seg {
-        corner::stencil(w, ctx)
-    } else {
-        None
-    };
-    for (j, ax) in cfg.axes.iter().enumerate() {
-        let (q0, q1, q2, q3) = (w[0].q[j], w[1].q[j], w[2].q[j], w[3].q[j]);
-        let vel = ((q3 - q2) / ts).abs();
-        let acc = ((q3 - 2.0 * q2 + q1) / (ts * ts)).abs();
-        let (v_share, a_share) = reserve(ax, ts);
-        let (vel_limit, acc_limit) = (ax.velocity * v_share, ax.acceleration * a_share);
-        let jerk_limit = ax.planned_jerk(ts);
-        let jerk = ((q3 - 3.0 * q2 + 3.0 * q1 - q0) / (ts * ts * ts)).abs();
-        m.velocity[j] = m.velocity[j].max(vel / ax.velocity);
-        m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
-        if vel > vel_limit * (1.0 + SLACK) || vel.is_nan() {
-            keep(
-                violation(Quantity::Velocity, j, &w[2..], vel, vel_limit),
-                &mut found,
-            );
-        }
-        if acc > acc_limit * (1.0 + SLACK) || acc.is_nan() {
-            keep(
-                violation(Quantity::Acceleration, j, &w[1..], acc, acc_limit),
-                &mut found,
-            );
-        }
-        if let Some(c) = &kink {
-            let [k0, k1, k2] = &c.q;
-            let acc = ((k2[j] - 2.0 * k1[j] + k0[j]) / (ts * ts)).abs();
-            m.acceleration[j] = m.acceleration[j].max(acc / ax.acceleration);
-            if acc > acc_limit * (1.0 + SLACK) || acc.is_nan() {
-                // The speed at the junction sets the jump: lower it there.
-                let v = Violation {
-                    s: (c.s, c.s),
-                    v: c.v,
-                    kink: true,
-                    ..violation(Quantity::Acceleration, j, &w[1..], acc, acc_limit)
-                };
-                keep(v, &mut found);
-            }
-            for side in c.sides.iter().flatten() {
-                let [k0, k1, k2, k3] = side.q.map(|x| x[j]);
-                let jerk = ((k3 - 3.0 * k2 + 3.0 * k1 - k0) / (ts * ts * ts)).abs();
-                m.jerk[j] = m.jerk[j].max(jerk / jerk_limit);
-                if jerk > jerk_limit * (1.0 + SLACK) || jerk.is_nan() {
-                    let v = Violation {
-                        s: side.s,
-                        v: side.v,
-                        ..violation(Quantity::Jerk, j, w, jerk, jerk_limit)
-                    };
-                    keep(v, &mut found);
-                }
-            }
-        }
-        if jerk_ok {
-            m.jerk[j] = m.jerk[j].max(jerk / jerk_limit);
-            if jerk > jerk_limit * (1.0 + SLACK) || jerk.is_nan() {
-                keep(
-                    violation(Quantity::Jerk, j, w, jerk, jerk_limit),
-                    &mut found,
-                );
-            }
-        }
-    }
-    if let Some(v) = branch_change(w) {
-        keep(v, &mut found);
-    }
-    let chord = chord_error(&w[2], &w[3], ctx.path);
-    m.chord = m.chord.max(chord / cfg.chord_tol);
-    if chord > cfg.chord_tol * (1.0 + SLACK) || chord.is_nan() {
-        keep(
-            violation(Quantity::Chord, 5, &w[2..], chord, cfg.chord_tol),
-            &mut found,
-        );
-    }
-    if let Some(v) = found {
-        record(out, v);
-    }
-}
-
-/// A change of rotary solution between the two newest setpoints (see [`Quantity::Branch`]).
-/// A tool passing near the vertical swings C fast but continuously, with the tilt near zero;
-/// it never steps C by exactly half a turn at a tilt of its own, nor by whole turns.
-fn branch_change(w: &[Sample; 4]) -> Option<Violation> {
-    use core::f64::consts::{PI, TAU};
-    let (a, b) = (&w[2].q, &w[3].q);
-    let (t0, t1, dc) = (a[3], b[3], b[4] - a[4]);
-    let near = |x: f64, y: f64| (x - y).abs() < 1e-3;
-    let flip = t0 * t1 < 0.0 && t0.abs() > 1e-3 && t1.abs() > 1e-3 && near(dc.abs(), PI);
-    let wrap = dc.abs() > PI && near((dc / TAU).round() * TAU, dc) && near(t0, t1);
-    (flip || wrap).then(|| Violation {
-        rotary: [[t0, a[4]], [t1, b[4]]],
-        ..violation(Quantity::Branch, 4, &w[2..], dc.abs(), 0.0)
-    })
-}
-
-/// Distance from `p` to the segment a..b.
-pub fn dist_to_chord(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    chord_foot(p, a, b).1
-}
-
-/// The foot of `p` on the segment a..b, as the fraction of the way from `a`, and the
-/// distance from `p` to it.
-pub fn chord_foot(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> (f64, f64) {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let f = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (f, (p - (a + ab * f)).norm())
-}
-
-/// Largest distance of the cutter path between setpoints `a` and `b` from their chord.
-fn chord_error(a: &Sample, b: &Sample, path: &Path) -> f64 {
-    let mut e = 0.0f64;
-    if a.seg == b.seg {
-        let Some(seg) = path.segments.get(a.seg) else {
-            return e;
-        };
-        if let (Geometry::Nurbs { curve, .. }, Some(ua), Some(ub)) = (&seg.geometry, a.u, b.u) {
-            for f in [0.25, 0.5, 0.75] {
-                let p = curve.cutter(ua + (ub - ua) * f, 0).p;
-                e = e.max(dist_to_chord(&p, &a.p, &b.p));
-            }
-        }
-        return e;
-    }
-    // The chord spans junctions: every segment end between them is a point of the path.
-    for seg in path.segments.get(a.seg..b.seg).unwrap_or(&[]) {
-        if !seg.rotary_only {
-            e = e.max(dist_to_chord(&seg.pose(seg.length).p, &a.p, &b.p));
-        }
-    }
-    e
-}
-
-/// One-sided step used to compare the joint derivatives on both sides of a junction, mm.
-const JUNCTION_STEP: f64 = 1e-4;
-
-/// For every segment, whether the junction at its start is G2-continuous in the machine
-/// joints: equal first and second derivatives dq/ds, d2q/ds2 from both sides (one-sided
-/// finite differences), and no change between mm and degrees of path. Segment 0 (the
-/// program start, from rest) counts as smooth.
-pub fn smooth_junctions(path: &Path, kin: &MachineKinematics, cfg: &PlanConfig) -> Vec<bool> {
-    let mut out = Vec::with_capacity(path.segments.len());
-    out.push(true);
-    for w in path.segments.windows(2) {
-        out.push(g2(&w[0], &w[1], kin, cfg));
-    }
-    out
-}
-
-pub(crate) fn g2(a: &Segment, b: &Segment, kin: &MachineKinematics, cfg: &PlanConfig) -> bool {
-    if a.rotary_only || b.rotary_only {
-        return false;
-    }
-    let h = JUNCTION_STEP.min(a.length / 4.0).min(b.length / 4.0);
-    if h <= 0.0 {
-        return false;
-    }
-    let lim = &cfg.rotary;
-    // Joints along a, then on into b, following one rotary branch.
-    let mut prev = a.pose(a.length - 3.0 * h).joints(kin, &[0.0; 5], lim);
-    let mut qa = [[0.0; 5]; 3];
-    for (i, q) in qa.iter_mut().enumerate() {
-        prev = a
-            .pose(a.length - (2 - i) as f64 * h)
-            .joints(kin, &prev, lim);
-        *q = prev;
-    }
-    let mut qb = [[0.0; 5]; 3];
-    for (i, q) in qb.iter_mut().enumerate() {
-        prev = b.pose(i as f64 * h).joints(kin, &prev, lim);
-        *q = prev;
-    }
-    (0..5).all(|j| {
-        let d1a = (qa[2][j] - qa[1][j]) / h;
-        let d1b = (qb[1][j] - qb[0][j]) / h;
-        let d2a = (qa[2][j] - 2.0 * qa[1][j] + qa[0][j]) / (h * h);
-        let d2b = (qb[2][j] - 2.0 * qb[1][j] + qb[0][j]) / (h * h);
-        let scale = d2a.abs().max(d2b.abs()).max(1.0);
-        (qa[2][j] - qb[0][j]).abs() < 1e-9
-            && (d1a - d1b).abs() < 1e-3 * d1a.abs().max(d1b.abs()).max(1.0) + 4.0 * h * scale
-            && (d2a - d2b).abs() < 1e-2 * scale
-    })
-}
-
+mod chord;
 mod corner;
+mod junction;
+mod sample;
+mod stencil;
+mod trace;
+
+pub use chord::{chord_foot, dist_to_chord};
+pub(crate) use junction::g2;
+pub use junction::smooth_junctions;
+pub use trace::{Earlier, Trace};
 #[cfg(test)]
 mod tests;

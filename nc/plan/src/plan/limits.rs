@@ -231,8 +231,8 @@ pub(super) fn section_ramps(
 
 #[cfg(test)]
 mod tests {
-    use super::super::state_at;
     use super::*;
+    use crate::plan::schedule::state_at;
     use crate::plan::stations::AXIS_SHARE;
     use nc_geom::scurve::{change_dist, push_section, reachable};
     use proptest::prelude::*;

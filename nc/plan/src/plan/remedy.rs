@@ -31,7 +31,7 @@ pub(super) fn cap_widened(st: &mut [Station], v: &Violation, w: &Widening) {
 
 fn cap(st: &mut [Station], v: &Violation, s: (f64, f64), factor: f64, floor: f64) {
     let share = matches!(v.quantity, Quantity::Jerk).then_some(AXIS_SHARE_LEAST);
-    super::cap_stations(st, s, (v.v * factor * CAP_MARGIN, floor), share);
+    super::schedule::cap_stations(st, s, (v.v * factor * CAP_MARGIN, floor), share);
 }
 
 /// Violation `v` is one the caps may follow below the floor speed, down to
@@ -69,7 +69,7 @@ impl Widening {
     /// mm/s, held to 0.0012 mm/s: 52 s).
     fn crawls(&self, st: &[Station], v: &Violation) -> bool {
         let cap = v.v * self.factor * CAP_MARGIN;
-        let (a, b) = super::stations_over(st, self.s);
+        let (a, b) = super::schedule::stations_over(st, self.s);
         st[a..b].iter().any(|x| cap < CRAWL * x.vlim)
     }
 }
@@ -97,7 +97,7 @@ impl Remedy {
         if !w.crawls(st, v) {
             return None;
         }
-        let (a, b) = super::stations_over(st, v.s);
+        let (a, b) = super::schedule::stations_over(st, v.s);
         let held = &st[a..b];
         if held.iter().any(|x| x.vlim <= V_FLOOR) {
             return (v.quantity == Quantity::Jerk).then_some(Remedy::Share(*v));
@@ -113,7 +113,7 @@ impl Remedy {
                 lower_share(st, v);
             }
             Remedy::Lower(v, factor) => {
-                let (a, b) = super::stations_over(st, v.s);
+                let (a, b) = super::schedule::stations_over(st, v.s);
                 for x in &mut st[a..b] {
                     if x.vlim < v.v {
                         x.vlim = (x.vlim * factor * CAP_MARGIN).max(V_FLOOR.min(x.vlim));
@@ -135,7 +135,7 @@ pub(super) fn lower_share(st: &mut [Station], v: &Violation) -> bool {
     if v.quantity != Quantity::Jerk || !(v.value > v.limit && v.limit > 0.0) {
         return false;
     }
-    let (a, b) = super::stations_over(st, v.s);
+    let (a, b) = super::schedule::stations_over(st, v.s);
     let Some(least) = st[a..b].iter().map(|x| f64::from(x.share)).reduce(f64::min) else {
         return false;
     };

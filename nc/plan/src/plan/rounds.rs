@@ -8,9 +8,11 @@
 //! refuses the program). Where the remedies end in a refusal, the window goes back to the
 //! stations and plan from before them and on without them ([`Remedies`]).
 
+use super::error::{refuse, too_long};
 use super::remedy::{below_floor, cap_for, cap_widened, lower_share, widening, Remedy};
+use super::schedule::{schedule, with_dwells};
 use super::V_JOINT_FLOOR;
-use super::{refuse, schedule, too_long, with_dwells, PlanError, Station, VERIFY_ROUNDS};
+use super::{PlanError, Station, VERIFY_ROUNDS};
 use crate::config::PlanConfig;
 use crate::profile::FeedProfile;
 use crate::verify::{check_from, Checked, Earlier, Quantity, Trace, MAX_CYCLES};

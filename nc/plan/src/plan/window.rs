@@ -25,10 +25,11 @@
 //! the memory is that of a window or two, whatever the program's length, and the time is
 //! linear in the program.
 
+use super::error::refuse;
 use super::limits::section_limits;
 use super::rounds::{Start, WindowPlan, Windows};
 use super::stations::Sampler;
-use super::{refuse, PlanError, Station};
+use super::{PlanError, Station};
 use crate::config::PlanConfig;
 use crate::profile::FeedProfile;
 use crate::verify::{check_from, g2};

@@ -7,7 +7,7 @@
 //! measures the stencil centred on the kink: the setpoints the interpolator would give one
 //! period before the junction, on it, and one period after.
 
-use super::{Ctx, Sample};
+use super::sample::{Ctx, Sample};
 use nc_geom::kinematics::Joints;
 
 /// Joints at path position s, near `prev`.
