@@ -59,24 +59,16 @@ pub enum RtError {
     Signal(nix::errno::Errno),
 }
 
-static STOP: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+static STOP: std::sync::LazyLock<std::sync::Arc<std::sync::atomic::AtomicBool>> =
+    std::sync::LazyLock::new(Default::default);
 
-extern "C" fn on_stop_signal(_: nix::libc::c_int) {
-    // Async-signal-safe: one atomic store.
-    STOP.store(true, std::sync::atomic::Ordering::SeqCst);
-}
-
-/// Make SIGINT and SIGTERM request a controlled stop instead of killing the process.
+/// Make SIGINT and SIGTERM request a controlled stop instead of killing the process: each
+/// sets [`stop_requested`] (signal-hook's handler, one async-signal-safe atomic store).
 pub fn install_stop_handler() -> Result<(), RtError> {
-    use nix::sys::signal::{sigaction, SaFlags, SigAction, SigHandler, SigSet, Signal};
-    let sa = SigAction::new(
-        SigHandler::Handler(on_stop_signal),
-        SaFlags::SA_RESTART,
-        SigSet::empty(),
-    );
-    for sig in [Signal::SIGINT, Signal::SIGTERM] {
-        // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
-        unsafe { sigaction(sig, &sa) }.map_err(RtError::Signal)?;
+    for sig in [signal_hook::consts::SIGINT, signal_hook::consts::SIGTERM] {
+        signal_hook::flag::register(sig, std::sync::Arc::clone(&STOP)).map_err(|e| {
+            RtError::Signal(nix::errno::Errno::from_raw(e.raw_os_error().unwrap_or(0)))
+        })?;
     }
     Ok(())
 }

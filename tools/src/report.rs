@@ -170,45 +170,7 @@ impl Report {
 
 /// The current time, UTC, RFC 3339 to the second.
 pub fn now_utc() -> String {
-    let secs = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map_or(0, |d| d.as_secs());
-    rfc3339(secs)
-}
-
-/// Seconds since 1970 as `YYYY-MM-DDTHH:MM:SSZ` (proleptic Gregorian, days to civil date
-/// after H. Hinnant's algorithm).
-fn rfc3339(secs: u64) -> String {
-    let days = (secs / 86_400) as i64;
-    let rem = secs % 86_400;
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = doy - (153 * mp + 2) / 5 + 1;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 };
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    format!(
-        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}Z",
-        rem / 3600,
-        rem / 60 % 60,
-        rem % 60
-    )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rfc3339_dates() {
-        assert_eq!(rfc3339(0), "1970-01-01T00:00:00Z");
-        // date -u -d @1795430096
-        assert_eq!(rfc3339(1_795_430_096), "2026-11-23T10:34:56Z");
-        assert_eq!(rfc3339(951_782_400), "2000-02-29T00:00:00Z");
-    }
+    humantime::format_rfc3339_seconds(std::time::SystemTime::now()).to_string()
 }
 
 /// How the planner streamed the program, for the report.
@@ -221,4 +183,17 @@ pub struct StreamNotes {
     pub checked_whole: bool,
     /// The program's lines, once the pre-pass has read it to its end.
     pub lines: Option<u32>,
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_start_time_is_rfc3339_utc_to_the_second() {
+        let t = super::now_utc();
+        assert_eq!(t.len(), "2026-11-23T10:34:56Z".len(), "{t}");
+        assert!(t.ends_with('Z'), "{t}");
+        let back = humantime::parse_rfc3339(&t).expect("parses back");
+        let ago = std::time::SystemTime::now().duration_since(back).unwrap();
+        assert!(ago.as_secs() < 60, "{t}");
+    }
 }
