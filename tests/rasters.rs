@@ -89,9 +89,10 @@ fn angle_deg(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// (the trace, one point a period), and the largest angle between a programmed tool axis
 /// and the commanded one at that nearest point (interpolated between the two periods'). Both
 /// run along the path in order: each point is looked for from where the last one was found,
-/// a window of periods on.
+/// a window of periods on. 256 periods are 25 mm at the feed, 250 moves (a smaller window
+/// can only find a point farther off, never nearer: it cannot hide a deviation).
 fn largest_move_off_path(moves: &[Move], rows: &[Row]) -> (f64, f64) {
-    const WINDOW: usize = 4000;
+    const WINDOW: usize = 256;
     let mut from = 0;
     let (mut worst, mut worst_deg): (f64, f64) = (0.0, 0.0);
     for m in moves {

@@ -25,7 +25,7 @@
 //! its position. Those cases are counted and printed (`POST_VERBOSE=1`, and `POST_SRC=1`
 //! for their text), and must stay under a twentieth of the programs accepted as posted;
 //! `POST_VERBOSE` also prints each program more than 1 % slower compressed.
-//! Cases: `POST_CASES` (default 64; `.ci/run` sets 256), seed `POST_SEED` (default 0).
+//! Cases: `POST_CASES` (default 24; `.ci/run` sets 256), seed `POST_SEED` (default 0).
 
 use nalgebra::Vector3;
 use nc_fit::compress::compress;
@@ -568,7 +568,7 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
 
 #[test]
 fn every_compressed_post_holds_every_limit_and_passes_its_points() {
-    let cases = env("POST_CASES", 64) as u32;
+    let cases = env("POST_CASES", 24) as u32;
     let seed = env("POST_SEED", 0);
     let config = ProptestConfig {
         cases,

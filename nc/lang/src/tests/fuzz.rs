@@ -85,8 +85,16 @@ fn mutate(src: &str, edits: &[Edit]) -> String {
     chars.into_iter().collect()
 }
 
+/// Cases of each property: `LANG_FUZZ_CASES` (default 500; `.ci/run` sets 2 000).
+fn cases() -> u32 {
+    std::env::var("LANG_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(500)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(2000))]
+    #![proptest_config(ProptestConfig::with_cases(cases()))]
 
     #[test]
     fn arbitrary_text_never_panics(src in any::<String>()) {
