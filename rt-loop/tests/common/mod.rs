@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use drives::link::{CanLink, MemLink};
-use drives::master::{configure, Master, SetupOptions, Supervision, WallClock};
+use drives::master::{configure, Clock, Master, SetupOptions, Supervision, WallClock};
 use drives::sim::{Lockstep, Record, SimNodeConfig, SimThread};
 use drives::wire::NodeId;
 use machine::bus::Drive;
@@ -29,65 +29,42 @@ pub const LENIENT: Supervision = Supervision {
 };
 
 /// Drives for X Y Z A C on nodes 1..=5 with these counts per mm or degree, simulated on
-/// `drive_end`; the master on `link` has configured them, with [`LENIENT`] supervision.
+/// `drive_end` in a thread of their own; the master on `link` has configured them, with
+/// [`LENIENT`] supervision.
 pub fn sim_bus<L: CanLink, D: CanLink + Send + 'static>(
     link: L,
     drive_end: D,
     period: f64,
     counts_per_unit: [f64; 5],
 ) -> (BusDrives<L>, SimThread) {
-    sim_bus_with(
-        link,
-        drive_end,
-        period,
-        counts_per_unit,
-        five_drives(),
-        LENIENT,
-    )
-}
-
-/// [`sim_bus`] with the simulated nodes (1..=5, with their faults) and supervision given.
-pub fn sim_bus_with<L: CanLink, D: CanLink + Send + 'static>(
-    mut link: L,
-    drive_end: D,
-    period: f64,
-    counts_per_unit: [f64; 5],
-    sims: Vec<SimNodeConfig>,
-    sup: Supervision,
-) -> (BusDrives<L>, SimThread) {
-    let drives = axis_drives(counts_per_unit);
-    let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
     // SCHED_FIFO where allowed (one below the loop's): on a loaded machine a starved drive
     // thread would miss its feedback deadline, a fault these tests did not inject.
-    let sim = SimThread::start_with(drive_end, sims, period, Duration::from_micros(20), || {
-        let _ = os::set_fifo(79);
-    })
-    .unwrap();
-    let mut opts = SetupOptions::new(period);
-    opts.boot_timeout = Duration::from_secs(5);
-    let initial = configure(
-        &mut link,
-        &nodes,
-        &opts,
-        &mut WallClock::default(),
-        &mut |_| {},
+    let sim = SimThread::start_with(
+        drive_end,
+        five_drives(),
+        period,
+        Duration::from_micros(20),
+        || {
+            let _ = os::set_fifo(79);
+        },
     )
     .unwrap();
-    let master = Master::new(link, &nodes, &initial, sup, os::now() as f64 * 1e-9).unwrap();
-    (BusDrives::new(master, &drives).unwrap(), sim)
+    let now = |_: &WallClock| os::now() as f64 * 1e-9;
+    let bus = take_over(
+        link,
+        &mut WallClock::default(),
+        now,
+        period,
+        counts_per_unit,
+        LENIENT,
+    );
+    (bus, sim)
 }
 
-/// Drives for X Y Z A C on nodes 1..=5, as simulated nodes.
-pub fn five_drives() -> Vec<SimNodeConfig> {
-    (1..=5)
-        .map(|n| SimNodeConfig::new(NodeId::new(n).unwrap()))
-        .collect()
-}
-
-/// [`sim_bus_with`] on a virtual clock: the drives `sims` on `drive_end`, set up by the
-/// master on `link` with their waits on the drives' clock.
+/// [`sim_bus`] on a virtual clock: the drives `sims` on `drive_end`, set up by the master on
+/// `link` with its waits on the drives' clock, and supervision `sup`.
 pub fn lockstep_bus<L: CanLink, D: CanLink>(
-    mut link: L,
+    link: L,
     drive_end: D,
     period: f64,
     counts_per_unit: [f64; 5],
@@ -95,14 +72,34 @@ pub fn lockstep_bus<L: CanLink, D: CanLink>(
     sup: Supervision,
 ) -> (BusDrives<L>, Lockstep<D>) {
     let mut sim = Lockstep::new(drive_end, sims, period);
+    let now = |s: &Lockstep<D>| s.now().as_secs_f64();
+    let bus = take_over(link, &mut sim, now, period, counts_per_unit, sup);
+    (bus, sim)
+}
+
+/// The master on `link` sets up drives 1..=5, its waits on `clock`, and takes them over at
+/// `now(clock)` s with supervision `sup`.
+fn take_over<L: CanLink, C: Clock>(
+    mut link: L,
+    clock: &mut C,
+    now: impl FnOnce(&C) -> f64,
+    period: f64,
+    counts_per_unit: [f64; 5],
+    sup: Supervision,
+) -> BusDrives<L> {
     let nodes: Vec<NodeId> = (1..=5).map(|n| NodeId::new(n).unwrap()).collect();
     let mut opts = SetupOptions::new(period);
     opts.boot_timeout = Duration::from_secs(5);
-    let initial = configure(&mut link, &nodes, &opts, &mut sim, &mut |_| {}).unwrap();
-    let now = sim.now().as_secs_f64();
-    let master = Master::new(link, &nodes, &initial, sup, now).unwrap();
-    let bus = BusDrives::new(master, &axis_drives(counts_per_unit)).unwrap();
-    (bus, sim)
+    let initial = configure(&mut link, &nodes, &opts, clock, &mut |_| {}).unwrap();
+    let master = Master::new(link, &nodes, &initial, sup, now(clock)).unwrap();
+    BusDrives::new(master, &axis_drives(counts_per_unit)).unwrap()
+}
+
+/// Drives for X Y Z A C on nodes 1..=5, as simulated nodes.
+pub fn five_drives() -> Vec<SimNodeConfig> {
+    (1..=5)
+        .map(|n| SimNodeConfig::new(NodeId::new(n).unwrap()))
+        .collect()
 }
 
 /// A program run through the whole `run` pipeline on the in-memory link.
