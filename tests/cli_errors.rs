@@ -169,12 +169,7 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
     check("no-feed", "G01 X0 Y0 Z0\n", "1", "F");
     check("garbage", "G01 X0 Y0 Z0 F100 Q7\n", "1:19", "Q");
     check("nurbs-first", &block("3", "1", GOOD_K), "1", "start pose");
-    check(
-        "after-end",
-        &format!("{START}M30\nG01 X1\n"),
-        "3:1",
-        "after the program end",
-    );
+    check("percent", &format!("{START}%\nM30\n"), "2:1", "`%`");
 }
 
 #[test]
@@ -412,7 +407,7 @@ fn the_pre_pass_passes_the_examples_and_refuses_a_point_outside_the_travel() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{stdout}");
     assert!(
-        stdout.contains("23 lines, 2 motion blocks, 1 segments"),
+        stdout.contains("22 lines, 2 motion blocks, 1 segments"),
         "{stdout}"
     );
     assert!(stdout.contains("lines/s"), "{stdout}");

@@ -87,5 +87,6 @@ pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc_lang::Se
         optional_stop: shop.optional_stop,
         kinematics: Some(crate::setup::MachineSetup::new(machine).kin),
         max_rpm: machine.spindle.as_ref().map(|s| s.max_rpm),
+        ..nc_lang::Setup::default()
     }
 }

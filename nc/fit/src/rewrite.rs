@@ -46,7 +46,7 @@ pub struct Rewritten {
     /// Seconds spent fitting (finding the runs and fitting them; reading, writing and the
     /// check excluded).
     pub fit_s: f64,
-    /// Physical lines read.
+    /// Physical lines of the program read, up to its end (`M02`/`M30` or its closing `%`).
     pub lines: u32,
 }
 
@@ -373,9 +373,9 @@ pub fn rewrite<R: BufRead, W: Write>(
         lines: ReadLines::new(input),
         state: Rc::clone(&state),
     };
-    let entries = Entries::new(recorder, setup);
+    let mut entries = Entries::new(recorder, setup);
     let failed = |state: &RefCell<State<'_, W>>| state.borrow_mut().error.take();
-    for entry in entries {
+    for entry in entries.by_ref() {
         if let Some(e) = failed(&state) {
             return Err(e);
         }
@@ -384,6 +384,13 @@ pub fn rewrite<R: BufRead, W: Write>(
             Entry::Action(a) => s.check.action(&a),
             Entry::Block(i, b) => s.on_block(i, b)?,
         }
+    }
+    // The lines after the program's end are not the program's, but they are the file's:
+    // they pass through unchanged.
+    let program_lines = state.borrow().lines_read;
+    let mut rest = entries.into_source();
+    while let Some(line) = rest.next_line() {
+        line.map_err(RewriteError::Parse)?;
     }
     if let Some(e) = failed(&state) {
         return Err(e);
@@ -401,6 +408,6 @@ pub fn rewrite<R: BufRead, W: Write>(
         summary: s.summary.clone(),
         dev,
         fit_s: s.fit_s,
-        lines: s.lines_read,
+        lines: program_lines,
     })
 }

@@ -81,8 +81,11 @@ pub enum ParseErrorKind {
     MisplacedBackslash,
     #[error("`\\` continues the line but the file ends here")]
     ContinuationAtEof,
-    #[error("`%` (tape marker) must stand alone on its line")]
+    #[error("`%` (tape marker) stands alone on the program's first line and on the line that ends the program; here it is neither")]
     MisplacedTapeMark,
+    /// Parameters, expressions, O-word flow control, active comments.
+    #[error("{0}")]
+    Interp(crate::interp_error::InterpError),
     #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P R S T U V W X Y Z")]
     UnsupportedWord { letter: char, value: f64 },
 

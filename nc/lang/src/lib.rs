@@ -2,26 +2,37 @@
 //!
 //! # The language
 //!
-//! A small, strict G-code dialect: the paper's `G06.5` double-NURBS block (Wang et al. 2007,
-//! docs/paper.md), Fanuc's 3-axis `G06.2` NURBS block and 5-axis `G00`/`G01`. Whatever is
-//! not listed here is an error, never silently ignored.
+//! RS274/NGC as LinuxCNC reads it (its interpreter `rs274` is the oracle of the
+//! conformance suite), with the paper's `G06.5` double-NURBS block, Fanuc's `G06.2` NURBS
+//! block and 5-axis `G00`/`G01`. Whatever is not listed here is an error, never silently
+//! ignored.
 //!
 //! ```text
-//! program   = { line } ;
-//! line      = [ "N" uint ] { word } [ "\" newline line ]      (a "\" continues the line)
-//!           | "%"                                             (tape marker, alone on its line)
-//! word      = letter number ;                  letters: A B C F G I J K M N P R U V W X Y Z
-//! number    = [ "+" | "-" ] ( digits [ "." [ digits ] ] | "." digits ) ;   no exponent
+//! line      = [ "/" ] [ "N" digits ] ( o-line | { word | assignment } ) [ "\" newline line ]
+//!           | "%"                      (first line: tape start; a later one ends the program)
+//! word      = letter value ;           letters: A B C F G H I J K M N O P R S T U V W X Y Z
+//! value     = number | "#" parameter | "[" expression "]" | function
+//! parameter = value (1..5601) | "<" name ">"  ("_name": global, else local to its call)
+//! assignment= "#" parameter "=" value
+//! o-line    = "O" ( value | "<" name ">" ) keyword { "[" expression "]" }
 //! comment   = "(" ... ")" on one line  |  ";" ... end of line
 //! ```
 //!
-//! Letters are case-insensitive, spaces between words optional (`G01X1Y2`). Per line:
+//! Spaces and tabs vanish anywhere outside comments (`G 0 X 1 . 5` is `G0X1.5`), letters
+//! are case-insensitive. Numbers have no exponent. Expressions have every RS274/NGC operator
+//! (`** * / MOD + - EQ NE GT GE LT LE AND OR XOR`) and function (`ABS ACOS ASIN ATAN[y]/[x]
+//! COS EXISTS EXP FIX FUP LN ROUND SIN SQRT TAN`), angles in degrees. On a line, every value
+//! reads the parameters as they were before the line; its assignments take effect after
+//! (numbered, then named). O-words: `sub endsub call return if elseif else endif while
+//! endwhile do repeat endrepeat break continue`. `(ABORT, text)` stops the program.
+//!
+//! Per line, after the interpreter:
 //!
 //! - `N` only as the first word; `G90` and `G21` (the defaults, the only modes supported) on
-//!   any line; `M02` / `M30` end the program, after which only blank, comment and `%` lines may
-//!   follow (without them the program ends at the end of the file). One code per modal group
-//!   and one word per letter on a line. A line of only `N`, `F`, `G90`, `G21` or `G00`/`G01`
-//!   sets modes and moves nothing.
+//!   any line; `M02` / `M30` end the program: the lines after it are not read (as LinuxCNC;
+//!   without them the program ends at the end of the file or at its closing `%`). One code
+//!   per modal group and one word per letter on a line. A line of only `N`, `F`, `G90`,
+//!   `G21` or `G00`/`G01` sets modes and moves nothing.
 //! - `F` sets the modal feed (mm/min, > 0). Every `G01` move (the start pose too) and every
 //!   NURBS block needs one in effect; `G00` does not.
 //! - `G00` / `G01` are modal: a line of coordinates alone continues the last of them. Missing
@@ -58,48 +69,69 @@
 //!
 //! # Design
 //!
-//! Three stages, each in its own file, each checking the rules it can see:
+//! The stages, each in its own file, each checking the rules it can see:
 //!
-//! - `lexer`: characters -> logical lines of words. Handles comments, `%`, continuation
-//!   lines (every word keeps its physical line and column) and number syntax.
-//! - `line`: one logical line -> its `N`, G and M codes decoded by modal group and the other
+//! - `text`: a physical line normalised (whitespace out, lower case, comments cut, every
+//!   character keeping its column); `tape`: logical lines, kept while a loop or a call may
+//!   go back to them.
+//! - `syntax` (with `expr`): a line read into its words, assignments and O-word, values as
+//!   expression trees, nothing evaluated.
+//! - `interp` (with `evaluate`, `flow`, `subs`, `params`): parameters, the flow, the
+//!   order of evaluation; hands each line's words, now numbers (`word`), on.
+//! - `line`: one line of words -> its `N`, G and M codes decoded by modal group and the other
 //!   words indexed by letter. Rules without state: unknown words, unsupported codes, repeats.
-//! - `parser` (with `nurbs` for an open block): the modal state machine. It resolves every
-//!   modal value, so each [`Block`](nc_geom::program::Block) of the result is complete.
+//! - `parser` (with `moves`, `nurbs`, `predefined`): the modal state machine. It resolves
+//!   every modal value, so each [`Block`](nc_geom::program::Block) of the result is complete,
+//!   and gives the interpreter the parameters that read its state (`#5420`, `#<_x>`, ...).
 //!
 //! Errors are reported at the first rule broken, at the offending token; parsing stops there
 //! (an NC program is only run when it is entirely valid). The parser never panics: no indexing
-//! that can fail, checked conversions, and every number is proved finite by the lexer. A
+//! that can fail, checked conversions, and every value is proved finite where it is computed. A
 //! property test feeds it arbitrary text and mutations of the paper's example.
 
 mod arc;
 pub(crate) mod codes;
 mod error;
-mod lexer;
-pub use lexer::continues;
+mod evaluate;
+mod expr;
+mod flow;
+mod interp;
+mod interp_error;
 mod line;
 mod modal;
 mod moves;
+mod name;
 mod nurbs;
+mod params;
 mod parser;
+mod predefined;
 mod rules;
 mod source;
 mod stream;
+mod subs;
+mod syntax;
+mod tape;
 #[cfg(test)]
 mod tests;
+mod text;
 mod vocab;
+mod word;
+pub use word::continues;
 
 pub use arc::{arc, ArcNet, Centre};
 pub use error::{Context, ParseError, ParseErrorKind};
-pub use lexer::word_limit;
+pub use interp_error::InterpError;
 pub use modal::{Setup, MAX_ERRORS, MM_PER_INCH};
+pub use name::Name;
 pub use rules::{
-    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_DWELL_S, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN,
-    MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
+    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_CALL_DEPTH, MAX_DWELL_S, MAX_LOOP_ITERATIONS,
+    MAX_PARAMETER, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN, MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH,
+    MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
 };
 pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
 pub use stream::{Entries, Entry};
 pub use vocab::{Motion, Plane};
+pub use word::word_limit;
 
 use nc_geom::program::Program;
 

@@ -6,7 +6,7 @@
 
 use super::codes::{g_code, m_code, Code, StopCode, GROUPS};
 use super::error::{Context, ParseError, ParseErrorKind};
-use super::lexer::Word;
+use super::word::Word;
 use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
@@ -102,7 +102,7 @@ impl<'w> Line<'w> {
 
     fn insert(&mut self, w: &Word) -> Result<(), ParseError> {
         let Some(slot) = self.slots.get_mut(letter_index(w.letter)) else {
-            return Ok(()); // unreachable: the lexer only produces ASCII letters
+            return Ok(()); // unreachable: the syntax only produces ASCII letters
         };
         if let Some(prev) = slot {
             let kind = ParseErrorKind::RepeatedWord {

@@ -13,7 +13,7 @@ pub const MM_PER_INCH: f64 = 25.4;
 /// The shop's side of a program: offsets, reference position, tools and switches. The
 /// default has none of them (G54 is then the machine zero; `G28`, `G55`..`G59`, `G43 H` are
 /// errors naming what is missing).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Setup {
     /// `G54`..`G59`: where the program's zero is, in machine coordinates (mm). `None`: not
     /// defined (an undefined `G54` is the machine zero; the others are errors).
@@ -34,6 +34,29 @@ pub struct Setup {
     /// The spindle's highest speed (rpm), where the machine has a spindle drive: an `S`
     /// above it is an error. `None`: any speed up to the language's range is reported only.
     pub max_rpm: Option<f64>,
+    /// Where `o<name> call` looks for `name.ngc` when the program does not define `name`,
+    /// in order (LinuxCNC's `SUBROUTINE_PATH`).
+    pub subroutine_dirs: Vec<std::path::PathBuf>,
+    /// Most times a program's loops may go back (all loops together, so also loops inside
+    /// loops): a program that would loop more is refused at the loop's line, instead of
+    /// holding the planner. Default [`crate::rules::MAX_LOOP_ITERATIONS`].
+    pub max_iterations: u64,
+}
+
+impl Default for Setup {
+    fn default() -> Self {
+        Setup {
+            work_offsets: [None; 6],
+            reference: None,
+            tools: BTreeMap::new(),
+            block_delete: false,
+            optional_stop: false,
+            kinematics: None,
+            max_rpm: None,
+            subroutine_dirs: Vec::new(),
+            max_iterations: crate::rules::MAX_LOOP_ITERATIONS,
+        }
+    }
 }
 
 /// The modal state of the language besides motion and feed.

@@ -9,10 +9,10 @@
 use super::arc::{self, Centre};
 use super::codes::Code;
 use super::error::{Context, ParseError, ParseErrorKind};
-use super::lexer::word_limit;
 use super::line::{Line, MOVE_WORDS};
 use super::nurbs::distance;
 use super::parser::{normalise, Parser};
+use super::word::word_limit;
 use crate::vocab::Motion;
 use crate::vocab::Plane;
 use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, SrcPos};
@@ -458,7 +458,7 @@ impl Parser<'_> {
             },
         };
         let inc = self.modal.incremental;
-        let resolve = |w: Option<super::lexer::Word>, prev: f64| -> Result<f64, ParseError> {
+        let resolve = |w: Option<super::word::Word>, prev: f64| -> Result<f64, ParseError> {
             match w {
                 None => Ok(prev),
                 Some(w) if inc => check_domain(w.letter, prev + w.value, w.pos),

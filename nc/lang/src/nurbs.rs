@@ -7,8 +7,8 @@
 //! knot count; the block is complete when that many knots have arrived.
 
 use super::error::{Context, ParseError, ParseErrorKind};
-use super::lexer::Word;
 use super::line::Line;
+use super::word::Word;
 use crate::rules::{MIN_TOOL_OFFSET_MM, START_TOLERANCE_MM};
 use crate::vocab::Motion;
 use nc_geom::program::MAX_BLOCK_CTRL;

@@ -85,7 +85,7 @@ impl<'s> Parser<'s> {
     }
 
     /// Takes one logical line (its words from the lexer).
-    pub fn line(&mut self, words: &[super::lexer::Word]) -> Result<(), ParseError> {
+    pub fn line(&mut self, words: &[super::word::Word]) -> Result<(), ParseError> {
         let Some(first) = words.first() else {
             return Ok(());
         };
@@ -443,7 +443,7 @@ impl<'s> Parser<'s> {
 }
 
 /// A `T` or `H` word as a tool number.
-fn tool_number(w: super::lexer::Word) -> Result<u32, ParseError> {
+fn tool_number(w: super::word::Word) -> Result<u32, ParseError> {
     match w.uint {
         Some(t) if t <= 99_999 => Ok(t),
         _ => Err(ParseErrorKind::BadNumber {

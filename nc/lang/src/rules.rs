@@ -37,3 +37,20 @@ pub const G_LIST: &str =
     "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G80 G90 G91 G93 G94";
 
 pub const M_LIST: &str = "M00 M01 M02 M03 M04 M05 M06 M07 M08 M09 M30";
+
+/// Highest numbered parameter (`#1`..`#5601`, as LinuxCNC).
+pub const MAX_PARAMETER: u32 = 5601;
+
+/// Most subroutine calls nested (LinuxCNC refuses a tenth).
+pub const MAX_CALL_DEPTH: usize = 9;
+
+/// Most brackets, functions and signs nested in one expression.
+pub const MAX_EXPR_DEPTH: usize = 64;
+
+/// Most iterations of one loop (`while`, `do`, `repeat`): a loop that never ends is refused
+/// at its line instead of holding the planner (LinuxCNC has no limit).
+pub const MAX_LOOP_ITERATIONS: u64 = 10_000_000;
+
+/// How close to a whole number a value must be where one is required (parameter and O-word
+/// numbers, loop counts), as LinuxCNC.
+pub const WHOLE_TOLERANCE: f64 = 1e-4;

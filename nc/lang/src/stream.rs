@@ -4,10 +4,11 @@
 //! them one by one.
 
 use super::error::ParseError;
-use super::lexer::{Lexer, Word};
+use super::interp::Interp;
 use super::modal::Setup;
 use super::parser::Parser;
 use super::source::LineSource;
+use super::word::Word;
 use nc_geom::program::{Action, Block, SrcPos};
 use std::collections::VecDeque;
 
@@ -24,7 +25,7 @@ pub enum Entry {
 /// next line (an open NURBS block is dropped), as [`super::parse_with`] does; a caller that
 /// stops at the first error simply stops.
 pub struct Entries<'s, S> {
-    lexer: Lexer<S>,
+    interp: Interp<S>,
     parser: Parser<'s>,
     words: Vec<Word>,
     pending: VecDeque<Entry>,
@@ -34,7 +35,7 @@ pub struct Entries<'s, S> {
 impl<'s, S: LineSource> Entries<'s, S> {
     pub fn new(lines: S, setup: &'s Setup) -> Self {
         Entries {
-            lexer: Lexer::new(lines, setup.block_delete),
+            interp: Interp::new(lines, setup),
             parser: Parser::new(setup),
             words: Vec::new(),
             pending: VecDeque::new(),
@@ -60,7 +61,19 @@ impl<'s, S: LineSource> Entries<'s, S> {
 
     /// Just past the last character of the source, once it is read to its end.
     pub fn eof(&self) -> SrcPos {
-        self.lexer.eof()
+        self.interp.eof()
+    }
+
+    /// The source, positioned after the last line the program read: a program ends at
+    /// `M02`/`M30` or its closing `%`, and the lines after it are not read (LinuxCNC's rule).
+    /// A reader that passes the text through (`dnurbs fit`) reads them from here.
+    pub fn into_source(self) -> S {
+        self.interp.tape.into_source()
+    }
+
+    /// Lines of the source held for a loop or a call to go back to (and the one being read).
+    pub fn kept_lines(&self) -> usize {
+        self.interp.tape.kept()
     }
 
     /// Motion blocks read so far.
@@ -98,7 +111,7 @@ impl<S: LineSource> Entries<'_, S> {
         if self.finished {
             return None;
         }
-        let result = match self.lexer.next_line(&mut self.words) {
+        let result = match self.interp.next(&self.parser, &mut self.words) {
             Ok(true) => self.parser.line(&self.words),
             Ok(false) => return None,
             Err(e) => Err(e),
@@ -133,7 +146,11 @@ impl<S: LineSource> Iterator for Entries<'_, S> {
                 Some(Err(e)) => return Some(Err(e)),
                 None => {
                     self.finished = true;
-                    let result = self.parser.check_end(self.lexer.eof());
+                    let eof = self.interp.eof();
+                    let result = self
+                        .interp
+                        .check_end(eof)
+                        .and_then(|()| self.parser.check_end(eof));
                     self.drain();
                     if let Err(e) = result {
                         self.parser.recover();

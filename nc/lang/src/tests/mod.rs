@@ -4,6 +4,7 @@
 
 mod errors;
 mod fuzz;
+mod interp;
 mod posts;
 mod source;
 

@@ -2,15 +2,20 @@
 
 use super::{fails, g065, message, KNOTS, OPEN, POINT};
 use crate::tests::at;
-use crate::{Context, Motion, ParseErrorKind as E};
+use crate::{parse, Context, Motion, ParseErrorKind as E};
 
 // ---- lexical rules -------------------------------------------------------------------------
 
 #[test]
 fn unexpected_character() {
     assert_eq!(
-        fails("G01 X0 Y0 Z0 F500 #1", 1, 19),
-        E::UnexpectedChar { ch: '#' }
+        fails("G01 X0 Y0 Z0 F500 $1", 1, 19),
+        E::UnexpectedChar { ch: '$' }
+    );
+    // `#` starts an assignment.
+    assert_eq!(
+        fails("G01 X0 Y0 Z0 F500 #1", 1, 21),
+        E::Interp(crate::InterpError::MissingEquals)
     );
     // Columns count characters, not bytes.
     assert_eq!(
@@ -31,13 +36,7 @@ fn letter_without_number() {
 #[test]
 fn number_too_large() {
     let src = format!("G00 X{} Y0 Z0", "9".repeat(400));
-    assert_eq!(
-        fails(&src, 1, 5),
-        E::NumberOutOfRange {
-            letter: 'X',
-            len: 400
-        }
-    );
+    assert_eq!(fails(&src, 1, 6), E::Interp(crate::InterpError::Infinite));
     // There are no exponents: `1e999` is X1 followed by the unknown word E999.
     assert_eq!(
         fails("G00 X1e999 Y0 Z0", 1, 7),
@@ -87,10 +86,9 @@ fn unsupported_word() {
 
 #[test]
 fn bad_sequence_number() {
-    assert_eq!(
-        fails("N1.5 G00 X0 Y0 Z0", 1, 1),
-        E::BadSequenceNumber { value: 1.5 }
-    );
+    // A fraction is read and ignored, as LinuxCNC does (`N1.5` is N1).
+    let p = parse("N1.5 G00 X0 Y0 Z0").unwrap();
+    assert!(matches!(p.blocks[0], nc_geom::program::Block::Linear(m) if m.n == Some(1)));
     assert_eq!(
         fails("N4294967296 G00 X0 Y0 Z0", 1, 1),
         E::BadSequenceNumber {
@@ -194,22 +192,13 @@ fn unsupported_m_code() {
 }
 
 #[test]
-fn words_after_program_end() {
-    let src = "G00 X0 Y0 Z0\nM30\n(comment)\n%\n\nG00 X1";
-    assert_eq!(
-        fails(src, 6, 1),
-        E::AfterProgramEnd {
-            letter: 'G',
-            end: at(2, 1)
-        }
-    );
-    assert_eq!(
-        fails("G00 X0 Y0 Z0 M02\nX1", 2, 1),
-        E::AfterProgramEnd {
-            letter: 'X',
-            end: at(1, 14)
-        }
-    );
+fn words_after_program_end_are_not_read() {
+    // LinuxCNC stops reading at M02/M30: what follows is never parsed.
+    let src = "G00 X0 Y0 Z0\nM30\n(comment)\n%\n\nG00 X1 garbage $$\n";
+    let p = parse(src).unwrap();
+    assert_eq!((p.blocks.len(), p.end), (1, Some(at(2, 1))));
+    let p = parse("G00 X0 Y0 Z0 M02\nX1").unwrap();
+    assert_eq!((p.blocks.len(), p.end), (1, Some(at(1, 14))));
 }
 
 #[test]

@@ -1,0 +1,379 @@
+//! The interpreter ([`Interp`]): RS274/NGC's parameters, expressions and flow control, between
+//! the program's text and the modal state machine (`parser`). It steps through the program's
+//! lines as LinuxCNC does (loops go back, calls go into a subroutine's body and return, a false
+//! branch is skipped), evaluates every expression on a line with the parameter values from
+//! before the line, applies the line's assignments (numbered ones, then named ones, each in
+//! source order) and hands the line's words, now plain numbers, to the parser.
+//!
+//! What runs here is the planner thread's work: it allocates and may take its time, but
+//! never without bound. Calls nest at most [`MAX_CALL_DEPTH`](crate::rules::MAX_CALL_DEPTH)
+//! deep, a program loops back at most [`Setup::max_iterations`] times, expressions nest at
+//! most [`MAX_EXPR_DEPTH`](crate::rules::MAX_EXPR_DEPTH) deep, and the lines kept are those a
+//! loop or a call may still go back to (`tape`).
+//!
+//! The program's flow (`flow.rs`) and the evaluation of a line (`evaluate.rs`) are methods
+//! of [`Interp`] in files of their own.
+
+use crate::error::{ParseError, ParseErrorKind};
+use crate::interp_error::InterpError;
+use crate::modal::Setup;
+use crate::name::Name;
+use crate::params::{Params, ARGUMENTS};
+use crate::source::LineSource;
+use crate::syntax::{self, Body, Keyword};
+use crate::tape::Tape;
+use crate::text::Normal;
+use crate::word::Word;
+use nc_geom::program::SrcPos;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::rc::Rc;
+
+/// What the interpreter reads from the machine's state: the parameters the state computes
+/// and whether the program has ended.
+pub(crate) trait State {
+    /// A numbered parameter the state gives (read-only: the position `#5420`.., the tool
+    /// `#5400`.., the offsets `#5221`..); `None` for a parameter the program keeps.
+    fn computed(&self, n: u32) -> Option<Result<f64, InterpError>>;
+    /// A predefined named parameter (`_x`, `_metric`, `_motion_mode`, ...): `None` when
+    /// `name` is not one.
+    fn predefined(&self, name: &str) -> Option<Result<f64, InterpError>>;
+    /// `M02`/`M30` has been executed.
+    fn ended(&self) -> bool;
+}
+
+/// Where a frame's lines come from.
+#[derive(Clone)]
+pub(crate) enum Src {
+    Main,
+    Sub(Rc<Sub>),
+}
+
+/// A subroutine: the lines of its body, its `endsub` last.
+pub(crate) struct Sub {
+    pub name: String,
+    pub body: Vec<Rc<Normal>>,
+    /// The line of its `sub`.
+    pub line: u32,
+    /// Where its `sub` line stands in the main program (`None`: from a file), and whether a
+    /// call found it by reading ahead (the program must then not run into it).
+    pub main_index: Option<usize>,
+    pub read_ahead: bool,
+}
+
+/// An open `if`, loop or `do`.
+#[derive(Clone, Debug)]
+pub(crate) struct Open {
+    pub label: String,
+    pub keyword: Keyword,
+    /// Index of its opening line in the frame's source.
+    pub start: usize,
+    pub line: u32,
+    /// `if`: a branch has run. `repeat`: the iterations still to run.
+    pub taken: bool,
+    pub remaining: i64,
+}
+
+/// One level of calls: level 0 is the main program.
+pub(crate) struct Frame {
+    pub src: Src,
+    /// The next line to execute.
+    pub pc: usize,
+    pub open: Vec<Open>,
+    /// The caller's `#1`..`#30`.
+    pub saved: [f64; ARGUMENTS],
+    /// The subroutine's name ("" for the main program): the scope of its labels.
+    pub name: String,
+}
+
+/// Skipping lines up to the next O-line of `label`: a false branch, a loop's exit.
+#[derive(Clone, Debug)]
+pub(crate) struct Skip {
+    pub label: String,
+    /// The line found is passed over (a loop's exit) rather than executed (an `else`).
+    pub consume: bool,
+    pub keyword: Keyword,
+    pub line: u32,
+}
+
+/// A `%` first in the program (tape mode): a later `%` line ends it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Percent {
+    Undecided,
+    On,
+    Off,
+}
+
+/// The interpreter over one main program.
+pub(crate) struct Interp<S> {
+    pub tape: Tape<S>,
+    pub params: Params,
+    pub frames: Vec<Frame>,
+    pub subs: HashMap<String, Rc<Sub>>,
+    /// Labels of `if`, loops and `do` by (scope, label): the keyword and line that opened them.
+    pub labels: HashMap<(String, String), (Keyword, u32)>,
+    pub skip: Option<Skip>,
+    /// A subroutine definition being read (not executed).
+    pub defining: Option<Sub>,
+    pub dirs: Vec<PathBuf>,
+    /// Loop-backs still allowed.
+    pub budget: u64,
+    /// `#<_value>` and `#<_value_returned>`.
+    pub value: f64,
+    pub value_returned: bool,
+    /// The physical line being executed (`#<_line>`).
+    pub line: u32,
+    block_delete: bool,
+    percent: Percent,
+    finished: bool,
+}
+
+pub(crate) fn err(kind: InterpError, pos: SrcPos) -> ParseError {
+    ParseErrorKind::Interp(kind).at(pos)
+}
+
+impl<S: LineSource> Interp<S> {
+    pub fn new(lines: S, setup: &Setup) -> Self {
+        Interp {
+            tape: Tape::new(lines),
+            params: Params::default(),
+            frames: vec![Frame {
+                src: Src::Main,
+                pc: 0,
+                open: Vec::new(),
+                saved: [0.0; ARGUMENTS],
+                name: String::new(),
+            }],
+            subs: HashMap::new(),
+            labels: HashMap::new(),
+            skip: None,
+            defining: None,
+            dirs: setup.subroutine_dirs.clone(),
+            budget: setup.max_iterations,
+            value: 0.0,
+            value_returned: false,
+            line: 0,
+            block_delete: setup.block_delete,
+            percent: Percent::Undecided,
+            finished: false,
+        }
+    }
+
+    /// Just past the source's last character, once it is read to its end.
+    pub fn eof(&self) -> SrcPos {
+        self.tape.eof()
+    }
+
+    /// The call level (0: the main program).
+    pub fn level(&self) -> usize {
+        self.frames.len() - 1
+    }
+
+    pub fn frame(&self) -> &Frame {
+        // There is always the main program's frame.
+        &self.frames[self.frames.len() - 1]
+    }
+
+    pub fn frame_mut(&mut self) -> &mut Frame {
+        let last = self.frames.len() - 1;
+        &mut self.frames[last]
+    }
+
+    /// The current frame's next line, and its index; `None` at the end of its source.
+    fn fetch(&mut self) -> Result<Option<(Rc<Normal>, usize)>, ParseError> {
+        let frame = self.frame();
+        let pc = frame.pc;
+        let line = match &frame.src {
+            Src::Main => self.tape.line(pc)?,
+            Src::Sub(sub) => sub.body.get(pc).cloned(),
+        };
+        Ok(line.map(|l| (l, pc)))
+    }
+
+    /// Lets the tape drop the main program's lines nothing can go back to: those before the
+    /// line being executed (it may open a loop) and before every open construct.
+    fn release(&mut self, current: usize) {
+        let main = &self.frames[0];
+        let here = if self.level() == 0 { current } else { main.pc };
+        let keep = main.open.iter().map(|o| o.start).fold(here, usize::min);
+        self.tape.release(keep);
+    }
+
+    /// The next line with words for the parser, into `words` (cleared first): `Ok(false)` at
+    /// the program's end, or when the source has no line yet. After an error in the flow
+    /// (an O-line), interpretation stops: the lines after it would run in a flow the program
+    /// did not mean.
+    pub fn next(&mut self, state: &impl State, words: &mut Vec<Word>) -> Result<bool, ParseError> {
+        words.clear();
+        loop {
+            if self.finished || state.ended() {
+                self.finished = true;
+                return Ok(false);
+            }
+            let Some((line, index)) = self.fetch()? else {
+                return Ok(false);
+            };
+            self.frame_mut().pc = index + 1;
+            self.release(index);
+            self.line = line.line;
+            match self.step(&line, index, state, words) {
+                Ok(true) => return Ok(true),
+                Ok(false) => {}
+                Err(e) => {
+                    // An error in the flow stops here: the lines after it would run in a
+                    // flow the program did not mean. A line's own error (a word, an
+                    // expression) does not: the next line is read as usual.
+                    let aborted =
+                        matches!(e.kind, ParseErrorKind::Interp(InterpError::Abort { .. }));
+                    self.finished = aborted || syntax::is_o_line(&line) || self.defining.is_some();
+                    return Err(e);
+                }
+            }
+        }
+    }
+
+    /// One line: `Ok(true)` when it has words for the parser.
+    fn step(
+        &mut self,
+        line: &Rc<Normal>,
+        index: usize,
+        state: &impl State,
+        words: &mut Vec<Word>,
+    ) -> Result<bool, ParseError> {
+        if self.defining.is_some() {
+            self.define(line)?;
+            return Ok(false);
+        }
+        if line.slash && self.block_delete {
+            return Ok(false);
+        }
+        let main = self.level() == 0;
+        if main && self.percent == Percent::Undecided {
+            if line.is_empty() && line.comment.is_none() {
+                return Ok(false);
+            }
+            self.percent = if line.is_percent() {
+                Percent::On
+            } else {
+                Percent::Off
+            };
+            if self.percent == Percent::On {
+                return Ok(false);
+            }
+        }
+        if line.text == ['%'] {
+            if main && self.percent == Percent::On && self.skip.is_none() {
+                self.finished = true;
+                return Ok(false);
+            }
+            if self.skip.is_none() {
+                return Err(ParseErrorKind::MisplacedTapeMark.at(line.pos(0)));
+            }
+            return Ok(false);
+        }
+        if let Some(skip) = &self.skip {
+            if !syntax::is_o_line(line) {
+                return Ok(false);
+            }
+            let syn = syntax::read(line)?;
+            let Body::O(o) = syn.body else {
+                return Ok(false);
+            };
+            let label = self.label_name(&o.label, state)?;
+            if label != skip.label {
+                return Ok(false);
+            }
+            let consume = skip.consume;
+            self.skip = None;
+            if consume {
+                return Ok(false);
+            }
+            self.o_line(o, label, index, line, state)?;
+            return Ok(false);
+        }
+        if line.is_empty() {
+            self.comment(line)?;
+            return Ok(false);
+        }
+        let syn = syntax::read(line)?;
+        match syn.body {
+            Body::O(o) => {
+                let label = self.label_name(&o.label, state)?;
+                self.o_line(o, label, index, line, state)?;
+                Ok(false)
+            }
+            Body::Items(items) => {
+                self.evaluate(syn.n, &items, state, words)?;
+                self.comment(line)?;
+                Ok(!words.is_empty())
+            }
+        }
+    }
+
+    /// A line's comment: `(ABORT, ...)` stops the program with its text.
+    fn comment(&self, line: &Normal) -> Result<(), ParseError> {
+        let Some((text, pos)) = &line.comment else {
+            return Ok(());
+        };
+        let body = text.trim_start();
+        if body.get(..6).map(str::to_ascii_lowercase).as_deref() == Some("abort,") {
+            let message = Name::new(body.get(6..).unwrap_or("").trim());
+            return Err(err(InterpError::Abort { message }, *pos));
+        }
+        Ok(())
+    }
+
+    /// At the source's end: what is still open is an error at `eof`.
+    pub fn check_end(&mut self, eof: SrcPos) -> Result<(), ParseError> {
+        if self.finished {
+            return Ok(());
+        }
+        self.finished = true;
+        if let Some(sub) = &self.defining {
+            return Err(err(
+                InterpError::NotClosed {
+                    label: Name::new(&sub.name),
+                    keyword: "sub",
+                    closer: "endsub",
+                    line: sub.line,
+                },
+                eof,
+            ));
+        }
+        if let Some(skip) = &self.skip {
+            return Err(err(
+                InterpError::NotClosed {
+                    label: Name::new(&skip.label),
+                    keyword: skip.keyword.name(),
+                    closer: "line",
+                    line: skip.line,
+                },
+                eof,
+            ));
+        }
+        if let Some(open) = self.frames[0].open.last() {
+            return Err(err(
+                InterpError::NotClosed {
+                    label: Name::new(&open.label),
+                    keyword: open.keyword.name(),
+                    closer: closer(open.keyword),
+                    line: open.line,
+                },
+                eof,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The keyword that closes `k`.
+pub(crate) fn closer(k: Keyword) -> &'static str {
+    match k {
+        Keyword::If | Keyword::ElseIf | Keyword::Else => "endif",
+        Keyword::While => "endwhile",
+        Keyword::Do => "while",
+        Keyword::Repeat => "endrepeat",
+        Keyword::Sub => "endsub",
+        _ => "end",
+    }
+}

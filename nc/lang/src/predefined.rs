@@ -1,0 +1,140 @@
+//! The parameters the modal state gives the interpreter ([`State`] for the parser): the
+//! position `#5420`.. and `#<_x>`.., the tool `#5400`.., the work offsets `#5220`..
+//! `#5221`.., the reference position `#5161`.., and the modes `#<_metric>`,
+//! `#<_motion_mode>`, ... as LinuxCNC names and numbers them. Lengths are in the program's
+//! units (G20/G21 in effect), positions in the active work coordinate system, as LinuxCNC's
+//! `#5420` reads. All of them are read-only: the offsets, the reference and the tools come
+//! from the machine file.
+
+use crate::codes::LengthComp;
+use crate::interp::State;
+use crate::interp_error::InterpError;
+use crate::name::Name;
+use crate::parser::Parser;
+use crate::vocab::{Motion, Plane};
+use nc_geom::program::Orientation;
+
+impl Parser<'_> {
+    /// The position in program coordinates: axis `i` (0..3 X Y Z, 3..6 A B C).
+    fn position(&self, i: usize, name: &str) -> Result<f64, InterpError> {
+        let unknown = || InterpError::PositionUnknown {
+            name: Name::new(name),
+        };
+        if i < 3 {
+            let here = self.here.or_else(|| {
+                self.setup
+                    .reference
+                    .map(|r| [r[0], r[1], r[2] - self.modal.tool_length])
+            });
+            let here = here.ok_or_else(unknown)?;
+            return Ok((here[i] - self.modal.offset[i]) / self.modal.scale());
+        }
+        match self.orientation {
+            Orientation::Angles { r1_deg, r2_deg } => Ok(match (i, self.rotary) {
+                (5, _) => r2_deg,
+                (3, Some(('A', _)) | None) | (4, Some(('B', _))) => r1_deg,
+                _ => 0.0,
+            }),
+            Orientation::Vector([0.0, 0.0, 1.0]) => Ok(0.0),
+            Orientation::Vector(_) => Err(unknown()),
+        }
+    }
+
+    /// Work offset `k` (0: G54), axis `i`, in program units.
+    fn offset(&self, k: usize, i: usize) -> f64 {
+        let o = self
+            .setup
+            .work_offsets
+            .get(k)
+            .copied()
+            .flatten()
+            .unwrap_or([0.0; 3]);
+        o.get(i).copied().unwrap_or(0.0) / self.modal.scale()
+    }
+
+    fn motion_mode(&self) -> f64 {
+        match self.mode {
+            None => 800.0,
+            Some(Motion::G00) => 0.0,
+            Some(Motion::G01) => 10.0,
+            Some(Motion::G02) => 20.0,
+            Some(Motion::G03) => 30.0,
+            Some(Motion::G062 | Motion::G065) => 10.0,
+        }
+    }
+}
+
+fn flag(b: bool) -> f64 {
+    f64::from(u8::from(b))
+}
+
+impl State for Parser<'_> {
+    fn computed(&self, n: u32) -> Option<Result<f64, InterpError>> {
+        let scale = self.modal.scale();
+        Some(Ok(match n {
+            5161..=5169 => {
+                let i = (n - 5161) as usize;
+                let r = self.setup.reference.unwrap_or([0.0; 3]);
+                r.get(i).copied().unwrap_or(0.0) / scale
+            }
+            5220 => f64::from(self.modal.work) + 1.0,
+            5221..=5390 if (n - 5221) % 20 < 10 => {
+                let k = ((n - 5221) / 20) as usize;
+                let i = ((n - 5221) % 20) as usize;
+                if k >= 6 {
+                    0.0
+                } else {
+                    self.offset(k, i)
+                }
+            }
+            5400 => f64::from(self.modal.loaded.unwrap_or(0)),
+            5401..=5413 => match n {
+                5403 => self.modal.tool_length / scale,
+                _ => 0.0,
+            },
+            5420..=5425 => return Some(self.position((n - 5420) as usize, "5420..5425")),
+            5426..=5428 => 0.0,
+            _ => return None,
+        }))
+    }
+
+    fn predefined(&self, name: &str) -> Option<Result<f64, InterpError>> {
+        let m = &self.modal;
+        let axis = |i: usize| Some(self.position(i, name));
+        Some(Ok(match name {
+            "_x" => return axis(0),
+            "_y" => return axis(1),
+            "_z" => return axis(2),
+            "_a" => return axis(3),
+            "_b" => return axis(4),
+            "_c" => return axis(5),
+            "_u" | "_v" | "_w" => 0.0,
+            "_motion_mode" => self.motion_mode(),
+            "_plane" => match m.plane {
+                Plane::Xy => 170.0,
+                Plane::Zx => 180.0,
+                Plane::Yz => 190.0,
+            },
+            "_ccomp" => 400.0,
+            "_metric" => flag(!m.inch),
+            "_imperial" => flag(m.inch),
+            "_absolute" => flag(!m.incremental),
+            "_incremental" => flag(m.incremental),
+            "_inverse_time" => flag(m.inverse_time),
+            "_units_per_minute" => flag(!m.inverse_time),
+            "_units_per_rev" => 0.0,
+            "_coord_system" => 540.0 + 10.0 * f64::from(m.work),
+            "_tool_offset" => flag(m.comp != LengthComp::Off && m.tool_length != 0.0),
+            "_feed" => self.feed.map_or(0.0, |f| f / m.scale()),
+            "_rpm" => m.rpm,
+            "_current_tool" => f64::from(m.loaded.unwrap_or(0)),
+            "_selected_tool" => f64::from(m.selected.unwrap_or(0)),
+            "_metric_machine" => 1.0,
+            _ => return None,
+        }))
+    }
+
+    fn ended(&self) -> bool {
+        self.end().is_some()
+    }
+}

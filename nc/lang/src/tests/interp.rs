@@ -1,0 +1,237 @@
+//! The interpreter: parameters, the order of evaluation on a line, flow control,
+//! subroutines, `%` and the end of the program, as LinuxCNC's `rs274` does them (each case
+//! was run through `rs274 -g`; the conformance suite in `tests/conformance.rs` compares whole
+//! programs).
+
+use super::{at, linear};
+use crate::{parse, parse_with, InterpError as I, ParseErrorKind as E, Setup};
+use nc_geom::program::Program;
+
+/// The X of every move.
+fn xs(p: &Program) -> Vec<f64> {
+    p.blocks.iter().map(|b| linear(b).end[0]).collect()
+}
+
+fn run(src: &str) -> Vec<f64> {
+    xs(&parse(src).unwrap_or_else(|e| panic!("{e}\n{src}")))
+}
+
+fn fails(src: &str) -> (E, u32, u32) {
+    let e = parse(src).expect_err("the program must be rejected");
+    (e.kind, e.pos.line, e.pos.col)
+}
+
+#[test]
+fn expressions_read_the_parameters_from_before_the_line() {
+    let src = "G0 X0 Y0 Z0\n#1=5 G0 X#1\nG0 X#1\n#1=1 #2=2 #1=#2 #2=#1\nG0 X[#1*10+#2]\nM2";
+    // #1 = old #2 = 0, #2 = old #1 = 5.
+    assert_eq!(run(src), [0.0, 0.0, 5.0, 5.0]);
+    let src = "G0 X0 Y0 Z0\n#1=2\nG0 X[2**3 + 10 MOD 4 - ABS[-1] + [1 GT 0]] Y0\nM2";
+    assert_eq!(run(src), [0.0, 8.0 + 2.0 - 1.0 + 1.0]);
+    let src = "G0 X0 Y0 Z0\nG0 X[ATAN[1]/[1]] Y[SQRT[16]] Z[ROUND[2.5]]\nM2";
+    let p = parse(src).unwrap();
+    assert_eq!(linear(&p.blocks[1]).end, [45.0, 4.0, 3.0]);
+    // Indirection, and a G code from a parameter.
+    let src = "#2=7 #7=3\nG0 X0 Y0 Z0\nG0 X##2\n#3=1\nG#3 X1 F100\nM2";
+    let p = parse(src).unwrap();
+    assert_eq!(xs(&p), [0.0, 3.0, 1.0]);
+    assert!(!linear(&p.blocks[2]).rapid);
+}
+
+#[test]
+fn named_parameters_local_global_and_created_by_their_assignment() {
+    let src = "#<a>=[#<a>+1]\n#<a>=[#<a>+1]\n#<_g>=3\nG0 X#<a> Y#<_g> Z[EXISTS[#<a>]]\nM2";
+    let p = parse(src).unwrap();
+    assert_eq!(linear(&p.blocks[0]).end, [2.0, 3.0, 1.0]);
+    let (kind, line, col) = fails("G0 X#<nope> Y0 Z0\nM2");
+    assert_eq!(
+        kind,
+        E::Interp(I::UndefinedNamed {
+            name: crate::Name::new("nope")
+        })
+    );
+    assert_eq!((line, col), (1, 5));
+    // A main program's local is not visible in a subroutine.
+    let src = "o<s> sub\nG0 X[EXISTS[#<x>]] Y#<_k> Z0\no<s> endsub\n#<x>=3 #<_k>=4\no<s> call\nM2";
+    assert_eq!(run(src), [0.0]);
+}
+
+#[test]
+fn predefined_parameters_read_the_state() {
+    let src = "G0 X1 Y2 Z3\nG0 X[#5420+#<_y>] Y#<_metric> Z#<_motion_mode>\nG20\nG0 X#<_x>\nM2";
+    let p = parse(src).unwrap();
+    assert_eq!(linear(&p.blocks[1]).end, [3.0, 1.0, 0.0]);
+    // In inches, #<_x> reads inches: X3 mm is X0.11811 in, written back unchanged.
+    assert!((linear(&p.blocks[2]).end[0] - 3.0).abs() < 1e-12);
+    let (kind, ..) = fails("#5420=1\nM2");
+    assert!(matches!(
+        kind,
+        E::Interp(I::ReadOnlyParameter { number: 5420, .. })
+    ));
+    let (kind, ..) = fails("#<_x>=1\nM2");
+    assert!(matches!(kind, E::Interp(I::ReadOnlyNamed { .. })));
+    let (kind, ..) = fails("G0 X#<_x>\nM2");
+    assert!(matches!(kind, E::Interp(I::PositionUnknown { .. })));
+}
+
+#[test]
+fn if_elseif_else() {
+    let prog = |v: i32| {
+        format!(
+            "G0 X0 Y0 Z0\n#1={v}\no1 if [#1 EQ 1]\nG0 X1\no1 elseif [#1 EQ 2]\nG0 X2\no1 else\nG0 X3\no1 endif\nM2"
+        )
+    };
+    assert_eq!(run(&prog(1)), [0.0, 1.0]);
+    assert_eq!(run(&prog(2)), [0.0, 2.0]);
+    assert_eq!(run(&prog(7)), [0.0, 3.0]);
+    // A false branch is not read: its errors do not count.
+    assert_eq!(
+        run("o1 if [0]\nG0 X[1/0] garbage $$\no1 endif\nG0 X1 Y0 Z0\nM2"),
+        [1.0]
+    );
+}
+
+#[test]
+fn loops() {
+    let src = "G0 X0 Y0 Z0\n#1=0\no1 while [#1 LT 3]\n#1=[#1+1]\nG0 X#1\no1 endwhile\nM2";
+    assert_eq!(run(src), [0.0, 1.0, 2.0, 3.0]);
+    let src = "G0 X0 Y0 Z0\n#1=0\no2 do\n#1=[#1+1]\nG0 X#1\no2 while [#1 LT 2]\nM2";
+    assert_eq!(run(src), [0.0, 1.0, 2.0]);
+    // repeat rounds half to even: [2.5] is 2.
+    let src = "G0 X0 Y0 Z0\n#1=0\no3 repeat [2.5]\n#1=[#1+1]\nG0 X#1\no3 endrepeat\nM2";
+    assert_eq!(run(src), [0.0, 1.0, 2.0]);
+    let src =
+        "G0 X0 Y0 Z0\n#1=0\no4 while [1]\n#1=[#1+1]\no5 if [#1 EQ 2]\no4 continue\no5 endif\n\
+               o6 if [#1 GT 3]\no4 break\no6 endif\nG0 X#1\no4 endwhile\nG0 X9\nM2";
+    assert_eq!(run(src), [0.0, 1.0, 3.0, 9.0]);
+}
+
+#[test]
+fn a_loop_that_never_ends_is_refused_at_its_line() {
+    let setup = Setup {
+        max_iterations: 1000,
+        ..Setup::default()
+    };
+    let e = parse_with("G0 X0 Y0 Z0\no1 while [1]\no1 endwhile\nM2", &setup).unwrap_err();
+    let first = e.errors[0];
+    assert!(
+        matches!(first.kind, E::Interp(I::TooManyIterations { .. })),
+        "{first}"
+    );
+    assert_eq!(first.pos, at(3, 1));
+    assert_eq!(e.errors.len(), 1, "interpretation stops at a flow error");
+}
+
+#[test]
+fn subroutines_with_arguments_and_return_values() {
+    let src = "o<twice> sub\no<twice> return [#1*2]\no<twice> endsub\n\
+               G0 X0 Y0 Z0\n#1=7\no<twice> call [5]\nG0 X#<_value> Y#1\nM2";
+    let p = parse(src).unwrap();
+    assert_eq!(
+        linear(&p.blocks[1]).end,
+        [10.0, 7.0, 0.0],
+        "#1 restored after the call"
+    );
+    // Called before its definition, which stands after M2.
+    let src = "G0 X0 Y0 Z0\no100 call [3]\nM2\no100 sub\nG0 X#1\no100 endsub\n";
+    assert_eq!(run(src), [0.0, 3.0]);
+    // Recursion ends at the call depth.
+    let src = "o<r> sub\no<r> call\no<r> endsub\no<r> call\nM2";
+    assert!(matches!(fails(src).0, E::Interp(I::TooManyCalls { .. })));
+    // Falling into a definition the program read ahead to.
+    let src = "o<a> call\no<a> sub\no<a> endsub\nM2";
+    assert!(matches!(
+        fails(src).0,
+        E::Interp(I::DefinitionInTheWay { .. })
+    ));
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\no<nowhere> call\nM2");
+    assert!(matches!(kind, E::Interp(I::SubroutineNotFound { .. })));
+    assert_eq!(line, 2);
+}
+
+#[test]
+fn a_subroutine_file_from_the_subroutine_directories() {
+    let dir = std::env::temp_dir().join(format!("dnurbs-subs-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("hop.ngc"),
+        "(header)\no<hop> sub\nG0 X#1\no<hop> endsub\nM2\n",
+    )
+    .unwrap();
+    let setup = Setup {
+        subroutine_dirs: vec![dir.join("missing"), dir.clone()],
+        ..Setup::default()
+    };
+    let p = parse_with("G0 X0 Y0 Z0\no<hop> call [4]\nG0 X5\nM2", &setup).unwrap();
+    assert_eq!(xs(&p), [0.0, 4.0, 5.0]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn labels_are_checked() {
+    let src = "o10 if [1]\no10 endif\no10 if [1]\no10 endif\nM2";
+    assert!(matches!(
+        fails(src),
+        (E::Interp(I::DuplicateLabel { line: 1, .. }), 3, 1)
+    ));
+    let src = "o10 if [1]\no11 endif\nM2";
+    assert!(matches!(fails(src).0, E::Interp(I::UnmatchedLabel { .. })));
+    let src = "o100 repeat [2]\no100 break\no100 endrepeat\nM2";
+    assert!(matches!(fails(src).0, E::Interp(I::MismatchedLabel { .. })));
+    let src = "G0 X0 Y0 Z0\no1 while [1]\nG0 X1\n";
+    assert!(matches!(
+        fails(src),
+        (E::Interp(I::NotClosed { line: 2, .. }), 3, 6)
+    ));
+    assert!(matches!(
+        fails("o<s> endsub\nM2").0,
+        E::Interp(I::NotInSubroutine { .. })
+    ));
+}
+
+#[test]
+fn percent_lines_and_the_program_end() {
+    // `%` first: a later `%` ends the program, nothing after it is read.
+    assert_eq!(run("\n%\nG0 X1 Y0 Z0\n%\nG0 X$$\n"), [1.0]);
+    // Without a `%` first, a `%` line is an error.
+    assert_eq!(fails("G0 X1 Y0 Z0\n%\nM2").0, E::MisplacedTapeMark);
+    // `% text` is no tape mark.
+    assert_eq!(fails("% O1000\nM2").0, E::MisplacedTapeMark);
+    // Text after M2 is not read.
+    assert_eq!(run("G0 X1 Y0 Z0\nM2\nthis is not gcode\n"), [1.0]);
+}
+
+#[test]
+fn spaces_anywhere_and_abort() {
+    assert_eq!(run("G 0 X 1 . 5 Y- 2 Z0\nG0X  16.339\nM2"), [1.5, 16.339]);
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\n(ABORT, tool broken)\nG0 X1\nM2");
+    assert_eq!(
+        kind,
+        E::Interp(I::Abort {
+            message: crate::Name::new("tool broken")
+        })
+    );
+    assert_eq!((line, col), (2, 1));
+}
+
+#[test]
+fn the_tape_keeps_only_what_a_loop_may_go_back_to() {
+    use crate::source::StrLines;
+    use crate::stream::Entries;
+    let mut src = String::from("G0 X0 Y0 Z0\n");
+    for k in 0..2000 {
+        src.push_str("#1=[#1+1] G1 X[#1*0.001] F100\n");
+        if k == 1000 {
+            src.push_str("o1 repeat [3]\nG1 X1\nG1 X2\no1 endrepeat\n");
+        }
+    }
+    src.push_str("M2\n");
+    let setup = Setup::default();
+    let mut entries = Entries::new(StrLines::new(&src), &setup);
+    let mut most = 0;
+    while let Some(e) = entries.next() {
+        e.unwrap();
+        most = most.max(entries.kept_lines());
+    }
+    assert!(most <= 6, "kept {most} lines");
+}
