@@ -23,12 +23,20 @@
 //!
 //! The centre comes from `I J K` (offsets from the start, in the plane's letters) or from `R`
 //! (`R > 0`: the arc of at most 180 deg, `R < 0`: the longer one). Posted coordinates are
-//! rounded, so the start and end radii differ slightly: up to [`ARC_RADIUS_TOL_MM`] is
-//! accepted, and the centre is moved onto the bisector of start and end (the nearest point to
-//! the programmed centre), so the arc runs exactly from the start to the programmed end.
+//! rounded, so the start and end radii differ slightly: what LinuxCNC accepts is accepted
+//! ([`ArcTol`]: [`ARC_RADIUS_TOL_MM`], or up to 100 times it within
+//! [`ARC_RADIUS_REL_TOL`] of the radius), and run as LinuxCNC runs it: about the programmed
+//! centre, the radius turning linearly with the angle from the start's to the end's
+//! (`spiral.rs`: pieces of degree 5), so the arc runs exactly from the start to the
+//! programmed end on LinuxCNC's path.
+
+mod spiral;
 
 use super::error::ParseErrorKind;
-use crate::rules::{ARC_RADIUS_TOL_MM, HELIX_TOL_MM, MIN_ARC_RADIUS_MM};
+use crate::rules::{
+    ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_IN, ARC_RADIUS_TOL_MM, ARC_REACH_TOL_IN, ARC_REACH_TOL_MM,
+    HELIX_TOL_MM, MIN_ARC_RADIUS_MM,
+};
 use crate::vocab::Plane;
 use core::f64::consts::{FRAC_PI_2, TAU};
 
@@ -40,6 +48,45 @@ const HELIX_ERR: f64 = 0.0027;
 /// far fewer (a full turn of radius 0.01 mm rising 200 000 mm: about 510 pieces); beyond it
 /// the arc is an error.
 const MAX_CTRL: usize = nc_geom::program::MAX_BLOCK_CTRL;
+
+/// Start and end radii closer than this are one radius (a circle, not a spiral).
+const SAME_RADIUS_MM: f64 = 1e-9;
+
+/// How far an arc's numbers may be off, in mm: LinuxCNC's tolerances in the program's units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ArcTol {
+    /// Start and end radii may differ by this ([`ARC_RADIUS_TOL_MM`]).
+    pub radius_mm: f64,
+    /// `R` may fall short of half the chord by this ([`ARC_REACH_TOL_MM`]).
+    pub reach_mm: f64,
+}
+
+impl ArcTol {
+    /// The tolerances of a program in inches (`G20`) or millimetres.
+    pub fn for_units(inch: bool) -> ArcTol {
+        if inch {
+            ArcTol {
+                radius_mm: ARC_RADIUS_TOL_IN * 25.4,
+                reach_mm: ARC_REACH_TOL_IN * 25.4,
+            }
+        } else {
+            ArcTol {
+                radius_mm: ARC_RADIUS_TOL_MM,
+                reach_mm: ARC_REACH_TOL_MM,
+            }
+        }
+    }
+
+    /// Whether radii `rs` and `re` differ by too much: by more than 100 times the
+    /// tolerance, or by more than the tolerance and [`ARC_RADIUS_REL_TOL`] of the radius.
+    fn mismatch(&self, rs: f64, re: f64) -> bool {
+        let abs = (rs - re).abs();
+        let rel = abs / rs.max(re);
+        abs.is_nan()
+            || abs > 100.0 * self.radius_mm
+            || (rel > ARC_RADIUS_REL_TOL && abs > self.radius_mm)
+    }
+}
 
 /// How the arc's centre is given.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,6 +119,7 @@ pub fn arc(
     plane: Plane,
     clockwise: bool,
     centre: Centre,
+    tol: ArcTol,
 ) -> Result<ArcNet, ParseErrorKind> {
     let (a, b, n) = plane.axes();
     let at = |p: &[f64; 3], i: usize| p.get(i).copied().unwrap_or(0.0);
@@ -80,30 +128,30 @@ pub fn arc(
     let (da, db) = (ea - sa, eb - sb);
     let chord = da.hypot(db);
     let full = chord <= 1e-9;
+    let mut end_radius = None;
     let (ca, cb) = match centre {
         Centre::Offsets(i, j) => {
             let (ca, cb) = (sa + i, sb + j);
             let rs = (sa - ca).hypot(sb - cb);
             let re = (ea - ca).hypot(eb - cb);
-            if (rs - re).is_nan() || (rs - re).abs() > ARC_RADIUS_TOL_MM {
-                return Err(ParseErrorKind::ArcRadiusMismatch { start: rs, end: re });
+            if tol.mismatch(rs, re) {
+                return Err(ParseErrorKind::ArcRadiusMismatch {
+                    start: rs,
+                    end: re,
+                    tol: tol.radius_mm,
+                });
             }
-            if full {
-                (ca, cb)
-            } else {
-                // The point of the bisector of start and end nearest the programmed centre.
-                let (ma, mb) = ((sa + ea) / 2.0, (sb + eb) / 2.0);
-                let (ua, ub) = (-db / chord, da / chord);
-                let t = (ca - ma) * ua + (cb - mb) * ub;
-                (ma + t * ua, mb + t * ub)
+            if !full && (rs - re).abs() > SAME_RADIUS_MM {
+                end_radius = Some(re);
             }
+            (ca, cb)
         }
         Centre::Radius(r) => {
             if full {
                 return Err(ParseErrorKind::ArcFullCircleRadius);
             }
             let half = chord / 2.0;
-            if r.abs() < half - ARC_RADIUS_TOL_MM {
+            if r.abs() < half - tol.reach_mm {
                 return Err(ParseErrorKind::ArcRadiusTooSmall { value: r, half });
             }
             let h = (r * r - half * half).max(0.0).sqrt();
@@ -142,6 +190,34 @@ pub fn arc(
     }
     // A sweep of (nearly) a whole turn between distinct points is a rounding artefact of a
     // tiny arc programmed the other way round: keep it, it is what the words say.
+    if let Some(re) = end_radius {
+        let (ctrl, weights, knots) = spiral::net(
+            start,
+            end,
+            [a, b, n],
+            (ca, cb),
+            phi0,
+            sweep,
+            (radius, re),
+            MAX_CTRL,
+        )?;
+        let mut centre = start;
+        if let Some(v) = centre.get_mut(a) {
+            *v = ca;
+        }
+        if let Some(v) = centre.get_mut(b) {
+            *v = cb;
+        }
+        return Ok(ArcNet {
+            degree: spiral::DEGREE as u8,
+            ctrl,
+            weights,
+            knots,
+            centre,
+            radius,
+            sweep,
+        });
+    }
     let rise = at(&end, n) - at(&start, n);
     let helix = rise != 0.0;
     let degree: usize = if helix { 4 } else { 2 };

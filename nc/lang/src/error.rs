@@ -8,8 +8,8 @@
 use core::fmt;
 
 use crate::rules::{
-    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_DWELL_S, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN,
-    MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
+    G_LIST, HELIX_TOL_MM, MAX_DWELL_S, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN, MIN_TOOL_OFFSET_MM,
+    MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
 };
 use crate::vocab::{Motion, Plane};
 use nc_geom::program::SrcPos;
@@ -177,8 +177,8 @@ pub enum ParseErrorKind {
     ArcCentreAndRadius { motion: Motion, letter: char },
     #[error("centre offset {letter} is not in the {} plane: its offsets are {}", .plane.name(), .plane.offset_letters())]
     ArcOffsetOutOfPlane { letter: char, plane: Plane },
-    #[error("the arc's radius is {start} mm at its start and {end} mm at its end: they differ by more than {ARC_RADIUS_TOL_MM} mm (check the end point and the centre)")]
-    ArcRadiusMismatch { start: f64, end: f64 },
+    #[error("the arc's radius is {start} mm at its start and {end} mm at its end: they differ by more than {tol} mm and 0.1 % of the radius, or by more than 100 x {tol} mm (LinuxCNC's rule; check the end point and the centre)")]
+    ArcRadiusMismatch { start: f64, end: f64, tol: f64 },
     #[error("arc radius R{value} is less than half the distance to the end point ({half} mm): no arc fits")]
     ArcRadiusTooSmall { value: f64, half: f64 },
     #[error("an arc given by R cannot end where it starts: program a full circle with its centre offsets")]

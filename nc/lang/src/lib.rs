@@ -118,15 +118,16 @@ mod vocab;
 mod word;
 pub use word::continues;
 
-pub use arc::{arc, ArcNet, Centre};
+pub use arc::{arc, ArcNet, ArcTol, Centre};
 pub use error::{Context, ParseError, ParseErrorKind};
 pub use interp_error::InterpError;
 pub use modal::{Setup, MAX_ERRORS, MM_PER_INCH};
 pub use name::Name;
 pub use rules::{
-    ARC_RADIUS_TOL_MM, G_LIST, HELIX_TOL_MM, MAX_CALL_DEPTH, MAX_DWELL_S, MAX_LOOP_ITERATIONS,
-    MAX_PARAMETER, MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN, MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH,
-    MIN_WEIGHT, M_LIST, START_TOLERANCE_MM,
+    ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_IN, ARC_RADIUS_TOL_MM, ARC_REACH_TOL_IN, ARC_REACH_TOL_MM,
+    G_LIST, HELIX_TOL_MM, MAX_CALL_DEPTH, MAX_DWELL_S, MAX_LOOP_ITERATIONS, MAX_PARAMETER,
+    MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN, MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST,
+    START_TOLERANCE_MM,
 };
 pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
 pub use stream::{Entries, Entry};

@@ -106,6 +106,7 @@ impl Parser<'_> {
         };
         let end = [r[0], r[1], r[2] - self.modal.tool_length];
         let tooling = self.tooling();
+        self.from_reference = Some(self.drained + self.blocks.len());
         self.blocks.push(Block::Linear(LinearMove {
             pos,
             n: line.n,
@@ -260,8 +261,15 @@ impl Parser<'_> {
             None => None,
         };
         let start = self.here.unwrap_or(end);
-        let net = arc::arc(start, end, plane, motion == Motion::G02, centre)
-            .map_err(|kind| kind.at(pos))?;
+        let net = arc::arc(
+            start,
+            end,
+            plane,
+            motion == Motion::G02,
+            centre,
+            arc::ArcTol::for_units(self.modal.inch),
+        )
+        .map_err(|kind| kind.at(pos))?;
         let length = (net.radius * net.sweep.abs()).hypot(rise(start, end, plane));
         let feed_mm_min = self.move_feed(line, motion, pos, length)?;
         let tooling = self.tooling();

@@ -43,6 +43,9 @@ pub(super) struct Parser<'s> {
     pub rotary: Option<(char, SrcPos)>,
     /// What the next motion block waits for.
     pub wait: Wait,
+    /// The index of the block that moves to the reference position because the program's
+    /// first move does not give a full pose (the machine is there already, homed).
+    pub from_reference: Option<usize>,
     open: Option<OpenNurbs>,
     /// The NURBS block that ended on the previous line (for a helpful extra-knot error).
     just_closed: Option<(SrcPos, usize)>,
@@ -70,6 +73,7 @@ impl<'s> Parser<'s> {
             orientation_given: false,
             rotary: None,
             wait: Wait::default(),
+            from_reference: None,
             open: None,
             just_closed: None,
             skipping: false,

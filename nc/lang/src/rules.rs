@@ -2,8 +2,20 @@
 //! ranges the parser holds programs to, and the codes it knows. The error messages quote
 //! them, and the parser's stages check them.
 
-/// Largest accepted difference between the start and end radius, mm.
-pub const ARC_RADIUS_TOL_MM: f64 = 0.002;
+/// An arc's start and end radii (centre format) may differ by up to this much, in the
+/// program's units, or by any amount up to 100 times this within 0.1 % of the radius:
+/// LinuxCNC's rule (its `CENTER_ARC_RADIUS_TOLERANCE_MM`/`_INCH`, 2 x 0.01 mm x sqrt 2 and
+/// 2 x 0.001 in x sqrt 2), so that what LinuxCNC runs, dnurbs runs.
+pub const ARC_RADIUS_TOL_MM: f64 = 0.02 * core::f64::consts::SQRT_2;
+/// [`ARC_RADIUS_TOL_MM`] in an inch program, inches.
+pub const ARC_RADIUS_TOL_IN: f64 = 0.002 * core::f64::consts::SQRT_2;
+/// The relative part of the rule (0.1 %).
+pub const ARC_RADIUS_REL_TOL: f64 = 0.001;
+/// How far `R` may fall short of half the chord and still reach the end point, in the
+/// program's units (LinuxCNC's `RADIUS_TOLERANCE_MM`/`_INCH`).
+pub const ARC_REACH_TOL_MM: f64 = 0.001_27;
+/// [`ARC_REACH_TOL_MM`] in an inch program, inches.
+pub const ARC_REACH_TOL_IN: f64 = 0.000_05;
 
 /// Smallest arc radius, mm.
 pub const MIN_ARC_RADIUS_MM: f64 = 1e-3;

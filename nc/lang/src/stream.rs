@@ -71,6 +71,12 @@ impl<'s, S: LineSource> Entries<'s, S> {
         self.interp.tape.into_source()
     }
 
+    /// The index of the block that starts at the reference position (the program's first
+    /// move leaves an axis out, so the homed machine starts where it is), once read.
+    pub fn from_reference(&self) -> Option<usize> {
+        self.parser.from_reference
+    }
+
     /// Lines of the source held for a loop or a call to go back to (and the one being read).
     pub fn kept_lines(&self) -> usize {
         self.interp.tape.kept()

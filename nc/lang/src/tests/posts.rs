@@ -170,6 +170,7 @@ fn steep_helices_are_on_the_true_helix_or_an_error() {
             super::super::vocab::Plane::Xy,
             false,
             super::super::Centre::Offsets(-0.01, 0.0),
+            super::super::ArcTol::for_units(false),
         )
     };
     assert!(arc(2e5).unwrap().ctrl.len() < nc_geom::program::MAX_BLOCK_CTRL);
@@ -230,7 +231,7 @@ fn planes_g18_and_g19_take_their_own_offsets() {
 fn arc_errors_name_what_is_wrong() {
     let f = |src| parse(src).unwrap_err().kind;
     assert!(matches!(
-        f("G00 X0 Y0 Z0\nG02 X10 Y0 I5.01 J0 F500"),
+        f("G00 X0 Y0 Z0\nG02 X10 Y0 I5.05 J0 F500"),
         E::ArcRadiusMismatch { .. }
     ));
     assert!(matches!(
