@@ -9,7 +9,7 @@
 
 use crate::error::ParseError;
 use crate::expr::whole;
-use crate::interp::{err, Interp, Open, Skip, State};
+use crate::interp::{err, Interp, Open, Skip, SkipKind, State};
 use crate::interp_error::InterpError;
 use crate::name::Name;
 use crate::source::LineSource;
@@ -76,7 +76,7 @@ impl<S: LineSource> Interp<S> {
                 let taken = truth(arg(self, 0)?);
                 self.push(label.clone(), keyword, index, line_no, taken, 0);
                 if !taken {
-                    self.skip_to(label, false, keyword, line_no);
+                    self.skip_to(label, SkipKind::Branch, keyword, line_no, index);
                 }
             }
             Keyword::ElseIf | Keyword::Else => {
@@ -85,7 +85,7 @@ impl<S: LineSource> Interp<S> {
                 let c = truth(arg(self, 0)?) || keyword == Keyword::Else;
                 let open = &mut self.frame_mut().open[k];
                 if open.taken || !c {
-                    self.skip_to(label, false, keyword, line_no);
+                    self.skip_to(label, SkipKind::Branch, keyword, line_no, index);
                 } else {
                     open.taken = true;
                 }
@@ -101,13 +101,14 @@ impl<S: LineSource> Interp<S> {
             Keyword::While => {
                 let top = self.frame().open.last();
                 if top.is_some_and(|t| t.label == label && t.keyword == Keyword::Do) {
-                    // The end of a `do` loop.
-                    if truth(arg(self, 0)?) {
+                    // The end of a `do` loop (a stale `break` ends it, see `doing_break`).
+                    if truth(arg(self, 0)?) && !self.doing_break {
                         self.again(&label, keyword, pos)?;
                         let start = self.frame().open.last().map_or(index, |t| t.start);
                         self.frame_mut().pc = start + 1;
                     } else {
                         self.frame_mut().open.pop();
+                        self.doing_break = false;
                     }
                     return Ok(());
                 }
@@ -118,7 +119,7 @@ impl<S: LineSource> Interp<S> {
                 }
                 if !truth(arg(self, 0)?) {
                     self.frame_mut().open.pop();
-                    self.skip_to(label, true, keyword, line_no);
+                    self.skip_to(label, SkipKind::Exit, keyword, line_no, index);
                 }
             }
             Keyword::EndWhile => {
@@ -135,7 +136,7 @@ impl<S: LineSource> Interp<S> {
                     let count = n.min(i64::MAX as f64) as i64;
                     self.push(label, keyword, index, line_no, false, count);
                 } else {
-                    self.skip_to(label, true, keyword, line_no);
+                    self.skip_to(label, SkipKind::Exit, keyword, line_no, index);
                 }
             }
             Keyword::EndRepeat => {
@@ -160,7 +161,8 @@ impl<S: LineSource> Interp<S> {
                 match (keyword, open.keyword) {
                     (Keyword::Break, _) => {
                         frame.open.truncate(k);
-                        self.skip_to(label, true, keyword, line_no);
+                        self.doing_break = true;
+                        self.skip_to(label, SkipKind::Exit, keyword, line_no, open.start);
                     }
                     (_, Keyword::While) => {
                         frame.open.truncate(k + 1);
@@ -170,7 +172,8 @@ impl<S: LineSource> Interp<S> {
                     _ => {
                         // `do`: on to its `while`, which decides.
                         frame.open.truncate(k + 1);
-                        self.skip_to(label, false, keyword, line_no);
+                        self.doing_continue = true;
+                        self.skip_to(label, SkipKind::Continue, keyword, line_no, open.start);
                     }
                 }
             }
@@ -198,10 +201,11 @@ impl<S: LineSource> Interp<S> {
         });
     }
 
-    fn skip_to(&mut self, label: String, consume: bool, keyword: Keyword, line: u32) {
+    fn skip_to(&mut self, label: String, kind: SkipKind, keyword: Keyword, line: u32, back: usize) {
         self.skip = Some(Skip {
             label,
-            consume,
+            kind,
+            back,
             keyword,
             line,
         });

@@ -90,10 +90,25 @@ pub(crate) struct Frame {
 #[derive(Clone, Debug)]
 pub(crate) struct Skip {
     pub label: String,
-    /// The line found is passed over (a loop's exit) rather than executed (an `else`).
-    pub consume: bool,
+    pub kind: SkipKind,
     pub keyword: Keyword,
     pub line: u32,
+    /// The loop's opening line (an exit that turns out to be a stale `continue` goes back
+    /// there).
+    pub back: usize,
+}
+
+/// Why lines are skipped, which decides what the O-lines of the label do meanwhile.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum SkipKind {
+    /// A branch not taken: the next `elseif`, `else` or `endif` runs as usual.
+    Branch,
+    /// Out of a loop (its condition false, a `break`, `repeat [0]`): up to and past its
+    /// `endwhile`, `endrepeat` or the `do`'s `while`; a `break` or `continue` of the same
+    /// loop on the way is skipped too.
+    Exit,
+    /// `continue` in a `do` loop: on to its `while`, which decides.
+    Continue,
 }
 
 /// A `%` first in the program (tape mode): a later `%` line ends it.
@@ -123,6 +138,14 @@ pub(crate) struct Interp<S> {
     pub value_returned: bool,
     /// The physical line being executed (`#<_line>`).
     pub line: u32,
+    /// LinuxCNC's `doing_break` and `doing_continue`: set by `break` and by `continue` in a
+    /// `do` loop, and cleared only where LinuxCNC clears them (a `do`'s `while` that does
+    /// not loop back; an `endwhile`/`endrepeat` reached while skipping). So a `break` out
+    /// of a `while` makes the next `do` loop run once, and a `continue` in a `do` makes the
+    /// next `break` out of a `while` go round again, as in LinuxCNC; a program moves as it
+    /// does there.
+    pub doing_break: bool,
+    pub doing_continue: bool,
     block_delete: bool,
     percent: Percent,
     finished: bool,
@@ -153,6 +176,8 @@ impl<S: LineSource> Interp<S> {
             value: 0.0,
             value_returned: false,
             line: 0,
+            doing_break: false,
+            doing_continue: false,
             block_delete: setup.block_delete,
             percent: Percent::Undecided,
             finished: false,
@@ -283,12 +308,25 @@ impl<S: LineSource> Interp<S> {
             if label != skip.label {
                 return Ok(false);
             }
-            let consume = skip.consume;
-            self.skip = None;
-            if consume {
-                return Ok(false);
+            match (skip.kind, o.keyword) {
+                (SkipKind::Branch, _) | (SkipKind::Continue, Some(Keyword::While)) => {
+                    self.skip = None;
+                    self.o_line(o, label, index, line, state)?;
+                }
+                (SkipKind::Exit, Some(Keyword::EndWhile | Keyword::EndRepeat)) => {
+                    let back = skip.back;
+                    self.skip = None;
+                    if self.doing_continue {
+                        self.doing_continue = false;
+                        self.frame_mut().pc = back;
+                    }
+                }
+                (SkipKind::Exit, Some(Keyword::While)) => {
+                    self.skip = None;
+                    self.doing_break = false;
+                }
+                _ => {}
             }
-            self.o_line(o, label, index, line, state)?;
             return Ok(false);
         }
         if line.is_empty() {

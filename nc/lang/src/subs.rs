@@ -203,7 +203,8 @@ impl<S: LineSource> Interp<S> {
         Err(failed(std::io::ErrorKind::InvalidData))
     }
 
-    /// The subroutine `name` defined further down the main program.
+    /// The subroutine `name` defined further down the main program (LinuxCNC reads ahead to
+    /// it, so a program may define its subroutines after `M02`).
     fn read_ahead(&mut self, name: &str, pos: SrcPos) -> Result<Sub, ParseError> {
         let missing = || {
             err(
@@ -213,10 +214,16 @@ impl<S: LineSource> Interp<S> {
                 pos,
             )
         };
-        if !matches!(self.frame().src, Src::Main) {
-            return Err(missing());
-        }
-        let mut i = self.frames[0].pc;
+        // From the line after the call, in the file it stands in: the main program, or a
+        // subroutine defined in it (a subroutine from a file is not searched).
+        let frame = self.frame();
+        let mut i = match &frame.src {
+            Src::Main => frame.pc,
+            Src::Sub(sub) => match sub.main_index {
+                Some(m) => m + 1 + frame.pc,
+                None => return Err(missing()),
+            },
+        };
         let mut sub: Option<Sub> = None;
         while let Some(line) = self.tape.line(i)? {
             match &mut sub {

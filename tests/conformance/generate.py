@@ -1,0 +1,331 @@
+#!/usr/bin/env python3
+"""Generates the conformance suite's programs under tests/conformance/programs/gen/.
+
+Deterministic (seeded): running it again writes the same files. Families:
+
+- expr:  parameter assignments (numbered, named local and global, indirection) and moves
+         whose words are random expressions over every operator and function; some lines
+         break a rule (divide by zero, an undefined name, a function's domain) on purpose;
+- flow:  nested while, do-while and repeat loops, if/elseif/else, break and continue;
+- subs:  subroutines with arguments and return values, nested calls, recursion with a
+         counter, calls before the definition (after M2);
+- arcs:  G02/G03 in G17, G18 and G19, centre (IJK) and radius (R, both signs) forms,
+         helices, full circles, G90 and G91, mm and inch;
+- units: G20/G21 and G90/G91 switched along a program, with parameters and rotary axes.
+
+Then run regen.py (system Python with LinuxCNC's `gcode` module) for the references.
+"""
+import math
+import os
+import random
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+OUT = os.path.join(HERE, "programs", "gen")
+
+FUNCS = ["ABS", "ACOS", "ASIN", "COS", "EXP", "FIX", "FUP", "LN", "ROUND", "SIN", "SQRT", "TAN"]
+OPS = ["**", "*", "/", "MOD", "+", "-", "EQ", "NE", "GT", "GE", "LT", "LE", "AND", "OR", "XOR"]
+
+
+def num(r, lo=-20.0, hi=20.0, digits=4):
+    v = round(r.uniform(lo, hi), digits)
+    return ("%." + str(digits) + "f") % v
+
+
+class Expr:
+    """Random expressions over the parameters that exist."""
+
+    def __init__(self, r, params):
+        self.r = r
+        self.params = params  # names (with #) that have been set
+
+    def value(self, depth):
+        r = self.r
+        k = r.random()
+        if depth <= 0 or k < 0.3:
+            if self.params and r.random() < 0.5:
+                return r.choice(self.params)
+            return num(r, -9, 9, r.choice([0, 1, 2, 4]))
+        if k < 0.45:
+            f = r.choice(FUNCS)
+            arg = self.bracketed(depth - 1)
+            if f in ("ACOS", "ASIN"):
+                arg = "[%s MOD 1]" % arg  # mostly in the domain
+            elif f in ("LN", "SQRT"):
+                arg = "[ABS%s + 0.5]" % arg
+            elif f == "EXP":
+                arg = "[%s MOD 5]" % arg
+            return f + arg
+        if k < 0.52:
+            return "ATAN%s/%s" % (self.bracketed(depth - 1), self.bracketed(depth - 1))
+        if k < 0.58:
+            return "-" + self.value(depth - 1)
+        return self.bracketed(depth - 1)
+
+    def bracketed(self, depth):
+        r = self.r
+        n = r.randint(1, 3)
+        parts = [self.value(depth)]
+        for _ in range(n):
+            op = r.choice(OPS)
+            rhs = self.value(depth)
+            if op == "**":
+                rhs = r.choice(["2", "3", "0.5", "[ABS%s MOD 3]" % self.bracketed(0)])
+                parts[-1] = "ABS[%s]" % parts[-1] if not parts[-1].startswith("[") else "ABS" + parts[-1]
+            if op in ("/", "MOD"):
+                rhs = "[%s + 0.37]" % rhs if r.random() < 0.95 else rhs
+            parts += [op, rhs]
+        return "[" + " ".join(parts) + "]"
+
+    def bounded(self, depth):
+        """An expression kept to a machine-sized value (mod 200)."""
+        return "[%s MOD 200 - 100]" % self.bracketed(depth)
+
+
+def expr_program(r, k):
+    lines = ["(expressions and parameters %d)" % k, "G21 G90 G17", "G0 X0 Y0 Z0"]
+    params = []
+    e = Expr(r, params)
+    feed = False
+    for _ in range(r.randint(8, 18)):
+        c = r.random()
+        mark = len(lines)
+        if c < 0.4:
+            name = r.choice(["#%d" % r.randint(1, 60), "#<p%d>" % r.randint(1, 8),
+                             "#<_g%d>" % r.randint(1, 4), "#[%d + 2]" % r.randint(1, 30)])
+            rhs = e.bounded(2)
+            # Several assignments on a line: they take effect together, after it.
+            extra = ""
+            if r.random() < 0.3:
+                extra = " #%d=%s" % (r.randint(1, 60), e.value(1))
+            lines.append("%s=%s%s" % (name, rhs, extra))
+            if len(lines[-1]) <= 200 and (name.startswith("#<") or name[1:].isdigit()):
+                params.append(name)
+        else:
+            words = ["X" + e.bounded(2), "Y" + e.bounded(1)]
+            if r.random() < 0.6:
+                words.append("Z" + e.bounded(1))
+            if r.random() < 0.3:
+                words.append("#%d=%s" % (r.randint(1, 60), e.value(1)))
+            r.shuffle(words)
+            g = r.choice(["G0", "G1"])
+            if g == "G1" and not feed:
+                words.append("F%d" % r.randint(100, 3000))
+            lines.append(g + " " + " ".join(words))
+            feed |= g == "G1" and len(lines[-1]) <= 200
+        if len(lines[-1]) > 200:
+            # Too long for LinuxCNC (252 characters): a shorter one of the same kind.
+            del lines[mark:]
+    if r.random() < 0.25:
+        # A line that breaks a rule: LinuxCNC and dnurbs stop there.
+        if True:
+            bad = r.choice(["G0 X[1/[%s - %s]]" % ("#9", "#9"), "G0 X#<undefined%d>" % k,
+                            "G0 X[SQRT[-1 - ABS[#3]]]", "G0 X[LN[0]]", "G0 X[ACOS[2]]",
+                            "#0=1", "G0 X[-1 ** 0.5]", "G0 X[5 MOD 0]"])
+            lines.append(bad)
+    lines.append("M2")
+    return lines
+
+
+def flow_program(r, k):
+    lines = ["(loops and branches %d)" % k, "G21 G90 G17", "G0 X0 Y0 Z0", "F600", "#1=0"]
+    label = [100]
+
+    def new_label():
+        label[0] += 10
+        return label[0]
+
+    def block(depth, counter):
+        out = []
+        for _ in range(r.randint(1, 3)):
+            c = r.random()
+            if depth <= 0 or c < 0.4:
+                out.append("#1=[#1+1]")
+                out.append("G1 X[#1 MOD 50] Y[#%d * 2 + #1 * 0.1] Z[-#1 MOD 7]" % counter)
+            elif c < 0.55:
+                n = new_label()
+                v = "#%d" % (10 + depth)
+                out += ["%s=0" % v, "o%d while [%s LT %d]" % (n, v, r.randint(0, 4))]
+                out += ["%s=[%s+1]" % (v, v)]
+                out += block(depth - 1, 10 + depth)
+                if r.random() < 0.4:
+                    m = new_label()
+                    out += ["o%d if [[#1 MOD 3] EQ 0]" % m,
+                            "o%d %s" % (n, r.choice(["break", "continue"])), "o%d endif" % m]
+                out += ["o%d endwhile" % n]
+            elif c < 0.7:
+                n = new_label()
+                v = "#%d" % (10 + depth)
+                out += ["%s=0" % v, "o%d do" % n, "%s=[%s+1]" % (v, v)]
+                out += block(depth - 1, 10 + depth)
+                out += ["o%d while [%s LT %d]" % (n, v, r.randint(1, 3))]
+            elif c < 0.85:
+                n = new_label()
+                out += ["o%d repeat [%s]" % (n, r.choice(["0", "1", "2", "3", "2.5", "1.5", "#1 MOD 3"]))]
+                out += block(depth - 1, counter)
+                out += ["o%d endrepeat" % n]
+            else:
+                n = new_label()
+                out += ["o%d if [[#1 MOD 4] %s %d]" % (n, r.choice(["EQ", "GT", "LT"]), r.randint(0, 3))]
+                out += block(depth - 1, counter)
+                if r.random() < 0.5:
+                    out += ["o%d elseif [#1 GT %d]" % (n, r.randint(0, 6))]
+                    out += block(depth - 1, counter)
+                if r.random() < 0.6:
+                    out += ["o%d else" % n]
+                    out += block(depth - 1, counter)
+                out += ["o%d endif" % n]
+        return out
+
+    lines += block(3, 1)
+    lines.append("M2")
+    return lines
+
+
+def subs_program(r, k):
+    lines = ["(subroutines %d)" % k]
+    names = ["s%d" % i for i in range(r.randint(2, 4))]
+    bodies = {}
+    for i, name in enumerate(names):
+        body = ["o<%s> sub" % name,
+                "#<here> = [#1 + #2 * 0.5]",
+                "G1 X[#<here> MOD 80] Y[#3 + %d] F%d" % (i, r.randint(200, 900))]
+        # Call a later subroutine (depth stays bounded by the number of names).
+        if i + 1 < len(names) and r.random() < 0.7:
+            body += ["o<%s> call [#1 + 1] [#2 * 2] [%s]" % (names[i + 1], num(r, -5, 5)),
+                     "G0 Y[#<_value> MOD 60] Z#<_value_returned>"]
+        if r.random() < 0.4:
+            body += ["o%d if [#1 GT 3]" % (i + 1), "o<%s> return [#1 * 10]" % name, "o%d endif" % (i + 1)]
+        body += ["o<%s> endsub [#<here> + %s]" % (name, num(r, 0, 3))]
+        bodies[name] = body
+    after = r.random() < 0.5
+    main = ["G21 G90 G17", "G0 X0 Y0 Z0"]
+    if r.random() < 0.5:
+        # Recursion with a counter, as LinuxCNC's factorial.ngc.
+        bodies["fact"] = ["o<fact> sub", "o1 if [#1 LE 1]", "o<fact> return [1]", "o1 endif",
+                          "o<fact> call [#1 - 1]", "o<fact> endsub [#1 * #<_value>]"]
+        main += ["o<fact> call [%d]" % r.randint(1, 6), "G0 X[#<_value> MOD 90]"]
+    for _ in range(r.randint(2, 5)):
+        args = " ".join("[%s]" % num(r, -5, 5, 2) for _ in range(r.randint(0, 4)))
+        main += ["#1=%s" % num(r, -3, 3), "o<%s> call %s" % (r.choice(names), args),
+                 "G0 X[#1 + #<_value> MOD 70] Y#<_value_returned>"]
+    defs = [l for n in bodies for l in bodies[n]]
+    if after:
+        lines += main + ["M2"] + defs
+    else:
+        lines += defs + main + ["M2"]
+    return lines
+
+
+def fmt(v, d=4):
+    s = ("%." + str(d) + "f") % v
+    return "0.0000" if s in ("-0.0000",) else s
+
+
+def arcs_program(r, k):
+    inch = r.random() < 0.3
+    unit = 25.4 if inch else 1.0
+    lines = ["(arcs %d)" % k, "G20" if inch else "G21", "G90", "G0 X0 Y0 Z0", "F%d" % r.randint(50, 500)]
+    pos = [0.0, 0.0, 0.0]
+    incremental = False
+    plane = 17
+    for _ in range(r.randint(4, 12)):
+        if r.random() < 0.25:
+            plane = r.choice([17, 18, 19])
+            lines.append("G%d" % plane)
+        if r.random() < 0.15:
+            incremental = not incremental
+            lines.append("G91" if incremental else "G90")
+        first, second, axis = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}[plane]
+        letters = "XYZ"
+        offs = "IJK"
+        if r.random() < 0.2:
+            # A straight move in between.
+            new = [p + r.uniform(-20, 20) / unit for p in pos]
+            new = [round(v, 4) for v in new]
+            words = " ".join("%s%s" % (letters[i], fmt(new[i] - pos[i] if incremental else new[i])) for i in range(3))
+            lines.append("G1 " + words)
+            pos = new
+            continue
+        rad = r.uniform(1, 30) / unit
+        a0 = r.uniform(0, 2 * math.pi)
+        centre = [pos[first] - rad * math.cos(a0), pos[second] - rad * math.sin(a0)]
+        cw = r.random() < 0.5
+        full = r.random() < 0.1
+        sweep = 0 if full else r.uniform(0.05, 1.9 * math.pi)
+        a1 = a0 - sweep if cw else a0 + sweep
+        end = list(pos)
+        end[first] = round(centre[0] + rad * math.cos(a1), 4)
+        end[second] = round(centre[1] + rad * math.sin(a1), 4)
+        if full:
+            end[first], end[second] = pos[first], pos[second]
+        if r.random() < 0.3:
+            end[axis] = round(pos[axis] + r.uniform(-5, 5) / unit, 4)
+        words = []
+        for i in range(3):
+            if end[i] != pos[i] or r.random() < 0.3:
+                v = end[i] - pos[i] if incremental else end[i]
+                words.append("%s%s" % (letters[i], fmt(v)))
+        use_r = (not full) and r.random() < 0.35
+        if use_r:
+            radius = rad if (sweep <= math.pi) else -rad
+            # R picks the arc; keep clear of the half circle where it is ambiguous.
+            if abs(sweep - math.pi) < 0.05:
+                continue
+            words.append("R%s" % fmt(radius))
+        else:
+            words.append("%s%s" % (offs[first], fmt(centre[0] - pos[first])))
+            words.append("%s%s" % (offs[second], fmt(centre[1] - pos[second])))
+        lines.append("%s %s" % ("G2" if cw else "G3", " ".join(words)))
+        # What the program says is where it is (to 4 decimals).
+        pos = [float(fmt(v)) for v in end]
+    lines.append("M2")
+    return lines
+
+
+def units_program(r, k):
+    lines = ["(units and distance modes %d)" % k, "G21 G90", "G0 X0 Y0 Z0 A0 C0", "F300"]
+    inch, inc = False, False
+    for _ in range(r.randint(6, 14)):
+        c = r.random()
+        if c < 0.2:
+            inch = not inch
+            lines.append("G20" if inch else "G21")
+        elif c < 0.35:
+            inc = not inc
+            lines.append("G91" if inc else "G90")
+        elif c < 0.5:
+            lines.append("#%d=%s" % (r.randint(1, 9), num(r, -10, 10)))
+        else:
+            words = ["X" + r.choice([num(r, -40, 40), "#%d" % r.randint(1, 9), "[#%d * 2]" % r.randint(1, 9)]),
+                     "Y" + num(r, -40, 40)]
+            if r.random() < 0.5:
+                words.append("Z" + num(r, -10, 10))
+            if r.random() < 0.4:
+                words.append("A" + num(r, -30, 30, 3))
+                words.append("C" + num(r, -180, 180, 3))
+            lines.append("%s %s" % (r.choice(["G0", "G1"]), " ".join(words)))
+    lines.append("M2")
+    return lines
+
+
+FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
+            ("arcs", arcs_program, 40), ("units", units_program, 20)]
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    for f in os.listdir(OUT):
+        if f.endswith(".ngc"):
+            os.remove(os.path.join(OUT, f))
+    total = 0
+    for name, make, count in FAMILIES:
+        for k in range(count):
+            r = random.Random("%s-%d" % (name, k))
+            with open(os.path.join(OUT, "%s-%02d.ngc" % (name, k)), "w") as f:
+                f.write("\n".join(make(r, k)) + "\n")
+            total += 1
+    print("%d programs in %s" % (total, os.path.relpath(OUT)))
+
+
+if __name__ == "__main__":
+    main()
