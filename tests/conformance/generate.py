@@ -227,6 +227,7 @@ def arcs_program(r, k):
     lines = ["(arcs %d)" % k, "G20" if inch else "G21", "G90", "G0 X0 Y0 Z0", "F%d" % r.randint(50, 500)]
     pos = [0.0, 0.0, 0.0]
     incremental = False
+    absolute_centre = False
     plane = 17
     for _ in range(r.randint(4, 12)):
         if r.random() < 0.25:
@@ -235,6 +236,10 @@ def arcs_program(r, k):
         if r.random() < 0.15:
             incremental = not incremental
             lines.append("G91" if incremental else "G90")
+        if r.random() < 0.1:
+            # Arc centres as absolute coordinates (G90.1) or offsets from the start (G91.1).
+            absolute_centre = not absolute_centre
+            lines.append("G90.1" if absolute_centre else "G91.1")
         first, second, axis = {17: (0, 1, 2), 18: (2, 0, 1), 19: (1, 2, 0)}[plane]
         letters = "XYZ"
         offs = "IJK"
@@ -272,6 +277,9 @@ def arcs_program(r, k):
             if abs(sweep - math.pi) < 0.05:
                 continue
             words.append("R%s" % fmt(radius))
+        elif absolute_centre:
+            words.append("%s%s" % (offs[first], fmt(centre[0])))
+            words.append("%s%s" % (offs[second], fmt(centre[1])))
         else:
             words.append("%s%s" % (offs[first], fmt(centre[0] - pos[first])))
             words.append("%s%s" % (offs[second], fmt(centre[1] - pos[second])))
@@ -293,8 +301,11 @@ def units_program(r, k):
         elif c < 0.35:
             inc = not inc
             lines.append("G91" if inc else "G90")
-        elif c < 0.5:
+        elif c < 0.45:
             lines.append("#%d=%s" % (r.randint(1, 9), num(r, -10, 10)))
+        elif c < 0.5:
+            lines.append(r.choice(["G64 P0.01 Q0.005", "G61", "G64", "G4 P0.2 G1 X%s" % num(r, -40, 40),
+                                   "G[0.1 * 10] Y%s" % num(r, -40, 40), "G0.0001 X%s" % num(r, -9, 9)]))
         else:
             words = ["X" + r.choice([num(r, -40, 40), "#%d" % r.randint(1, 9), "[#%d * 2]" % r.randint(1, 9)]),
                      "Y" + num(r, -40, 40)]

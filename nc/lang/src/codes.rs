@@ -58,13 +58,15 @@ pub enum Code {
     WorkOffset(u8),
     /// `G61` exact stop (false) / `G64` blending (true).
     Blend(bool),
+    /// `G90.1` (true: arc centres `I J K` absolute) / `G91.1` (relative to the start).
+    ArcCentreAbsolute(bool),
     Stop(StopCode),
     Spindle(Spindle),
     Coolant(Coolant),
 }
 
 /// Modal groups, as indices of [`super::line::Line`]'s code table.
-pub const GROUPS: usize = 14;
+pub const GROUPS: usize = 15;
 
 impl Code {
     pub fn group(self) -> usize {
@@ -83,13 +85,14 @@ impl Code {
             Code::Stop(_) => 11,
             Code::Spindle(_) => 12,
             Code::Coolant(_) => 13,
+            Code::ArcCentreAbsolute(_) => 14,
         }
     }
 }
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 30] = [
+const G_CODES: [(f64, Code); 32] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -118,7 +121,9 @@ const G_CODES: [(f64, Code); 30] = [
     (64.0, Code::Blend(true)),
     (80.0, Code::CannedOff),
     (90.0, Code::Incremental(false)),
+    (90.1, Code::ArcCentreAbsolute(true)),
     (91.0, Code::Incremental(true)),
+    (91.1, Code::ArcCentreAbsolute(false)),
     (93.0, Code::InverseTime(true)),
 ];
 

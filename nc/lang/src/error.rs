@@ -86,7 +86,7 @@ pub enum ParseErrorKind {
     /// Parameters, expressions, O-word flow control, active comments.
     #[error("{0}")]
     Interp(crate::interp_error::InterpError),
-    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P R S T U V W X Y Z")]
+    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P Q R S T U V W X Y Z")]
     UnsupportedWord { letter: char, value: f64 },
 
     // ---- line structure ----------------------------------------------------------------
@@ -104,6 +104,10 @@ pub enum ParseErrorKind {
         first: f64,
         second: f64,
     },
+    #[error("{letter}{value} is not a code: {letter} numbers are whole (M) or have one decimal (G), within 0.001")]
+    NotACode { letter: char, value: f64 },
+    #[error("{letter} is an axis this machine does not have: dnurbs's machines have X Y Z and two rotary axes (U V W are the orientation curve of a G06.5 block only)")]
+    NoSuchAxis { letter: char },
     #[error("unsupported G-code {}: dnurbs accepts {G_LIST}", Code('G', *.code))]
     UnsupportedGCode { code: f64 },
     #[error("unsupported M-code {}: dnurbs accepts {M_LIST}", Code('M', *.code))]

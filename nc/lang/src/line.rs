@@ -11,7 +11,7 @@ use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].
-pub(super) const KNOWN: &str = "ABCFGHIJKMNOPRSTUVWXYZ";
+pub(super) const KNOWN: &str = "ABCFGHIJKMNOPQRSTUVWXYZ";
 
 /// Words that make a line move the machine (in the modal motion mode if no G word is given).
 pub(super) const MOVE_WORDS: &str = "XYZABCIJKR";
@@ -65,8 +65,8 @@ impl<'w> Line<'w> {
                     value: w.value,
                 }),
                 'N' => Err(ParseErrorKind::MisplacedSequenceNumber { value: w.value }),
-                'G' => g_code(w.value),
-                'M' => m_code(w.value),
+                'G' => code_number(w.value, 10.0, 0.001).and_then(g_code),
+                'M' => code_number(w.value, 1.0, 1e-4).and_then(m_code),
                 _ => {
                     if !line.knots_only {
                         line.insert(w)?;
@@ -146,6 +146,10 @@ impl<'w> Line<'w> {
     /// Fails on the first word whose letter is not in `allowed`.
     pub fn only(&self, allowed: &str, context: Context) -> Result<(), ParseError> {
         match self.body.iter().find(|w| !allowed.contains(w.letter)) {
+            // U V W on a move: an axis dnurbs's machines do not have.
+            Some(w) if matches!(context, Context::Move(_)) && "UVW".contains(w.letter) => {
+                Err(ParseErrorKind::NoSuchAxis { letter: w.letter }.at(w.pos))
+            }
             Some(w) => Err(ParseErrorKind::WordNotAllowed {
                 letter: w.letter,
                 context,
@@ -159,6 +163,21 @@ impl<'w> Line<'w> {
     pub fn require(&self, letter: char, context: Context, at: SrcPos) -> Result<Word, ParseError> {
         self.get(letter)
             .ok_or(ParseErrorKind::MissingWord { letter, context }.at(at))
+    }
+}
+
+/// A G or M word's value as its code, read as LinuxCNC does: `value * scale` within `tol` of
+/// a whole number (`G1.0001` is G1, `G[0.1*10]` is G1, `G1.001` is no code).
+fn code_number(value: f64, scale: f64, tol: f64) -> Result<f64, ParseErrorKind> {
+    let t = value * scale;
+    let n = t.round();
+    if (t - n).abs() <= tol {
+        Ok(n / scale)
+    } else {
+        Err(ParseErrorKind::NotACode {
+            letter: if scale == 1.0 { 'M' } else { 'G' },
+            value,
+        })
     }
 }
 

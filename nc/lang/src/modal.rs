@@ -74,6 +74,8 @@ pub(super) struct Modal {
     pub tool_length: f64,
     /// `G64` (true) or `G61`; dnurbs follows the programmed path exactly in both.
     pub blend: bool,
+    /// `G90.1`: arc centres `I J K` are absolute coordinates (else offsets from the start).
+    pub arc_absolute: bool,
     /// Selected tool (`T`) and loaded tool (after `M06`).
     pub selected: Option<u32>,
     pub loaded: Option<u32>,
@@ -93,6 +95,7 @@ impl Default for Modal {
             comp: LengthComp::Off,
             tool_length: 0.0,
             blend: true,
+            arc_absolute: false,
             selected: None,
             loaded: None,
             rpm: 0.0,

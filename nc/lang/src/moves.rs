@@ -67,6 +67,11 @@ impl Parser<'_> {
             s.push('H');
         }
         if matches!(line.code_of_group(10), Some((Code::Blend(true), _))) {
+            // G64 P (path tolerance) Q (naive-CAM tolerance): permissions to leave the
+            // path, which dnurbs does not need: it follows the programmed path.
+            s.push_str("PQ");
+        }
+        if matches!(line.code_of_group(1), Some((Code::Dwell, _))) {
             s.push('P');
         }
         s
@@ -249,6 +254,19 @@ impl Parser<'_> {
                     (None, None) => {
                         return Err(ParseErrorKind::ArcWithoutCentre { motion, plane }.at(pos));
                     }
+                    (Some(i), Some(j)) if self.modal.arc_absolute => {
+                        // G90.1: the centre's coordinates (work offset applied); made
+                        // offsets from the start below.
+                        Centre::Offsets(i + self.modal.offset[a], j + self.modal.offset[b])
+                    }
+                    (i, _) if self.modal.arc_absolute => {
+                        let letter = Plane::offset_letter(if i.is_none() { a } else { b });
+                        let kind = ParseErrorKind::MissingWord {
+                            letter,
+                            context: Context::Move(motion),
+                        };
+                        return Err(kind.at(pos));
+                    }
                     (i, j) => Centre::Offsets(i.unwrap_or(0.0), j.unwrap_or(0.0)),
                 }
             }
@@ -261,6 +279,13 @@ impl Parser<'_> {
             None => None,
         };
         let start = self.here.unwrap_or(end);
+        let centre = match centre {
+            Centre::Offsets(ca, cb) if self.modal.arc_absolute => {
+                let at = |i: usize| start.get(i).copied().unwrap_or(0.0);
+                Centre::Offsets(ca - at(a), cb - at(b))
+            }
+            c => c,
+        };
         let net = arc::arc(
             start,
             end,

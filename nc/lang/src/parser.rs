@@ -140,7 +140,11 @@ impl<'s> Parser<'s> {
         self.feed_word(&line)?;
         self.machine_words(&line)?;
         if self.is_dwell(&line) {
+            // The dwell first, then a move on the same line (LinuxCNC's order).
             self.dwell(&line)?;
+            if line.motion.is_some() {
+                self.motion(&line)?;
+            }
         } else {
             self.motion(&line)?;
         }
@@ -185,6 +189,7 @@ impl<'s> Parser<'s> {
                 Code::Incremental(inc) => self.modal.incremental = inc,
                 Code::InverseTime(it) => self.modal.inverse_time = it,
                 Code::Blend(b) => self.modal.blend = b,
+                Code::ArcCentreAbsolute(abs) => self.modal.arc_absolute = abs,
                 Code::WorkOffset(i) => {
                     let defined = self
                         .setup
@@ -340,19 +345,27 @@ impl<'s> Parser<'s> {
         Ok(())
     }
 
-    /// `G04 P<s>` / `G04 X<s>`.
+    /// `G04 P<s>` / `G04 X<s>`; with `G00`/`G01` on the line, `P` only (X is the move's).
     fn dwell(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
-        line.only("GMFSTPX", Context::Dwell)?;
-        if let Some((m, pos)) = line.motion {
-            let kind = ParseErrorKind::ConflictingCodes {
-                letter: 'G',
-                first: 4.0,
-                second: motion_value(m),
-            };
-            return Err(kind.at(pos));
+        let with_move = match line.motion {
+            Some((Motion::G00 | Motion::G01, _)) => true,
+            Some((m, pos)) => {
+                // G02/G03 use P for turns, the NURBS blocks for their degree.
+                let kind = ParseErrorKind::ConflictingCodes {
+                    letter: 'G',
+                    first: 4.0,
+                    second: motion_value(m),
+                };
+                return Err(kind.at(pos));
+            }
+            None => false,
+        };
+        if !with_move {
+            line.only("GMFSTPX", Context::Dwell)?;
         }
         let pos = line.first_of("G").map_or(line.first, |w| w.pos);
-        let t = match (line.get('P'), line.get('X')) {
+        let x = line.get('X').filter(|_| !with_move);
+        let t = match (line.get('P'), x) {
             (Some(p), Some(x)) => {
                 let kind = ParseErrorKind::RepeatedWord {
                     letter: 'X',

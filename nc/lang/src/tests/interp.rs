@@ -235,3 +235,36 @@ fn the_tape_keeps_only_what_a_loop_may_go_back_to() {
     }
     assert!(most <= 6, "kept {most} lines");
 }
+
+#[test]
+fn codes_as_linuxcnc_reads_them() {
+    // A dwell and a move on one line: the dwell first, X is the move's.
+    let p = parse("G0 X0 Y0 Z0\nG4 P0.5 G0 X10\nM2").unwrap();
+    assert_eq!(xs(&p), [0.0, 10.0]);
+    assert_eq!(p.actions.len(), 1);
+    // G and M values within LinuxCNC's tolerance; `G1.001` is no code.
+    assert_eq!(
+        run("G0.0001 X0 Y0 Z0\nG[0.1 * 10] X2 F100\nM[1 + 1]"),
+        [0.0, 2.0]
+    );
+    assert!(matches!(
+        fails("G1.001 X0 Y0 Z0").0,
+        E::NotACode { letter: 'G', .. }
+    ));
+    // G64 P Q are accepted (dnurbs follows the programmed path), W is no axis.
+    assert_eq!(run("G64 P0.01 Q0.01\nG0 X1 Y0 Z0\nM2"), [1.0]);
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\nG1 X1 W5 F100\nM2");
+    assert_eq!((kind, line, col), (E::NoSuchAxis { letter: 'W' }, 2, 7));
+    // G90.1: arc centres are coordinates (work offset applied), both of the plane's needed.
+    let p = parse("G0 X10 Y0 Z0\nG90.1 G3 X-10 Y0 I0 J0 F100\nM2").unwrap();
+    let nc_geom::program::Block::Nurbs(arc) = &p.blocks[1] else {
+        panic!()
+    };
+    let mid = arc.ctrl[arc.ctrl.len() / 2];
+    assert!(
+        (mid[0].hypot(mid[1]) - 10.0).abs() < 1e-9 && mid[1] > 0.0,
+        "{mid:?}"
+    );
+    let (kind, ..) = fails("G0 X10 Y0 Z0\nG90.1 G3 X-10 Y0 I0 F100\nM2");
+    assert!(matches!(kind, E::MissingWord { letter: 'J', .. }));
+}

@@ -74,9 +74,9 @@ fn tape_mark_not_alone() {
 #[test]
 fn unsupported_word() {
     assert_eq!(
-        fails("G00 X0 Y0 Z0 Q1000", 1, 14),
+        fails("G00 X0 Y0 Z0 E1000", 1, 14),
         E::UnsupportedWord {
-            letter: 'Q',
+            letter: 'E',
             value: 1000.0
         }
     );
