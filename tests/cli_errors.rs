@@ -159,7 +159,7 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
         "1:1",
         "cutter radius compensation G41 is not supported",
     );
-    check("g81", "G81 X0 Y0 Z-5 R2 F100\n", "1:1", "canned cycle G81");
+    check("g84", "G84 X0 Y0 Z-5 R2 F100\n", "1:1", "canned cycle G84");
     check(
         "m98",
         "G01 X0 Y0 Z0 F100\nM98\n",

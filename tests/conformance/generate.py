@@ -319,8 +319,55 @@ def units_program(r, k):
     return lines
 
 
+def cycles_program(r, k):
+    """Canned cycles in every plane, G90 and G91, G98 and G99, with L, sticky words, mm and
+    inch."""
+    inch = r.random() < 0.3
+    unit = 25.4 if inch else 1.0
+    lines = ["(canned cycles %d)" % k, "G20" if inch else "G21", "G90 G94",
+             "G0 X0 Y0 Z%s" % fmt(r.uniform(5, 30) / unit), "F%d" % r.randint(50, 800),
+             "S1000 M3"]
+    plane = 17
+    inc = False
+    for _ in range(r.randint(2, 6)):
+        if r.random() < 0.4:
+            plane = r.choice([17, 18, 19])
+            lines.append("G%d" % plane)
+        if r.random() < 0.3:
+            inc = not inc
+            lines.append("G91" if inc else "G90")
+        lines.append(r.choice(["G98", "G99", ""]))
+        cycle = r.choice([73, 81, 82, 83, 85, 86, 89])
+        first, second, axis = {17: "XYZ", 18: "ZXY", 19: "YZX"}[plane]
+        words = []
+        if inc:
+            rr = r.uniform(-3, 2) / unit
+            depth = -r.uniform(1, 10) / unit
+            words += ["%s%s" % (first, fmt(r.uniform(-20, 20) / unit)), "%s%s" % (second, fmt(r.uniform(-20, 20) / unit))]
+        else:
+            rr = r.uniform(1, 8) / unit
+            depth = rr - r.uniform(1, 12) / unit
+            words += ["%s%s" % (first, fmt(r.uniform(-50, 50) / unit)), "%s%s" % (second, fmt(r.uniform(-50, 50) / unit))]
+        words += ["R%s" % fmt(rr), "%s%s" % (axis, fmt(depth))]
+        if cycle in (82, 86, 89):
+            words.append("P%s" % fmt(r.uniform(0, 1), 2))
+        if cycle in (73, 83):
+            words.append("Q%s" % fmt(r.uniform(0.5, 4) / unit))
+        if r.random() < 0.3:
+            words.append("L%d" % r.randint(1, 4))
+        lines.append("G%d %s" % (cycle, " ".join(words)))
+        # More holes of the same cycle: positions only, the other words sticky.
+        for _ in range(r.randint(0, 3)):
+            lines.append("%s%s %s%s" % (first, fmt(r.uniform(-40, 40) / unit), second, fmt(r.uniform(-40, 40) / unit)))
+        if r.random() < 0.5:
+            lines.append("G80")
+            lines.append("G0 %s%s" % (axis, fmt(r.uniform(5, 30) / unit)))
+    lines.append("M2")
+    return [l for l in lines if l]
+
+
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
-            ("arcs", arcs_program, 40), ("units", units_program, 20)]
+            ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40)]
 
 
 def main():

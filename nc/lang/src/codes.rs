@@ -2,10 +2,11 @@
 //!
 //! One code per group on a line (`G00 G01` on one line is an error, `G90 G94 G17 G49 G40 G80`
 //! is six groups). Codes of real posts that dnurbs cannot honour have their own error, never
-//! a silent skip: cutter compensation (`G41`/`G42`), canned cycles (`G73`..`G89`).
+//! a silent skip: cutter compensation (`G41`/`G42`), the canned cycles dnurbs does not run
+//! (tapping `G74`/`G84`, back boring `G87`, `G88`).
 
 use crate::error::ParseErrorKind;
-use crate::vocab::{Motion, Plane};
+use crate::vocab::{Cycle, Motion, Plane};
 use nc_geom::program::{Coolant, Spindle};
 
 /// Tool-length compensation.
@@ -52,7 +53,7 @@ pub enum Code {
     /// `G40`.
     CompensationOff,
     LengthComp(LengthComp),
-    /// `G80`: no canned cycle (dnurbs has none, so this is always in effect).
+    /// `G80`: no canned cycle; without another motion code on its line, no motion mode.
     CannedOff,
     /// `G54`..`G59`: index 0..=5.
     WorkOffset(u8),
@@ -60,13 +61,15 @@ pub enum Code {
     Blend(bool),
     /// `G90.1` (true: arc centres `I J K` absolute) / `G91.1` (relative to the start).
     ArcCentreAbsolute(bool),
+    /// `G99` (true: canned cycles retract to `R`) / `G98` (to the level they started from).
+    Retract(bool),
     Stop(StopCode),
     Spindle(Spindle),
     Coolant(Coolant),
 }
 
 /// Modal groups, as indices of [`super::line::Line`]'s code table.
-pub const GROUPS: usize = 15;
+pub const GROUPS: usize = 16;
 
 impl Code {
     pub fn group(self) -> usize {
@@ -86,13 +89,14 @@ impl Code {
             Code::Spindle(_) => 12,
             Code::Coolant(_) => 13,
             Code::ArcCentreAbsolute(_) => 14,
+            Code::Retract(_) => 15,
         }
     }
 }
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 32] = [
+const G_CODES: [(f64, Code); 41] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -119,7 +123,16 @@ const G_CODES: [(f64, Code); 32] = [
     (59.0, Code::WorkOffset(5)),
     (61.0, Code::Blend(false)),
     (64.0, Code::Blend(true)),
+    (73.0, Code::Motion(Motion::Cycle(Cycle::G73))),
     (80.0, Code::CannedOff),
+    (81.0, Code::Motion(Motion::Cycle(Cycle::G81))),
+    (82.0, Code::Motion(Motion::Cycle(Cycle::G82))),
+    (83.0, Code::Motion(Motion::Cycle(Cycle::G83))),
+    (85.0, Code::Motion(Motion::Cycle(Cycle::G85))),
+    (86.0, Code::Motion(Motion::Cycle(Cycle::G86))),
+    (89.0, Code::Motion(Motion::Cycle(Cycle::G89))),
+    (98.0, Code::Retract(false)),
+    (99.0, Code::Retract(true)),
     (90.0, Code::Incremental(false)),
     (90.1, Code::ArcCentreAbsolute(true)),
     (91.0, Code::Incremental(true)),

@@ -86,7 +86,7 @@ pub enum ParseErrorKind {
     /// Parameters, expressions, O-word flow control, active comments.
     #[error("{0}")]
     Interp(crate::interp_error::InterpError),
-    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K M N O P Q R S T U V W X Y Z")]
+    #[error("word {letter}{value} is not supported: dnurbs accepts the words A B C F G H I J K L M N O P Q R S T U V W X Y Z")]
     UnsupportedWord { letter: char, value: f64 },
 
     // ---- line structure ----------------------------------------------------------------
@@ -104,6 +104,16 @@ pub enum ParseErrorKind {
         first: f64,
         second: f64,
     },
+    #[error("canned cycle {cycle} with inverse-time feed (G93): cycles need a feed in mm/min (G94), as in LinuxCNC")]
+    CycleInverseTime { cycle: crate::vocab::Cycle },
+    #[error("canned cycle {cycle} needs the spindle turning (M03 or M04) before it")]
+    CycleSpindleOff { cycle: crate::vocab::Cycle },
+    #[error("canned cycle: R at {r} mm is below the hole's bottom at {depth} mm")]
+    CycleRBelowDepth { r: f64, depth: f64 },
+    #[error("L{value}: a canned cycle's repeats are a whole number from 1")]
+    BadRepeat { value: f64 },
+    #[error("Q{value}: the peck of G73/G83 must be above 0")]
+    BadPeck { value: f64 },
     #[error("{letter}{value} is not a code: {letter} numbers are whole (M) or have one decimal (G), within 0.001")]
     NotACode { letter: char, value: f64 },
     #[error("{letter} is an axis this machine does not have: dnurbs's machines have X Y Z and two rotary axes (U V W are the orientation curve of a G06.5 block only)")]

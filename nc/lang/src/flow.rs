@@ -211,13 +211,19 @@ impl<S: LineSource> Interp<S> {
         });
     }
 
-    /// One more loop-back, within the program's budget.
-    fn again(&mut self, label: &str, keyword: Keyword, pos: SrcPos) -> Result<(), ParseError> {
+    /// One more loop-back or call, within the program's budget.
+    pub(crate) fn again(
+        &mut self,
+        label: &str,
+        keyword: Keyword,
+        pos: SrcPos,
+    ) -> Result<(), ParseError> {
         if self.budget == 0 {
             return Err(err(
                 InterpError::TooManyIterations {
                     label: Name::new(label),
                     keyword: keyword.name(),
+                    most: self.max_iterations,
                 },
                 pos,
             ));

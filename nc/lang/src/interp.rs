@@ -7,7 +7,7 @@
 //!
 //! What runs here is the planner thread's work: it allocates and may take its time, but
 //! never without bound. Calls nest at most [`MAX_CALL_DEPTH`](crate::rules::MAX_CALL_DEPTH)
-//! deep, a program loops back at most [`Setup::max_iterations`] times, expressions nest at
+//! deep, a program loops back and calls at most [`Setup::max_iterations`] times, expressions nest at
 //! most [`MAX_EXPR_DEPTH`](crate::rules::MAX_EXPR_DEPTH) deep, and the lines kept are those a
 //! loop or a call may still go back to (`tape`).
 //!
@@ -131,8 +131,9 @@ pub(crate) struct Interp<S> {
     /// A subroutine definition being read (not executed).
     pub defining: Option<Sub>,
     pub dirs: Vec<PathBuf>,
-    /// Loop-backs still allowed.
+    /// Loop-backs and calls still allowed, of [`Self::max_iterations`].
     pub budget: u64,
+    pub max_iterations: u64,
     /// `#<_value>` and `#<_value_returned>`.
     pub value: f64,
     pub value_returned: bool,
@@ -173,6 +174,7 @@ impl<S: LineSource> Interp<S> {
             defining: None,
             dirs: setup.subroutine_dirs.clone(),
             budget: setup.max_iterations,
+            max_iterations: setup.max_iterations,
             value: 0.0,
             value_returned: false,
             line: 0,

@@ -4,7 +4,7 @@
 //! say the rule.
 
 use crate::name::Name;
-use crate::rules::{MAX_CALL_DEPTH, MAX_EXPR_DEPTH, MAX_LOOP_ITERATIONS, MAX_PARAMETER};
+use crate::rules::{MAX_CALL_DEPTH, MAX_EXPR_DEPTH, MAX_PARAMETER};
 
 /// What the interpreter refused.
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
@@ -112,8 +112,12 @@ pub enum InterpError {
         label: Name,
         kind: std::io::ErrorKind,
     },
-    #[error("o{label} {keyword}: more than {MAX_LOOP_ITERATIONS} iterations, the most dnurbs runs of one loop (a loop that never ends?)")]
-    TooManyIterations { label: Name, keyword: &'static str },
+    #[error("o{label} {keyword}: the program has gone round its loops and called its subroutines {most} times, the most a program may (a loop that never ends?)")]
+    TooManyIterations {
+        label: Name,
+        keyword: &'static str,
+        most: u64,
+    },
     #[error("the program ends inside o{label} {keyword} of line {line}: its o{label} {closer} is missing")]
     NotClosed {
         label: Name,

@@ -91,6 +91,7 @@
 
 mod arc;
 pub(crate) mod codes;
+mod cycles;
 mod error;
 mod evaluate;
 mod expr;
@@ -131,7 +132,7 @@ pub use rules::{
 };
 pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
 pub use stream::{Entries, Entry};
-pub use vocab::{Motion, Plane};
+pub use vocab::{Cycle, Motion, Plane};
 pub use word::word_limit;
 
 use nc_geom::program::Program;

@@ -37,9 +37,10 @@ pub struct Setup {
     /// Where `o<name> call` looks for `name.ngc` when the program does not define `name`,
     /// in order (LinuxCNC's `SUBROUTINE_PATH`).
     pub subroutine_dirs: Vec<std::path::PathBuf>,
-    /// Most times a program's loops may go back (all loops together, so also loops inside
-    /// loops): a program that would loop more is refused at the loop's line, instead of
-    /// holding the planner. Default [`crate::rules::MAX_LOOP_ITERATIONS`].
+    /// Most times a program's loops may go back and its subroutines be called, all together
+    /// (so also loops inside loops and calls inside calls): a program that would do more is
+    /// refused at the line, instead of holding the planner. Default
+    /// [`crate::rules::MAX_LOOP_ITERATIONS`].
     pub max_iterations: u64,
 }
 
@@ -76,6 +77,10 @@ pub(super) struct Modal {
     pub blend: bool,
     /// `G90.1`: arc centres `I J K` are absolute coordinates (else offsets from the start).
     pub arc_absolute: bool,
+    /// The canned cycles' sticky words and `G98`/`G99`.
+    pub cycle: CycleState,
+    /// The spindle as last commanded.
+    pub spindle: nc_geom::program::Spindle,
     /// Selected tool (`T`) and loaded tool (after `M06`).
     pub selected: Option<u32>,
     pub loaded: Option<u32>,
@@ -96,6 +101,12 @@ impl Default for Modal {
             tool_length: 0.0,
             blend: true,
             arc_absolute: false,
+            // LinuxCNC's rs274 starts in G99.
+            cycle: CycleState {
+                retract_to_r: true,
+                ..CycleState::default()
+            },
+            spindle: nc_geom::program::Spindle::Off,
             selected: None,
             loaded: None,
             rpm: 0.0,
@@ -112,4 +123,21 @@ impl Modal {
             1.0
         }
     }
+}
+
+/// What a cycle keeps between its lines (LinuxCNC's `cycle_*` settings).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct CycleState {
+    /// The level the cycle started from (workpiece mm along the cycle axis), while cycles
+    /// follow each other.
+    pub initial: Option<f64>,
+    /// `R`, the depth, `P` and `Q` as last written (program units).
+    pub r: f64,
+    pub depth: f64,
+    pub p: f64,
+    pub q: f64,
+    /// `G99` (retract to `R`) rather than `G98`.
+    pub retract_to_r: bool,
+    /// The cycle the last motion ran, if it was one: a line of another one needs its words.
+    pub active: Option<crate::vocab::Cycle>,
 }

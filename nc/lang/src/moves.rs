@@ -54,6 +54,10 @@ impl Parser<'_> {
         motion: Motion,
         pos: SrcPos,
     ) -> Result<(), ParseError> {
+        if let Motion::Cycle(c) = motion {
+            return self.cycle(line, c, pos);
+        }
+        self.end_cycle();
         match motion {
             Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
             _ => self.linear(line, motion, pos),
@@ -97,7 +101,7 @@ impl Parser<'_> {
 
     /// The current position, starting at the reference position if the program has none
     /// yet (`missing` names the axis the line left out, for the error without one).
-    fn here_or_reference(
+    pub(crate) fn here_or_reference(
         &mut self,
         line: &Line<'_>,
         pos: SrcPos,
@@ -187,7 +191,7 @@ impl Parser<'_> {
         Ok(())
     }
 
-    fn push_linear(
+    pub(crate) fn push_linear(
         &mut self,
         line: &Line<'_>,
         pos: SrcPos,
@@ -504,7 +508,7 @@ impl Parser<'_> {
 
 /// A resolved coordinate must stay within the word's domain (offsets and G91 can push a
 /// valid word outside it).
-fn check_domain(letter: char, value: f64, pos: SrcPos) -> Result<f64, ParseError> {
+pub(crate) fn check_domain(letter: char, value: f64, pos: SrcPos) -> Result<f64, ParseError> {
     let max = word_limit(letter);
     if value.abs() <= max {
         Ok(value)

@@ -190,6 +190,11 @@ impl<'s> Parser<'s> {
                 Code::InverseTime(it) => self.modal.inverse_time = it,
                 Code::Blend(b) => self.modal.blend = b,
                 Code::ArcCentreAbsolute(abs) => self.modal.arc_absolute = abs,
+                Code::Retract(to_r) => self.modal.cycle.retract_to_r = to_r,
+                Code::CannedOff if line.motion.is_none() => {
+                    self.mode = None;
+                    self.end_cycle();
+                }
                 Code::WorkOffset(i) => {
                     let defined = self
                         .setup
@@ -335,6 +340,7 @@ impl<'s> Parser<'s> {
                     self.stop(pos, ActionKind::ChangeTool { tool }, true);
                 }
                 Code::Spindle(dir) => {
+                    self.modal.spindle = dir;
                     let rpm = self.modal.rpm;
                     self.act(pos, ActionKind::Spindle { dir, rpm });
                 }
@@ -479,6 +485,7 @@ fn motion_value(m: Motion) -> f64 {
         Motion::G03 => 3.0,
         Motion::G062 => 6.2,
         Motion::G065 => 6.5,
+        Motion::Cycle(c) => c.code(),
     }
 }
 

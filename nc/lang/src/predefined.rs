@@ -60,6 +60,7 @@ impl Parser<'_> {
             Some(Motion::G02) => 20.0,
             Some(Motion::G03) => 30.0,
             Some(Motion::G062 | Motion::G065) => 10.0,
+            Some(Motion::Cycle(c)) => 10.0 * c.code(),
         }
     }
 }
@@ -130,6 +131,9 @@ impl State for Parser<'_> {
             "_current_tool" => f64::from(m.loaded.unwrap_or(0)),
             "_selected_tool" => f64::from(m.selected.unwrap_or(0)),
             "_metric_machine" => 1.0,
+            "_retract_r_plane" => flag(m.cycle.retract_to_r),
+            "_retract_old_z" => flag(!m.cycle.retract_to_r),
+            "_ijk_absolute_mode" => flag(m.arc_absolute),
             _ => return None,
         }))
     }

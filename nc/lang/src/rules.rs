@@ -46,7 +46,7 @@ pub const START_TOLERANCE_MM: f64 = 1e-3;
 
 /// The list the unsupported-code error names.
 pub const G_LIST: &str =
-    "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G80 G90 G90.1 G91 G91.1 G93 G94";
+    "G00 G01 G02 G03 G04 G06.2 G06.5 G17 G18 G19 G20 G21 G28 G40 G43 G43.4 G49 G53 G54-G59 G61 G64 G73 G80 G81 G82 G83 G85 G86 G89 G90 G90.1 G91 G91.1 G93 G94 G98 G99";
 
 pub const M_LIST: &str = "M00 M01 M02 M03 M04 M05 M06 M07 M08 M09 M30";
 
@@ -59,8 +59,9 @@ pub const MAX_CALL_DEPTH: usize = 9;
 /// Most brackets, functions and signs nested in one expression.
 pub const MAX_EXPR_DEPTH: usize = 64;
 
-/// Most iterations of one loop (`while`, `do`, `repeat`): a loop that never ends is refused
-/// at its line instead of holding the planner (LinuxCNC has no limit).
+/// Most loop-backs (`while`, `do`, `repeat`) and subroutine calls of one program, all
+/// together: a loop that never ends is refused at its line instead of holding the planner
+/// (LinuxCNC has no limit).
 pub const MAX_LOOP_ITERATIONS: u64 = 10_000_000;
 
 /// How close to a whole number a value must be where one is required (parameter and O-word

@@ -58,6 +58,58 @@ pub enum Motion {
     G03,
     G062,
     G065,
+    /// A canned cycle (expanded into straight moves).
+    Cycle(Cycle),
+}
+
+/// The canned cycles dnurbs runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cycle {
+    /// Drilling with chip breaking (pecks, a small retract between them).
+    G73,
+    /// Drilling.
+    G81,
+    /// Drilling with a dwell at the bottom.
+    G82,
+    /// Peck drilling (out to `R` between pecks).
+    G83,
+    /// Boring, feed out.
+    G85,
+    /// Boring, spindle stopped at the bottom, rapid out.
+    G86,
+    /// Boring, dwell at the bottom, feed out.
+    G89,
+}
+
+impl Cycle {
+    /// The cycle's G number.
+    pub fn code(self) -> f64 {
+        match self {
+            Cycle::G73 => 73.0,
+            Cycle::G81 => 81.0,
+            Cycle::G82 => 82.0,
+            Cycle::G83 => 83.0,
+            Cycle::G85 => 85.0,
+            Cycle::G86 => 86.0,
+            Cycle::G89 => 89.0,
+        }
+    }
+
+    /// It dwells at the bottom: `P` (seconds) is required when it starts.
+    pub fn dwells(self) -> bool {
+        matches!(self, Cycle::G82 | Cycle::G86 | Cycle::G89)
+    }
+
+    /// It pecks: `Q` (the peck, > 0) is required when it starts.
+    pub fn pecks(self) -> bool {
+        matches!(self, Cycle::G73 | Cycle::G83)
+    }
+}
+
+impl fmt::Display for Cycle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "G{}", self.code())
+    }
 }
 
 impl fmt::Display for Motion {
@@ -69,6 +121,7 @@ impl fmt::Display for Motion {
             Motion::G03 => "G03",
             Motion::G062 => "G06.2",
             Motion::G065 => "G06.5",
+            Motion::Cycle(c) => return write!(f, "{c}"),
         })
     }
 }

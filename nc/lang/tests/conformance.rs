@@ -17,6 +17,8 @@
 //! words of its refusal: it must be refused with them, after the same moves as LinuxCNC up to
 //! that line, and the list must not hold a program that now conforms. A program whose motion
 //! differs for a reason given there (`motion: ...`) must be read without error.
+//!
+//! `CONFORMANCE_DUMP=gen/arcs-00.ngc` prints dnurbs's moves of that program.
 
 use nc_geom::program::{Block, Orientation};
 use nc_lang::{Entries, Entry, ParseError, Setup, StrLines};
@@ -351,6 +353,16 @@ fn compare(
             ours.push((b, e));
         }
         here = e;
+    }
+    if std::env::var("CONFORMANCE_DUMP").is_ok_and(|d| d == name) {
+        for (b, e) in &ours {
+            let kind = match b {
+                Block::Linear(l) if l.rapid => "T",
+                Block::Linear(_) => "F",
+                Block::Nurbs(_) => "A",
+            };
+            println!("{kind} {:?}", &e[..3]);
+        }
     }
     // Where dnurbs stops (a listed difference, or LinuxCNC's error) only the moves before
     // that line are compared.

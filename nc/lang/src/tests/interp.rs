@@ -268,3 +268,55 @@ fn codes_as_linuxcnc_reads_them() {
     let (kind, ..) = fails("G0 X10 Y0 Z0\nG90.1 G3 X-10 Y0 I0 F100\nM2");
     assert!(matches!(kind, E::MissingWord { letter: 'J', .. }));
 }
+
+#[test]
+fn canned_cycles_are_refused_with_what_they_miss() {
+    let start = "G0 X0 Y0 Z10\nF100 S1000 M3\n";
+    let kind = |rest: &str| fails(&format!("{start}{rest}\nM2")).0;
+    assert!(matches!(
+        kind("G81 X1 Y1 Z-2"),
+        E::MissingWord { letter: 'R', .. }
+    ));
+    assert!(matches!(
+        kind("G81 X1 Y1 R2"),
+        E::MissingWord { letter: 'Z', .. }
+    ));
+    assert!(matches!(
+        kind("G82 X1 Y1 R2 Z-2"),
+        E::MissingWord { letter: 'P', .. }
+    ));
+    assert!(matches!(kind("G83 X1 Y1 R2 Z-2 Q0"), E::BadPeck { .. }));
+    assert!(matches!(kind("G81 X1 Y1 R2 Z-2 L0"), E::BadRepeat { .. }));
+    assert!(matches!(
+        kind("G81 X1 Y1 R-3 Z-2"),
+        E::CycleRBelowDepth { .. }
+    ));
+    assert!(matches!(
+        kind("M5\nG86 X1 Y1 R2 Z-2 P1"),
+        E::CycleSpindleOff { .. }
+    ));
+    assert!(matches!(
+        kind("G93 G81 X1 Y1 R2 Z-2 F1"),
+        E::CycleInverseTime { .. }
+    ));
+    // G80 ends the cycle and the motion mode: a position alone is then an error.
+    assert!(matches!(
+        kind("G81 X1 Y1 R2 Z-2\nG80\nX5"),
+        E::NoMotionMode { .. }
+    ));
+    // A G81 hole: over it at the start level, down to R, feed to Z, back up (G99: to R).
+    let p = parse(&format!("{start}G81 X1 Y2 R2 Z-2\nM2")).unwrap();
+    let ends: Vec<[f64; 3]> = p.blocks.iter().map(|b| linear(b).end).collect();
+    let want = [
+        [0.0, 0.0, 10.0],
+        [1.0, 2.0, 10.0],
+        [1.0, 2.0, 2.0],
+        [1.0, 2.0, -2.0],
+        [1.0, 2.0, 2.0],
+    ];
+    assert_eq!(ends, want);
+    assert_eq!(
+        p.blocks.iter().map(|b| linear(b).rapid).collect::<Vec<_>>(),
+        [true, true, true, false, true]
+    );
+}

@@ -176,10 +176,10 @@ fn cutter_compensation_and_canned_cycles_are_refused_by_name() {
         E::CutterCompensation { code: 42.0 }
     );
     assert_eq!(
-        fails("G81 X0 Y0 Z-5 R2", 1, 1),
-        E::CannedCycle { code: 81.0 }
+        fails("G84 X0 Y0 Z-5 R2", 1, 1),
+        E::CannedCycle { code: 84.0 }
     );
-    assert!(message("G83").contains("post the cycle expanded into G00/G01 moves"));
+    assert!(message("G87").contains("post the cycle expanded into G00/G01 moves"));
 }
 
 #[test]
