@@ -149,10 +149,24 @@ impl Server {
             std::fs::remove_file(path)
                 .with_context(|| format!("{}: cannot remove the stale socket", path.display()))?;
         }
-        let listener = UnixListener::bind(path)
+        // Bound beside its name, given its mode, then renamed into place: the socket never
+        // appears under `path` with the umask's mode.
+        let mut staging = path.as_os_str().to_owned();
+        staging.push(format!(".{}.new", std::process::id()));
+        let staging = std::path::PathBuf::from(staging);
+        let _ = std::fs::remove_file(&staging);
+        let listener = UnixListener::bind(&staging)
             .with_context(|| format!("{}: cannot create the control socket", path.display()))?;
-        std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o660))
-            .with_context(|| format!("{}: cannot set mode 0660", path.display()))?;
+        let placed = std::fs::set_permissions(&staging, std::fs::Permissions::from_mode(0o660))
+            .with_context(|| format!("{}: cannot set mode 0660", path.display()))
+            .and_then(|()| {
+                std::fs::rename(&staging, path)
+                    .with_context(|| format!("{}: cannot put the socket in place", path.display()))
+            });
+        if let Err(e) = placed {
+            let _ = std::fs::remove_file(&staging);
+            return Err(e);
+        }
         listener.set_nonblocking(true)?;
         Ok(Server {
             listener,
