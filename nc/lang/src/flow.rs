@@ -103,7 +103,6 @@ impl<S: LineSource> Interp<S> {
                 if top.is_some_and(|t| t.label == label && t.keyword == Keyword::Do) {
                     // The end of a `do` loop (a stale `break` ends it, see `doing_break`).
                     if truth(arg(self, 0)?) && !self.doing_break {
-                        self.again(&label, keyword, pos)?;
                         let start = self.frame().open.last().map_or(index, |t| t.start);
                         self.frame_mut().pc = start + 1;
                     } else {
@@ -124,7 +123,6 @@ impl<S: LineSource> Interp<S> {
             }
             Keyword::EndWhile => {
                 let k = self.find(&label, &[Keyword::While], keyword, pos)?;
-                self.again(&label, keyword, pos)?;
                 let frame = self.frame_mut();
                 frame.open.truncate(k + 1);
                 frame.pc = frame.open[k].start;
@@ -147,7 +145,6 @@ impl<S: LineSource> Interp<S> {
                 open.remaining -= 1;
                 let (remaining, start) = (open.remaining, open.start);
                 if remaining > 0 {
-                    self.again(&label, keyword, pos)?;
                     self.frame_mut().pc = start + 1;
                 } else {
                     frame.open.pop();
@@ -167,7 +164,6 @@ impl<S: LineSource> Interp<S> {
                     (_, Keyword::While) => {
                         frame.open.truncate(k + 1);
                         frame.pc = open.start;
-                        self.again(&label, keyword, pos)?;
                     }
                     _ => {
                         // `do`: on to its `while`, which decides.
@@ -211,21 +207,14 @@ impl<S: LineSource> Interp<S> {
         });
     }
 
-    /// One more loop-back or call, within the program's budget.
-    pub(crate) fn again(
-        &mut self,
-        label: &str,
-        keyword: Keyword,
-        pos: SrcPos,
-    ) -> Result<(), ParseError> {
+    /// One more line run again (in a loop or a subroutine), within the program's budget.
+    pub(crate) fn again(&mut self, line: &Normal) -> Result<(), ParseError> {
         if self.budget == 0 {
             return Err(err(
                 InterpError::TooManyIterations {
-                    label: Name::new(label),
-                    keyword: keyword.name(),
-                    most: self.max_iterations,
+                    most: self.max_loop_lines,
                 },
-                pos,
+                line.pos(0),
             ));
         }
         self.budget -= 1;

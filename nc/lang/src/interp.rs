@@ -7,8 +7,9 @@
 //!
 //! What runs here is the planner thread's work: it allocates and may take its time, but
 //! never without bound. Calls nest at most [`MAX_CALL_DEPTH`](crate::rules::MAX_CALL_DEPTH)
-//! deep, a program loops back and calls at most [`Setup::max_iterations`] times, expressions nest at
-//! most [`MAX_EXPR_DEPTH`](crate::rules::MAX_EXPR_DEPTH) deep, and the lines kept are those a
+//! deep, a program runs at most [`Setup::max_loop_lines`] lines again (in loops and
+//! subroutines, counted line by line, so a long loop body costs what it runs), expressions nest
+//! at most [`MAX_EXPR_DEPTH`](crate::rules::MAX_EXPR_DEPTH) deep, and the lines kept are those a
 //! loop or a call may still go back to (`tape`).
 //!
 //! The program's flow (`flow.rs`) and the evaluation of a line (`evaluate.rs`) are methods
@@ -131,9 +132,11 @@ pub(crate) struct Interp<S> {
     /// A subroutine definition being read (not executed).
     pub defining: Option<Sub>,
     pub dirs: Vec<PathBuf>,
-    /// Loop-backs and calls still allowed, of [`Self::max_iterations`].
+    /// Lines that may still run again (in a loop or a subroutine), of [`Self::max_loop_lines`].
     pub budget: u64,
-    pub max_iterations: u64,
+    pub max_loop_lines: u64,
+    /// Main-program lines run so far for the first time (the next new line's index).
+    fresh: usize,
     /// `#<_value>` and `#<_value_returned>`.
     pub value: f64,
     pub value_returned: bool,
@@ -173,8 +176,9 @@ impl<S: LineSource> Interp<S> {
             skip: None,
             defining: None,
             dirs: setup.subroutine_dirs.clone(),
-            budget: setup.max_iterations,
-            max_iterations: setup.max_iterations,
+            budget: setup.max_loop_lines,
+            max_loop_lines: setup.max_loop_lines,
+            fresh: 0,
             value: 0.0,
             value_returned: false,
             line: 0,
@@ -243,6 +247,12 @@ impl<S: LineSource> Interp<S> {
             self.frame_mut().pc = index + 1;
             self.release(index);
             self.line = line.line;
+            if self.level() == 0 && index >= self.fresh {
+                self.fresh = index + 1;
+            } else if let Err(e) = self.again(&line) {
+                self.finished = true;
+                return Err(e);
+            }
             match self.step(&line, index, state, words) {
                 Ok(true) => return Ok(true),
                 Ok(false) => {}

@@ -112,12 +112,8 @@ pub enum InterpError {
         label: Name,
         kind: std::io::ErrorKind,
     },
-    #[error("o{label} {keyword}: the program has gone round its loops and called its subroutines {most} times, the most a program may (a loop that never ends?)")]
-    TooManyIterations {
-        label: Name,
-        keyword: &'static str,
-        most: u64,
-    },
+    #[error("the program has run {most} lines again in its loops and subroutines, the most a program may (a loop that never ends? the machine file's [program] max_loop_lines sets the limit)")]
+    TooManyIterations { most: u64 },
     #[error("the program ends inside o{label} {keyword} of line {line}: its o{label} {closer} is missing")]
     NotClosed {
         label: Name,

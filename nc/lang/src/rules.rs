@@ -59,10 +59,11 @@ pub const MAX_CALL_DEPTH: usize = 9;
 /// Most brackets, functions and signs nested in one expression.
 pub const MAX_EXPR_DEPTH: usize = 64;
 
-/// Most loop-backs (`while`, `do`, `repeat`) and subroutine calls of one program, all
-/// together: a loop that never ends is refused at its line instead of holding the planner
-/// (LinuxCNC has no limit).
-pub const MAX_LOOP_ITERATIONS: u64 = 10_000_000;
+/// Most lines one program may run again, in its loops (`while`, `do`, `repeat`) and
+/// subroutines, all together and counted line by line: a loop that never ends is refused at
+/// a line instead of holding the planner (LinuxCNC has no limit). At the interpreter's speed
+/// (docs/measurements.md) this is about a minute and a half of interpretation.
+pub const MAX_LOOP_LINES: u64 = 100_000_000;
 
 /// How close to a whole number a value must be where one is required (parameter and O-word
 /// numbers, loop counts), as LinuxCNC.

@@ -99,9 +99,6 @@ impl<S: LineSource> Interp<S> {
         args: &[f64],
         pos: SrcPos,
     ) -> Result<(), ParseError> {
-        // Calls count against the program's budget as loop-backs do: a subroutine calling
-        // itself twice, nine deep, would otherwise run 2^9 times per call, and more with more.
-        self.again(&name, Keyword::Call, pos)?;
         if self.level() >= MAX_CALL_DEPTH {
             return Err(err(
                 InterpError::TooManyCalls {

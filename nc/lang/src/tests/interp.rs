@@ -109,7 +109,7 @@ fn loops() {
 #[test]
 fn a_loop_that_never_ends_is_refused_at_its_line() {
     let setup = Setup {
-        max_iterations: 1000,
+        max_loop_lines: 1000,
         ..Setup::default()
     };
     let e = parse_with("G0 X0 Y0 Z0\no1 while [1]\no1 endwhile\nM2", &setup).unwrap_err();
@@ -118,8 +118,36 @@ fn a_loop_that_never_ends_is_refused_at_its_line() {
         matches!(first.kind, E::Interp(I::TooManyIterations { .. })),
         "{first}"
     );
-    assert_eq!(first.pos, at(3, 1));
+    // The 1001st line run again is the `while` (lines 2 and 3 alternate from there).
+    assert_eq!(first.pos, at(2, 1));
     assert_eq!(e.errors.len(), 1, "interpretation stops at a flow error");
+}
+
+#[test]
+fn the_loop_budget_counts_lines_so_a_long_body_costs_what_it_runs() {
+    let setup = Setup {
+        max_loop_lines: 1000,
+        ..Setup::default()
+    };
+    // 9 lines a round, the first round's new: 100 rounds run 891 lines again, 200 too many.
+    let body = "#1=[#1+1]\n".repeat(8);
+    let program = |rounds: u32| {
+        format!("G0 X0 Y0 Z0\n#1=0\no1 repeat [{rounds}]\n{body}o1 endrepeat\nG0 X[#1/8]\nM2")
+    };
+    let ok = parse_with(&program(100), &setup).expect("100 rounds fit the budget");
+    assert_eq!(xs(&ok), [0.0, 100.0]);
+    let e = parse_with(&program(200), &setup).unwrap_err();
+    assert!(matches!(
+        e.errors[0].kind,
+        E::Interp(I::TooManyIterations { most: 1000 })
+    ));
+    // Subroutine bodies count too: a sub called from a loop.
+    let sub = "o<s> sub\n#1=[#1+1]\no<s> endsub\nG0 X0 Y0 Z0\n#1=0\no1 repeat [1000]\no<s> call\no1 endrepeat\nM2";
+    let e = parse_with(sub, &setup).unwrap_err();
+    assert!(matches!(
+        e.errors[0].kind,
+        E::Interp(I::TooManyIterations { .. })
+    ));
 }
 
 #[test]
