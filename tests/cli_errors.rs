@@ -187,9 +187,8 @@ fn geometry_rules_found_after_parsing_are_positioned_too() {
 #[test]
 fn bad_machine_files_and_missing_files_exit_2() {
     let bad = temp("machine.toml");
-    let text = std::fs::read_to_string(machine("paper-ac-table.toml"))
-        .unwrap()
-        .replace("velocity = 250.0", "velocity = -3.0");
+    let text =
+        common::machine_text("paper-ac-table.toml").replace("velocity = 250.0", "velocity = -3.0");
     std::fs::write(&bad, text).unwrap();
     let prog = data("paper-example.nc");
     let out = dnurbs(&[
@@ -269,9 +268,8 @@ fn busload_prints_the_documented_numbers_and_refuses_an_overloaded_bus() {
     );
     // The same machine at 1 ms: 120.5 %, refused with the numbers.
     let fast = temp("fast.toml");
-    let body = std::fs::read_to_string(&mach)
-        .unwrap()
-        .replace("period_ms = 2.0", "period_ms = 1.0");
+    let body =
+        common::machine_text("paper-ac-table.toml").replace("period_ms = 2.0", "period_ms = 1.0");
     std::fs::write(&fast, body).unwrap();
     let out = dnurbs(&["busload", "--machine", fast.to_str().unwrap()]);
     let _ = std::fs::remove_file(&fast);

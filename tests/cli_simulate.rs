@@ -416,7 +416,8 @@ fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
 
     let m = dnurbs_tools::load_machine(&mach).unwrap();
     let shop = dnurbs_tools::shop::ShopArgs::default().load().unwrap();
-    let prog = nc_lang::parse_with(&text, &dnurbs_tools::shop::parse_setup(&m, &shop)).unwrap();
+    let prog =
+        nc_lang::parse_with(&text, &dnurbs_tools::shop::parse_setup(&m, &shop).unwrap()).unwrap();
     let setup = dnurbs_tools::setup::MachineSetup::new(&m);
     let whole = dnurbs_tools::simulate::run(&prog, &setup, setup.method).unwrap();
     let mut want = dnurbs_tools::simulate::summarize(&whole, &setup, prog.blocks.len());
@@ -456,7 +457,7 @@ fn a_long_program_is_simulated_as_it_is_read_with_the_whole_paths_summary() {
 /// refused it on its first ramp.
 #[test]
 fn a_jerk_set_huge_is_planned_at_a_tenth_of_the_acceleration_a_period_and_said() {
-    let text = std::fs::read_to_string(machine("xyzac-trt-mill.toml")).unwrap();
+    let text = common::machine_text("xyzac-trt-mill.toml");
     let huge: String = text
         .lines()
         .map(|l| match l.split_once('=') {
@@ -501,4 +502,81 @@ fn a_jerk_set_huge_is_planned_at_a_tenth_of_the_acceleration_a_period_and_said()
     );
     let s: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_within_limits(&s);
+}
+
+#[test]
+fn a_program_as_linuxcnc_users_write_it_runs_on_every_shipped_machine() {
+    // Its first move gives only Z (the homed machine starts at its reference), G55 and
+    // G43 H1 come from the machine file's offsets and tool table, mm from its start-up modes.
+    let nc = temp("shop.nc");
+    let program = "G0 Z5\nT1 M6\nG43 H1 G55\nG0 X10 Y10\nG1 Z-1 F300\nG1 X20\nG0 Z5\nM30\n";
+    std::fs::write(&nc, program).unwrap();
+    for name in [
+        "paper-ac-table.toml",
+        "xyzac-trt-mill.toml",
+        "xyzbc-trt-mill.toml",
+    ] {
+        let mill = config::load(&machine(name)).unwrap();
+        let trace = temp("shop.csv");
+        let out = dnurbs(&[
+            "simulate",
+            nc.to_str().unwrap(),
+            "--machine",
+            machine(name).to_str().unwrap(),
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let rows = read_trace(&trace);
+        let _ = std::fs::remove_file(&trace);
+        let (first, last) = (&rows[0], &rows[rows.len() - 1]);
+        assert_eq!(
+            first.p,
+            mill.reference.unwrap(),
+            "{name}: starts at the reference"
+        );
+        let end = [20.0, 10.0, 5.0];
+        assert!(
+            last.p.iter().zip(end).all(|(a, b)| (a - b).abs() < 1e-9),
+            "{name}: ends at {:?}",
+            last.p
+        );
+        // The tool's length (80 mm, T1 of the machine's table) is between tip and spindle.
+        assert!(
+            (last.axes[2] - 85.0).abs() < 1e-6,
+            "{name}: Z {}",
+            last.axes[2]
+        );
+    }
+    // A program without G20/G21 on a machine whose start-up modes say inch: in inches.
+    std::fs::write(&nc, "G0 Z1\nG1 X2 Y1 F10\nM30\n").unwrap();
+    let inch = temp("inch.toml");
+    let text = common::machine_text("xyzac-trt-mill.toml").replace("G17 G21", "G17 G20");
+    std::fs::write(&inch, text).unwrap();
+    let trace = temp("inch.csv");
+    let out = dnurbs(&[
+        "simulate",
+        nc.to_str().unwrap(),
+        "--machine",
+        inch.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows = read_trace(&trace);
+    let last = &rows[rows.len() - 1].p;
+    let _ = [&nc, &inch, &trace].map(std::fs::remove_file);
+    let end = [50.8, 25.4, 25.4];
+    assert!(
+        last.iter().zip(end).all(|(a, b)| (a - b).abs() < 1e-9),
+        "{last:?}"
+    );
 }

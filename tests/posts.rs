@@ -46,7 +46,7 @@ fn shop() -> dnurbs_tools::shop::ShopOptions {
 #[test]
 fn every_post_plans_within_the_machine_limits() {
     let m = machine();
-    let parse = parse_setup(&m, &shop());
+    let parse = parse_setup(&m, &shop()).unwrap();
     let setup = MachineSetup::new(&m);
     for name in POSTS {
         let prog = dnurbs_tools::load_program(&posts(name), &parse)
@@ -93,7 +93,7 @@ fn every_post_plans_within_the_machine_limits() {
 #[test]
 fn every_post_is_fitted_as_the_whole_text_fit_fits_it() {
     let m = machine();
-    let mut parse = parse_setup(&m, &shop());
+    let mut parse = parse_setup(&m, &shop()).unwrap();
     parse.work_offsets = [Some([0.0; 3]); 6];
     let setup = MachineSetup::new(&m);
     let opts = nc_fit::options::Options::default();
@@ -211,7 +211,7 @@ fn check_run(
     compress: Option<bool>,
 ) -> dnurbs_tools::report::Report {
     let setup = MachineSetup::new(m).with_compress(compress);
-    let parse = parse_setup(m, &shop());
+    let parse = parse_setup(m, &shop()).unwrap();
     let prog = dnurbs_tools::load_program(&posts(name), &parse).unwrap();
     // The program the planner plans, compressed where compression is on.
     let prog = setup.prepare(prog).0;
@@ -617,8 +617,10 @@ fn work_offsets_from_a_linuxcnc_parameter_file_move_the_program_and_errors_name_
         nc_geom::program::Block::Nurbs(n) => *n.ctrl.last().unwrap(),
     };
     for name in ["fusion-fanuc-3axis.nc", "mastercam-fanuc-3axis.nc"] {
-        let plain = dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &shop())).unwrap();
-        let moved = dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &with)).unwrap();
+        let plain =
+            dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &shop()).unwrap()).unwrap();
+        let moved =
+            dnurbs_tools::load_program(&posts(name), &parse_setup(&m, &with).unwrap()).unwrap();
         assert_eq!(plain.blocks.len(), moved.blocks.len());
         let mut shifted = 0;
         for (a, b) in plain.blocks.iter().zip(&moved.blocks) {

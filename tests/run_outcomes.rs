@@ -5,7 +5,7 @@
 
 mod common;
 
-use dnurbs_tools::demo::{DEMO_MACHINE, DEMO_PROGRAM};
+use dnurbs_tools::demo::DEMO_PROGRAM;
 use dnurbs_tools::exit;
 use dnurbs_tools::run::run;
 use drives::sim::Faults;
@@ -14,8 +14,7 @@ use std::time::Duration;
 /// The paper example on the paper's machine, its drives simulated with `faults(node)`, on
 /// simulated time.
 fn run_with(faults: impl Fn(u8) -> Faults) -> dnurbs_tools::run::RunResult {
-    let machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
-        .expect("the demo machine");
+    let machine = dnurbs_tools::demo::demo_machine().expect("the demo machine");
     let opts = common::run_options("paper-example.nc", None);
     common::run_simulated(DEMO_PROGRAM.as_bytes(), &machine, faults, &opts, |_, _| {}).0
 }
@@ -132,8 +131,7 @@ fn dense_run(compress: bool) {
     };
     let points = nc_plan::fixtures::resample(wave, std::f64::consts::TAU, 20_000, 0.05);
     let src = nc_plan::fixtures::g01_program(&points, 3000.0);
-    let mut machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
-        .expect("the demo machine");
+    let mut machine = dnurbs_tools::demo::demo_machine().expect("the demo machine");
     machine.realtime.feedback_timeout_s = 2.0;
     machine.realtime.heartbeat_timeout_s = 5.0;
     machine.realtime.max_consecutive_overruns = 100_000;
@@ -180,8 +178,7 @@ fn try_run_program(
     program: &str,
     name: &str,
 ) -> anyhow::Result<(dnurbs_tools::report::Report, Vec<Vec<i32>>)> {
-    let machine = config::from_str(DEMO_MACHINE, std::path::Path::new("paper-ac-table.toml"))
-        .expect("the demo machine");
+    let machine = dnurbs_tools::demo::demo_machine().expect("the demo machine");
     let opts = common::run_options(name, None);
     let (r, records) = dnurbs_tools::run::simulated::run_simulated(
         dnurbs_tools::feed::Input::Text(program.as_bytes().into()),

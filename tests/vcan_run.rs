@@ -271,7 +271,8 @@ fn vcan_run_cam_post_with_spindle_and_coolant_on_the_bus() {
         }
         .load()
         .unwrap(),
-    );
+    )
+    .unwrap();
     let prog = dnurbs_tools::load_program(&program, &parse).unwrap();
     let rpm = common::first_spindle_rpm(&prog).expect("the post starts the spindle");
     let spindle = machine.spindle.as_ref().unwrap();

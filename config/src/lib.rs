@@ -97,6 +97,12 @@
 //! node = 7
 //! mist_output = 1           # M07 (output 1..=8 of 0x6200:01)
 //! flood_output = 2          # M08; M09 switches both off
+//!
+//! [program]                 # optional, as is every key in it
+//! startup = "G17 G21 G40 G49 G54 G64 G80 G90 G94"  # modes before the first line
+//! tool_table = "mill.tbl"   # LinuxCNC tool.tbl, relative to this file
+//! subroutine_path = ["subs"]    # where `o<name> call` finds name.ngc, relative to this file
+//! max_loop_lines = 100000000    # most lines run again in loops and subroutines
 //! ```
 //!
 //! Example files: `config/machines/*.toml`.
@@ -128,9 +134,21 @@ pub fn load(path: &Path) -> Result<Machine, ConfigError> {
     from_str(&text, path)
 }
 
-/// Parses and validates a machine configuration held in `text`; `origin` names it in errors.
+/// Parses and validates a machine configuration held in `text`; `origin` names it in errors,
+/// and the files it names (`[program] tool_table`) are read relative to its folder.
 pub fn from_str(text: &str, origin: &Path) -> Result<Machine, ConfigError> {
+    from_str_with_files(text, origin, &|path| std::fs::read_to_string(path))
+}
+
+/// [`from_str`] with the files the machine file names read by `read` (given the path
+/// resolved against `origin`'s folder): a machine file built into the program (`dnurbs
+/// demo`) has its tool table built in beside it.
+pub fn from_str_with_files(
+    text: &str,
+    origin: &Path,
+    read: &dyn Fn(&Path) -> std::io::Result<String>,
+) -> Result<Machine, ConfigError> {
     let src = source::Source::parse(text, origin)?;
     let raw = src.raw()?;
-    validate::machine(raw, &src)
+    validate::machine(raw, &src, read)
 }

@@ -33,6 +33,18 @@ pub(crate) struct RawFile {
     pub spindle: Option<RawSpindle>,
     /// `[coolant]`: the coolant valves' I/O module.
     pub coolant: Option<RawCoolant>,
+    /// `[program]`: how programs are read.
+    pub program: Option<RawProgram>,
+}
+
+/// `[program]`: start-up modes, tool table, subroutine path, loop limit; every key optional.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawProgram {
+    pub startup: Option<String>,
+    pub tool_table: Option<String>,
+    pub subroutine_path: Option<Vec<String>>,
+    pub max_loop_lines: Option<i64>,
 }
 
 /// `[spindle]`: a CiA-402 drive in profile velocity mode.

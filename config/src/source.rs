@@ -38,6 +38,11 @@ impl<'a> Source<'a> {
         }
     }
 
+    /// The file's name as given.
+    pub fn origin(&self) -> &'a Path {
+        self.origin
+    }
+
     /// Deserializes the raw types. Errors are [`ConfigError::Schema`] with the key path.
     pub fn raw(&self) -> Result<RawFile, ConfigError> {
         let de = toml::de::Deserializer::from(self.doc.clone());

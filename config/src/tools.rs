@@ -12,16 +12,7 @@ use crate::error::{ConfigError, LineCol, Location};
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// One tool of the table.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tool {
-    /// Length along the spindle, mm (`Z`).
-    pub length_mm: f64,
-    /// Diameter, mm (`D`), if given.
-    pub diameter_mm: Option<f64>,
-    /// The comment after `;`, trimmed.
-    pub comment: String,
-}
+pub use machine::Tool;
 
 /// Largest tool length, mm.
 pub const MAX_TOOL_LENGTH_MM: f64 = 1e4;

@@ -13,10 +13,15 @@ use machine::Machine;
 
 mod hardware;
 mod motion;
+mod program;
 mod spindle;
 
 /// Converts the raw file into a validated [`Machine`].
-pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigError> {
+pub(crate) fn machine(
+    raw: RawFile,
+    src: &Source<'_>,
+    read: &dyn Fn(&std::path::Path) -> std::io::Result<String>,
+) -> Result<Machine, ConfigError> {
     let check = Check { src };
     let (name, period_s) = check.machine(&raw.machine)?;
     let kinematics = check.kinematics(&raw.kinematics)?;
@@ -80,7 +85,9 @@ pub(crate) fn machine(raw: RawFile, src: &Source<'_>) -> Result<Machine, ConfigE
         Some(r) => Some(check.point(&["reference", "position"], r.position)?),
         None => None,
     };
+    let program = program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
     Ok(Machine {
+        program,
         spindle,
         coolant,
         work_offsets,

@@ -127,6 +127,46 @@ fn paper_example_tilted_fits_xyzac_trt_machine() {
 }
 
 #[test]
+fn every_shipped_machine_is_ready_for_real_programs() {
+    // A homed position, G54..G59, a tool table and start-up modes: a program that leaves an
+    // axis out of its first move, selects G55 or calls G43 H1 runs as it does on LinuxCNC.
+    let mut names: Vec<String> = std::fs::read_dir(machines_dir())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "paper-ac-table.toml",
+            "xyzac-trt-mill.toml",
+            "xyzbc-trt-mill.toml"
+        ]
+    );
+    for name in names {
+        let m = config::load(&machines_dir().join(&name)).unwrap_or_else(|e| panic!("{e}"));
+        let reference = m
+            .reference
+            .unwrap_or_else(|| panic!("{name}: no reference"));
+        let inside = |v: f64, l: &AxisLimits| l.min <= v && v <= l.max;
+        assert!(
+            inside(reference[0], &m.axes.x)
+                && inside(reference[1], &m.axes.y)
+                && inside(reference[2], &m.axes.z),
+            "{name}: the reference is outside the travel"
+        );
+        assert!(
+            m.work_offsets.iter().all(Option::is_some),
+            "{name}: G54..G59"
+        );
+        assert!(m.program.startup.contains("G21"), "{name}: start-up units");
+        assert!(m.program.tools.len() >= 20, "{name}: tool table");
+        assert!(m.program.tools.values().all(|t| t.diameter_mm.is_some()));
+    }
+}
+
+#[test]
 fn defaults_apply_when_keys_are_omitted() {
     let m: Machine = parse(MINIMAL).unwrap();
     assert_eq!(m.period_s, Machine::DEFAULT_PERIOD_MS / 1000.0);

@@ -11,8 +11,10 @@ use std::fmt;
 use std::str::FromStr;
 
 pub mod bus;
+pub mod program;
 pub mod spindle;
 
+pub use program::{ProgramSetup, Tool};
 pub use spindle::{Coolant, Spindle};
 
 /// A validated machine configuration.
@@ -43,6 +45,8 @@ pub struct Machine {
     pub spindle: Option<crate::spindle::Spindle>,
     /// `[coolant]`: the coolant valves' I/O module, if the machine has one on its bus.
     pub coolant: Option<crate::spindle::Coolant>,
+    /// `[program]`: start-up modes, tool table, subroutine path, loop limit.
+    pub program: ProgramSetup,
 }
 
 impl Machine {

@@ -19,6 +19,17 @@ pub fn machine(name: &str) -> PathBuf {
     root().join("config/machines").join(name)
 }
 
+/// A shipped machine file's text, its tool table named by absolute path, so the text can be
+/// edited and written anywhere.
+pub fn machine_text(name: &str) -> String {
+    let text = std::fs::read_to_string(machine(name)).expect("a shipped machine file");
+    let table = machine("mill.tbl");
+    text.replace(
+        "tool_table = \"mill.tbl\"",
+        &format!("tool_table = {:?}", table.to_str().unwrap()),
+    )
+}
+
 /// Run `dnurbs` with the given arguments.
 pub fn dnurbs(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dnurbs"))

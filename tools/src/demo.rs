@@ -10,6 +10,10 @@ use std::time::Duration;
 
 /// The demo's machine: the paper's machine (its drives on an in-process bus).
 pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-table.toml");
+/// The demo machine's tool table (its `[program] tool_table`).
+pub const DEMO_TOOLS: &str = include_str!("../../config/machines/mill.tbl");
+/// Where the demo's machine file says it is.
+pub const DEMO_MACHINE_PATH: &str = "config/machines/paper-ac-table.toml";
 /// The demo's program: the paper's example.
 pub const DEMO_PROGRAM: &str = include_str!("../../tests/data/paper-example.nc");
 
@@ -33,16 +37,28 @@ pub fn demo(
     link: DemoLink,
     input: Input,
 ) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
-    let machine = config::from_str(
-        DEMO_MACHINE,
-        std::path::Path::new("config/machines/paper-ac-table.toml"),
-    )?;
+    let machine = demo_machine()?;
     match link {
         DemoLink::Memory => demo_on(&machine, opts, input, || {
             Ok(MemLink::pair(DEMO_QUEUE_FRAMES))
         }),
         DemoLink::Socketpair => demo_on(&machine, opts, input, SocketLink::pair),
     }
+}
+
+/// The demo's machine file, read with its built-in tool table.
+pub fn demo_machine() -> Result<Machine, config::ConfigError> {
+    config::from_str_with_files(
+        DEMO_MACHINE,
+        std::path::Path::new(DEMO_MACHINE_PATH),
+        &|path| {
+            if path == std::path::Path::new("config/machines/mill.tbl") {
+                Ok(DEMO_TOOLS.to_owned())
+            } else {
+                std::fs::read_to_string(path)
+            }
+        },
+    )
 }
 
 fn demo_on<L: CanLink + Send + 'static>(

@@ -243,7 +243,7 @@ fn stage(
 ) -> anyhow::Result<Staged> {
     let started = crate::report::now_utc();
     let setup = MachineSetup::new(machine).with_compress(opts.shop.compress);
-    let shop = crate::shop::parse_setup(machine, &opts.shop);
+    let shop = crate::shop::parse_setup(machine, &opts.shop)?;
     // The queues live as long as the process: the planner thread may outlive a run that a
     // stop ended while it planned.
     let queues: &'static mut Queues = Box::leak(Queues::new());

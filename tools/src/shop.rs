@@ -12,7 +12,8 @@ use std::path::PathBuf;
 #[derive(clap::Args, Clone, Debug, Default)]
 pub struct ShopArgs {
     /// Tool table in LinuxCNC's tool.tbl format (`T1 P1 Z+75.0 D6.0 ;comment`): the
-    /// lengths `G43 H` / `G43.4 H` apply (Z, mm).
+    /// lengths `G43 H` / `G43.4 H` apply (Z, mm). Replaces the machine file's
+    /// `[program] tool_table`.
     #[arg(long, value_name = "TOOL.TBL")]
     pub tools: Option<PathBuf>,
     /// Work offsets in LinuxCNC's parameter-file format (`linuxcnc.var`: `5221 120.5` is G54
@@ -39,8 +40,8 @@ pub struct ShopArgs {
 /// The shop's options as values (tool lengths loaded).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ShopOptions {
-    /// Tool number -> length, mm.
-    pub tools: BTreeMap<u32, f64>,
+    /// Tool number -> length, mm, from `--tools` (else the machine file's table is used).
+    pub tools: Option<BTreeMap<u32, f64>>,
     /// G54..G59 from `--offsets`, over the machine file's.
     pub work_offsets: config::offsets::WorkOffsets,
     pub block_delete: bool,
@@ -53,11 +54,13 @@ impl ShopArgs {
     /// Loads the tool table, if one is given.
     pub fn load(&self) -> Result<ShopOptions, InputError> {
         let tools = match &self.tools {
-            Some(path) => config::tools::load_tools(path)?
-                .into_iter()
-                .map(|(n, t)| (n, t.length_mm))
-                .collect(),
-            None => BTreeMap::new(),
+            Some(path) => Some(
+                config::tools::load_tools(path)?
+                    .into_iter()
+                    .map(|(n, t)| (n, t.length_mm))
+                    .collect(),
+            ),
+            None => None,
         };
         let work_offsets = match &self.offsets {
             Some(path) => config::offsets::load_offsets(path)?,
@@ -77,16 +80,41 @@ impl ShopArgs {
     }
 }
 
-/// The parser's setup for `machine` and the shop's options.
-pub fn parse_setup(machine: &config::Machine, shop: &ShopOptions) -> nc_lang::Setup {
-    nc_lang::Setup {
+/// The parser's setup for `machine` and the shop's options: the machine file's
+/// `[program]` table (start-up modes, tool table, subroutine path, loop limit) with the
+/// shop's `--tools` and `--offsets` over it.
+pub fn parse_setup(
+    machine: &config::Machine,
+    shop: &ShopOptions,
+) -> Result<nc_lang::Setup, InputError> {
+    let program = &machine.program;
+    let tools = shop.tools.clone().unwrap_or_else(|| {
+        program
+            .tools
+            .iter()
+            .map(|(n, t)| (*n, t.length_mm))
+            .collect()
+    });
+    let mut setup = nc_lang::Setup {
         work_offsets: std::array::from_fn(|k| shop.work_offsets[k].or(machine.work_offsets[k])),
         reference: machine.reference,
-        tools: shop.tools.clone(),
+        tools,
         block_delete: shop.block_delete,
         optional_stop: shop.optional_stop,
         kinematics: Some(crate::setup::MachineSetup::new(machine).kin),
         max_rpm: machine.spindle.as_ref().map(|s| s.max_rpm),
+        subroutine_dirs: program.subroutine_dirs.clone(),
+        max_loop_lines: program.max_loop_lines,
         ..nc_lang::Setup::default()
+    };
+    if !program.startup.is_empty() {
+        // Checked when the machine file was read; the shop's offsets only add to it.
+        setup.startup = nc_lang::Startup::parse(&program.startup, &setup).map_err(|e| {
+            InputError::MachineUse(format!(
+                "{}: [program] startup = {:?}: column {}: {}",
+                machine.name, program.startup, e.col, e.message
+            ))
+        })?;
     }
+    Ok(setup)
 }

@@ -108,6 +108,8 @@ mod parser;
 mod predefined;
 mod rules;
 mod source;
+mod startup;
+mod startup_parse;
 mod stream;
 mod subs;
 mod syntax;
@@ -126,11 +128,12 @@ pub use modal::{Setup, MAX_ERRORS, MM_PER_INCH};
 pub use name::Name;
 pub use rules::{
     ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_IN, ARC_RADIUS_TOL_MM, ARC_REACH_TOL_IN, ARC_REACH_TOL_MM,
-    G_LIST, HELIX_TOL_MM, MAX_CALL_DEPTH, MAX_DWELL_S, MAX_LOOP_ITERATIONS, MAX_PARAMETER,
+    G_LIST, HELIX_TOL_MM, MAX_CALL_DEPTH, MAX_DWELL_S, MAX_LOOP_LINES, MAX_PARAMETER,
     MIN_ARC_RADIUS_MM, MIN_FEED_MM_MIN, MIN_TOOL_OFFSET_MM, MIN_VECTOR_LENGTH, MIN_WEIGHT, M_LIST,
     START_TOLERANCE_MM,
 };
 pub use source::{LineSource, ReadLines, StrLines, MAX_LINE_BYTES};
+pub use startup::{Startup, StartupError, STARTUP_CODES};
 pub use stream::{Entries, Entry};
 pub use vocab::{Cycle, Motion, Plane};
 pub use word::word_limit;

@@ -37,11 +37,14 @@ pub struct Setup {
     /// Where `o<name> call` looks for `name.ngc` when the program does not define `name`,
     /// in order (LinuxCNC's `SUBROUTINE_PATH`).
     pub subroutine_dirs: Vec<std::path::PathBuf>,
-    /// Most times a program's loops may go back and its subroutines be called, all together
-    /// (so also loops inside loops and calls inside calls): a program that would do more is
-    /// refused at the line, instead of holding the planner. Default
-    /// [`crate::rules::MAX_LOOP_ITERATIONS`].
-    pub max_iterations: u64,
+    /// Most lines a program may run again, in its loops and subroutines, all together (so
+    /// also loops inside loops and calls inside calls), counted line by line: a program that
+    /// would run more is refused at the line, instead of holding the planner. Default
+    /// [`crate::rules::MAX_LOOP_LINES`].
+    pub max_loop_lines: u64,
+    /// Modes in effect before the program's first line (the machine file's
+    /// `[program] startup`).
+    pub startup: crate::startup::Startup,
 }
 
 impl Default for Setup {
@@ -55,7 +58,8 @@ impl Default for Setup {
             kinematics: None,
             max_rpm: None,
             subroutine_dirs: Vec::new(),
-            max_iterations: crate::rules::MAX_LOOP_ITERATIONS,
+            max_loop_lines: crate::rules::MAX_LOOP_LINES,
+            startup: crate::startup::Startup::default(),
         }
     }
 }

@@ -52,6 +52,9 @@ pub(super) struct Parser<'s> {
     /// After an error inside a NURBS block: skip its remaining control-point and knot lines.
     skipping: bool,
     end: Option<SrcPos>,
+    /// The start-up modes did not apply (a setup changed after [`crate::Startup::parse`]
+    /// checked them): the first line reports it.
+    startup_error: Option<ParseError>,
 }
 
 impl<'s> Parser<'s> {
@@ -60,7 +63,7 @@ impl<'s> Parser<'s> {
             offset: setup.work_offsets[0].unwrap_or([0.0; 3]),
             ..Modal::default()
         };
-        Parser {
+        let mut parser = Parser {
             setup,
             modal,
             blocks: Vec::new(),
@@ -78,7 +81,13 @@ impl<'s> Parser<'s> {
             just_closed: None,
             skipping: false,
             end: None,
+            startup_error: None,
+        };
+        let startup = setup.startup.words();
+        if !startup.is_empty() {
+            parser.startup_error = parser.line(startup).err();
         }
+        parser
     }
 
     /// After an error on a line: drop an open NURBS block and skip the rest of its lines.
@@ -90,6 +99,9 @@ impl<'s> Parser<'s> {
 
     /// Takes one logical line (its words from the lexer).
     pub fn line(&mut self, words: &[super::word::Word]) -> Result<(), ParseError> {
+        if let Some(e) = self.startup_error.take() {
+            return Err(e);
+        }
         let Some(first) = words.first() else {
             return Ok(());
         };

@@ -18,7 +18,7 @@ pub fn check(
 ) -> anyhow::Result<Outcome> {
     let machine = load_machine(machine)?;
     let shop = shop.load()?;
-    let parse = parse_setup(&machine, &shop);
+    let parse = parse_setup(&machine, &shop)?;
     let setup = MachineSetup::new(&machine);
     let file = program.display().to_string();
     let reader = std::fs::File::open(program).map_err(|error| InputError::ReadProgram {

@@ -58,7 +58,7 @@ pub fn fit(
     }
     .load()?;
     // No work offsets: the program's own numbers are what the fit reads and writes.
-    let mut parse = parse_setup(&machine, &shop);
+    let mut parse = parse_setup(&machine, &shop)?;
     parse.work_offsets = [Some([0.0; 3]); 6];
     let file = program.display().to_string();
     let unreadable = |error| InputError::ReadProgram {

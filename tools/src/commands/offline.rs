@@ -31,7 +31,7 @@ pub fn simulate(
         eprintln!("dnurbs simulate: warning (simulate uses no bus; run would refuse): {e}");
     }
     let shop = shop.load()?;
-    let parse = parse_setup(&machine, &shop);
+    let parse = parse_setup(&machine, &shop)?;
     let setup = MachineSetup::new(&machine).with_compress(shop.compress);
     let method = method.unwrap_or(setup.method);
     let name = program.display().to_string();
@@ -123,7 +123,7 @@ pub fn simulate(
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
     let machine = load_machine(machine)?;
     let shop = shop.load()?;
-    let parse = parse_setup(&machine, &shop);
+    let parse = parse_setup(&machine, &shop)?;
     let setup = MachineSetup::new(&machine).with_compress(shop.compress);
     println!(
         "| program | method | feed fluctuation max | feed fluctuation rms | chord error max (mm) | cycles | axis limits |"

@@ -7,6 +7,7 @@ mod fuzz;
 mod interp;
 mod posts;
 mod source;
+mod startup;
 
 use super::parse;
 use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Program, SrcPos};

@@ -1,0 +1,78 @@
+//! Validation of `[program]` into [`machine::ProgramSetup`]: the start-up modes as the NC
+//! language reads them, the tool table loaded, the subroutine folders present, the loop
+//! limit in range. Paths are relative to the machine file's folder.
+
+use crate::check::Check;
+use crate::error::ConfigError;
+use crate::raw::RawProgram;
+use machine::ProgramSetup;
+use std::path::{Path, PathBuf};
+
+/// Largest `max_loop_lines`.
+const MAX_LOOP_LINES: i64 = 1_000_000_000_000;
+
+pub(crate) fn program(
+    check: &Check<'_, '_>,
+    raw: RawProgram,
+    work_offsets: &[Option<[f64; 3]>; 6],
+    read: &dyn Fn(&Path) -> std::io::Result<String>,
+) -> Result<ProgramSetup, ConfigError> {
+    let mut program = ProgramSetup::default();
+    if let Some(text) = raw.startup {
+        let setup = nc_lang::Setup {
+            work_offsets: *work_offsets,
+            ..nc_lang::Setup::default()
+        };
+        let startup = nc_lang::Startup::parse(&text, &setup).map_err(|e| {
+            let rule = format!(
+                "column {} of the modes: {} (start-up modes: {})",
+                e.col,
+                e.message,
+                nc_lang::STARTUP_CODES
+            );
+            check.invalid(&["program", "startup"], Some(format!("{text:?}")), rule)
+        })?;
+        program.startup = startup.text().to_owned();
+    }
+    let folder = check
+        .src
+        .origin()
+        .parent()
+        .map(PathBuf::from)
+        .unwrap_or_default();
+    if let Some(path) = raw.tool_table {
+        let resolved = folder.join(&path);
+        let text = read(&resolved).map_err(|source| {
+            check.invalid(
+                &["program", "tool_table"],
+                Some(format!("{path:?}")),
+                format!(
+                    "cannot read {} ({source}); the path is relative to the machine file's folder",
+                    resolved.display()
+                ),
+            )
+        })?;
+        program.tools = crate::tools::tools_from_str(&text, &resolved)?;
+        program.tool_table = Some(resolved);
+    }
+    for (i, dir) in raw.subroutine_path.unwrap_or_default().iter().enumerate() {
+        let resolved = folder.join(dir);
+        if !resolved.is_dir() {
+            let rule = format!(
+                "entry {} ({}) is not a folder; the path is relative to the machine file's folder",
+                i + 1,
+                resolved.display()
+            );
+            return Err(check.invalid(&["program", "subroutine_path"], None, rule));
+        }
+        program.subroutine_dirs.push(resolved);
+    }
+    if let Some(n) = raw.max_loop_lines {
+        if !(1..=MAX_LOOP_LINES).contains(&n) {
+            let rule = format!("must be in 1..={MAX_LOOP_LINES} (lines)");
+            return Err(check.invalid(&["program", "max_loop_lines"], Some(n.to_string()), rule));
+        }
+        program.max_loop_lines = n as u64;
+    }
+    Ok(program)
+}

@@ -1,0 +1,104 @@
+//! `[program]`: start-up modes read as the NC language reads them, the tool table and the
+//! subroutine folders relative to the machine file, the loop limit; every rule with its
+//! position.
+
+mod common;
+
+use common::{assert_at, assert_mentions, fail, pos_of, MINIMAL, ORIGIN};
+
+fn with(program: &str) -> String {
+    format!("{MINIMAL}\n[program]\n{program}\n")
+}
+
+#[test]
+fn an_empty_program_table_and_none_give_the_defaults() {
+    let none = common::parse(MINIMAL).unwrap();
+    let empty = common::parse(&with("")).unwrap();
+    assert_eq!(none.program, empty.program);
+    assert_eq!(none.program.startup, "");
+    assert!(none.program.tools.is_empty() && none.program.subroutine_dirs.is_empty());
+    // One default for the machine file and the NC language.
+    assert_eq!(none.program.max_loop_lines, nc_lang::MAX_LOOP_LINES);
+}
+
+#[test]
+fn startup_modes_are_checked_where_they_are_written() {
+    let m = common::parse(&with("startup = \" G20 G17 G40 G49 G90 G94 G64 P0.001 \"")).unwrap();
+    assert_eq!(m.program.startup, "G20 G17 G40 G49 G90 G94 G64 P0.001");
+    let text = with("startup = \"G20 G0 X1\"");
+    let (_, shown) = fail(&text);
+    assert_at(&shown, pos_of(&text, "\"G20 G0"));
+    assert_mentions(
+        &shown,
+        &[
+            "program.startup",
+            "column 5",
+            "G0",
+            "only codes that set a mode",
+        ],
+    );
+    // A work offset must be defined by the machine file.
+    let (_, shown) = fail(&with("startup = \"G55\""));
+    assert_mentions(&shown, &["program.startup", "G55"]);
+    let text = format!(
+        "{MINIMAL}\n[work_offsets]\nG55 = [1.0, 2.0, 3.0]\n\n[program]\nstartup = \"G55\"\n"
+    );
+    assert_eq!(common::parse(&text).unwrap().program.startup, "G55");
+}
+
+#[test]
+fn the_tool_table_and_subroutines_are_found_beside_the_machine_file() {
+    let dir = std::env::temp_dir().join(format!("dnurbs-config-program-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("subs")).unwrap();
+    std::fs::write(dir.join("mill.tbl"), "T1 P1 Z50 D6 ;flat\nT2 P2 Z75.5\n").unwrap();
+    let file = dir.join("mill.toml");
+    let text =
+        with("tool_table = \"mill.tbl\"\nsubroutine_path = [\"subs\"]\nmax_loop_lines = 1000");
+    std::fs::write(&file, &text).unwrap();
+    let m = config::load(&file).unwrap();
+    assert_eq!(m.program.tools[&1].diameter_mm, Some(6.0));
+    assert_eq!(m.program.tools[&2].length_mm, 75.5);
+    assert_eq!(m.program.tool_table, Some(dir.join("mill.tbl")));
+    assert_eq!(m.program.subroutine_dirs, [dir.join("subs")]);
+    assert_eq!(m.program.max_loop_lines, 1000);
+
+    // A table that is not there, a folder that is not there: the key, the path tried.
+    let missing = with("tool_table = \"nowhere.tbl\"");
+    std::fs::write(&file, &missing).unwrap();
+    let shown = config::load(&file).unwrap_err().to_string();
+    assert_mentions(
+        &shown,
+        &[
+            "program.tool_table",
+            "nowhere.tbl",
+            "relative to the machine file",
+        ],
+    );
+    let missing = with("subroutine_path = [\"subs\", \"gone\"]");
+    std::fs::write(&file, &missing).unwrap();
+    let shown = config::load(&file).unwrap_err().to_string();
+    assert_mentions(
+        &shown,
+        &["program.subroutine_path", "entry 2", "gone", "not a folder"],
+    );
+    // An error in the table names the table's own line and column.
+    std::fs::write(dir.join("mill.tbl"), "T1 P1 Z50\nT1 P2 Z60\n").unwrap();
+    std::fs::write(&file, with("tool_table = \"mill.tbl\"")).unwrap();
+    let shown = config::load(&file).unwrap_err().to_string();
+    assert_mentions(&shown, &["mill.tbl:2:1", "already in the table"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_loop_limit_is_in_range_and_unknown_keys_are_refused() {
+    for bad in ["0", "-5", "1000000000001"] {
+        let text = with(&format!("max_loop_lines = {bad}"));
+        let (_, shown) = fail(&text);
+        let mut at = pos_of(&text, "max_loop_lines = ");
+        at.column += "max_loop_lines = ".len();
+        assert_at(&shown, at);
+        assert_mentions(&shown, &[ORIGIN, "program.max_loop_lines", "1..="]);
+    }
+    let (_, shown) = fail(&with("startup_code = \"G21\""));
+    assert_mentions(&shown, &["startup_code"]);
+}
