@@ -366,8 +366,43 @@ def cycles_program(r, k):
     return [l for l in lines if l]
 
 
+def offsets_program(r, k):
+    """G92, G92.1, G92.2, G92.3 among moves, arcs, G91, G20 and the parameters that read
+    them (#5210, #<_x>)."""
+    inch = r.random() < 0.3
+    lines = ["(G92 offsets %d)" % k, "G20" if inch else "G21", "G90 G17",
+             "G0 X%s Y%s Z%s" % (num(r, -5, 5), num(r, -5, 5), num(r, 1, 5)), "F%d" % r.randint(20, 400)]
+    inc = False
+    for _ in range(r.randint(6, 14)):
+        c = r.random()
+        if c < 0.3:
+            axes = [a for a in "XYZ" if r.random() < 0.6] or ["X"]
+            lines.append("G92 " + " ".join("%s%s" % (a, num(r, -10, 10)) for a in axes))
+        elif c < 0.42:
+            lines.append(r.choice(["G92.1", "G92.2", "G92.3"]))
+        elif c < 0.5:
+            inc = not inc
+            lines.append("G91" if inc else "G90")
+        elif c < 0.58:
+            # Not #5211..: LinuxCNC keeps them in the machine's units, and rs274's machine is
+            # an inch machine where dnurbs's are metric (tests/interp.rs checks them in mm).
+            lines.append("G1 X[#<_x> + #5210] Y[#<_y> + 1] Z[#<_z> - #5210]")
+        elif c < 0.68:
+            # A quarter circle about a centre 3 units off, from wherever it is.
+            d = r.choice([1, -1])
+            lines.append("%s X[#<_x> + %d] Y[#<_y> + %d] I%d J0" % (r.choice(["G2", "G3"]), 3 * d, 3 * d, 3 * d))
+        else:
+            words = ["X" + num(r, -10, 10), "Y" + num(r, -10, 10)]
+            if r.random() < 0.4:
+                words.append("Z" + num(r, -3, 3))
+            lines.append("%s %s" % (r.choice(["G0", "G1"]), " ".join(words)))
+    lines.append("M2")
+    return lines
+
+
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
-            ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40)]
+            ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
+            ("offsets", offsets_program, 20)]
 
 
 def main():

@@ -16,7 +16,8 @@ Usage (Debian package linuxcnc-uspace, system Python):
     /usr/bin/python3 tests/conformance/regen.py FILE.ngc   # some
 
 Reference format, one motion per line, lengths in mm (the module reports inches), angles in
-degrees:
+degrees; positions are where the tool goes: the interpreter's program coordinates plus the
+G5x and G92 offsets it sets (dnurbs's blocks are in that frame):
     T <line> x y z a b c                       rapid (STRAIGHT_TRAVERSE)
     F <line> x y z a b c                       feed (STRAIGHT_FEED)
     A <line> <plane> <turn> x y z c1 c2 a b c  arc (ARC_FEED): end point, centre in the plane's
@@ -49,6 +50,19 @@ class Canon:
         self.out = []
         self.line = 0
         self.plane = 1
+        # The program's zero: the G5x and G92 offsets (mm). The interpreter reports program
+        # coordinates; the reference is where the tool goes, the program's plus these.
+        self.g5x = [0.0] * 3
+        self.g92 = [0.0] * 3
+
+    def offset(self):
+        return [g + h for g, h in zip(self.g5x, self.g92)]
+
+    def set_g5x_offset(self, index, x, y, z, *rest):
+        self.g5x = [x * MM, y * MM, z * MM]
+
+    def set_g92_offset(self, x, y, z, *rest):
+        self.g92 = [x * MM, y * MM, z * MM]
 
     # Queries the interpreter makes: rs274's answers (user units inch, XYZABC, no tools).
     def get_external_length_units(self):
@@ -76,10 +90,10 @@ class Canon:
         self.plane = plane
 
     def straight_traverse(self, x, y, z, a, b, c, u, v, w):
-        self.out.append(("T", self.line, [x * MM, y * MM, z * MM, a, b, c]))
+        self.out.append(("T", self.line, [x * MM, y * MM, z * MM, a, b, c], self.offset()))
 
     def straight_feed(self, x, y, z, a, b, c, u, v, w):
-        self.out.append(("F", self.line, [x * MM, y * MM, z * MM, a, b, c]))
+        self.out.append(("F", self.line, [x * MM, y * MM, z * MM, a, b, c], self.offset()))
 
     def arc_feed(self, e1, e2, c1, c2, turn, axis_end, a, b, c, u, v, w):
         # End point back in X Y Z from the plane's first, second and axis coordinates.
@@ -90,7 +104,7 @@ class Canon:
         else:
             xyz = (e2, axis_end, e1)
         vals = [v * MM for v in xyz] + [c1 * MM, c2 * MM, a, b, c]
-        self.out.append(("A", self.line, PLANES[self.plane], turn, vals))
+        self.out.append(("A", self.line, PLANES[self.plane], turn, vals, self.offset()))
 
     def __getattr__(self, name):
         # Every other canonical call (feeds, spindle, comments, offsets): not motion.
@@ -157,7 +171,15 @@ def rs274_run(path):
     plane = "XY"
     printed = []
     motion = []
+    g5x, g92 = [0.0] * 3, [0.0] * 3
     for line in run.stdout.splitlines():
+        m = re.search(r"SET_G5X_OFFSET\(\d+, (.*)\)", line)
+        if m:
+            g5x = [float(t) * scale for t in m.group(1).split(",")[:3]]
+        m = re.search(r"SET_G92_OFFSET\((.*)\)", line)
+        if m:
+            g92 = [float(t) * scale for t in m.group(1).split(",")[:3]]
+        offset = [g + h for g, h in zip(g5x, g92)]
         if "USE_LENGTH_UNITS(CANON_UNITS_INCHES)" in line:
             scale = MM
         elif "USE_LENGTH_UNITS(CANON_UNITS_MM)" in line:
@@ -176,10 +198,10 @@ def rs274_run(path):
                 xyz = [0.0] * 3
                 xyz[first], xyz[second], xyz[axis] = e1, e2, ax
                 vals = [v * scale for v in xyz] + [c1 * scale, c2 * scale, a, b, c]
-                motion.append(("A", 0, plane, int(turn), vals))
+                motion.append(("A", 0, plane, int(turn), vals, offset))
             else:
                 kind = "T" if m.group(1) == "STRAIGHT_TRAVERSE" else "F"
-                motion.append((kind, 0, [v * scale for v in nums[:3]] + nums[3:6]))
+                motion.append((kind, 0, [v * scale for v in nums[:3]] + nums[3:6], offset))
     return run, printed, motion
 
 
@@ -196,7 +218,7 @@ def rs274_check(path, motion):
         return None, error
     for (name, scale, nums), move in zip(printed, motion):
         if move[0] == "A":
-            _, _, plane, turn, vals = move
+            _, _, plane, turn, vals = move[:5]
             e = vals[0:3]
             first, second, axis = {"XY": (0, 1, 2), "YZ": (1, 2, 0), "XZ": (2, 0, 1)}[plane]
             want = [e[first], e[second], vals[3], vals[4], turn, e[axis]] + vals[5:8]
@@ -233,11 +255,17 @@ def write(path, out_path):
                 % os.path.relpath(path, HERE))
         f.write("P %s\n" % precision)
         for move in motion:
+            # Program coordinates plus the program's zero (the G5x and G92 offsets).
+            off = move[-1]
             if move[0] == "A":
-                _, line, plane, turn, vals = move
+                _, line, plane, turn, vals, _ = move
+                first, second, _ = {"XY": (0, 1, 2), "YZ": (1, 2, 0), "XZ": (2, 0, 1)}[plane]
+                vals = ([v + o for v, o in zip(vals[0:3], off)]
+                        + [vals[3] + off[first], vals[4] + off[second]] + vals[5:])
                 f.write("A %d %s %d %s\n" % (line, plane, turn, " ".join(fmt(v) for v in vals)))
             else:
-                kind, line, vals = move
+                kind, line, vals, _ = move
+                vals = [v + o for v, o in zip(vals[0:3], off)] + vals[3:]
                 f.write("%s %d %s\n" % (kind, line, " ".join(fmt(v) for v in vals)))
         if error:
             f.write("E %d %s\n" % (error[0], error[1].replace("\n", " ")))

@@ -20,6 +20,30 @@ pub enum LengthComp {
     Off,
 }
 
+/// `G92` and its relatives: the coordinate-system offset that shifts every work offset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum G92 {
+    /// `G92 X Y Z`: the current point gets the given coordinates.
+    Set,
+    /// `G92.1`: the offset is 0, and so are its parameters (5211..).
+    Reset,
+    /// `G92.2`: the offset is 0, its parameters kept.
+    Suspend,
+    /// `G92.3`: the offset from its parameters again.
+    Restore,
+}
+
+impl G92 {
+    pub fn value(self) -> f64 {
+        match self {
+            G92::Set => 92.0,
+            G92::Reset => 92.1,
+            G92::Suspend => 92.2,
+            G92::Restore => 92.3,
+        }
+    }
+}
+
 /// Program stops and ends.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopCode {
@@ -43,6 +67,8 @@ pub enum Code {
     Home,
     /// `G53` move in machine coordinates (non-modal).
     MachineCoords,
+    /// `G92`, `G92.1`, `G92.2`, `G92.3` (non-modal).
+    CoordOffset(G92),
     Plane(Plane),
     /// `G20` (true) / `G21`.
     Inch(bool),
@@ -75,7 +101,7 @@ impl Code {
     pub fn group(self) -> usize {
         match self {
             Code::Motion(_) => 0,
-            Code::Dwell | Code::Home | Code::MachineCoords => 1,
+            Code::Dwell | Code::Home | Code::MachineCoords | Code::CoordOffset(_) => 1,
             Code::Plane(_) => 2,
             Code::Inch(_) => 3,
             Code::Incremental(_) => 4,
@@ -96,7 +122,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 41] = [
+const G_CODES: [(f64, Code); 45] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -133,6 +159,10 @@ const G_CODES: [(f64, Code); 41] = [
     (89.0, Code::Motion(Motion::Cycle(Cycle::G89))),
     (98.0, Code::Retract(false)),
     (99.0, Code::Retract(true)),
+    (92.0, Code::CoordOffset(G92::Set)),
+    (92.1, Code::CoordOffset(G92::Reset)),
+    (92.2, Code::CoordOffset(G92::Suspend)),
+    (92.3, Code::CoordOffset(G92::Restore)),
     (90.0, Code::Incremental(false)),
     (90.1, Code::ArcCentreAbsolute(true)),
     (91.0, Code::Incremental(true)),

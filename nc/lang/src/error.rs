@@ -41,6 +41,8 @@ pub enum Context {
     ControlPoint(Motion),
     /// A line with no motion at all (only `N`, `F`, `G90`, `G21`, `M02`/`M30`).
     NoMotion,
+    /// A `G92` line (`tenth` 0), `G92.1`, `G92.2` or `G92.3`.
+    CoordOffset { tenth: u8 },
 }
 
 impl fmt::Display for Context {
@@ -51,6 +53,8 @@ impl fmt::Display for Context {
             Context::NoMotion => f.write_str("a line without motion"),
             Context::Dwell => f.write_str("a G04 (dwell) line"),
             Context::LengthComp => f.write_str("a G43/G43.4 (tool length) line"),
+            Context::CoordOffset { tenth: 0 } => f.write_str("a G92 line"),
+            Context::CoordOffset { tenth } => write!(f, "a G92.{tenth} line"),
         }
     }
 }
@@ -171,13 +175,19 @@ pub enum ParseErrorKind {
     NurbsIncremental { motion: Motion },
     #[error("work offset {} is not defined: define it under [work_offsets] in the machine file or in an --offsets file", Code('G', *.code))]
     UnknownWorkOffset { code: f64 },
+    #[error("{} and {motion} on one line both take the axis words: put them on lines of their own", Code('G', *.code))]
+    AxisWordsTwice { code: f64, motion: Motion },
+    #[error("G92 {axis}: dnurbs offsets X Y Z only (a rotary axis offset would turn the part to another angle than the program's)")]
+    OffsetRotary { axis: char },
+    #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]
+    OffsetWithoutAxes,
     #[error("{} needs the machine's reference position: define [reference] in the machine file", Code('G', *.code))]
     NoReference { code: f64 },
     #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]
     MachineMoveRotated { code: f64, axis: char },
     #[error("{} needs G00 or G01 in effect (it is a straight move in machine coordinates)", Code('G', *.code))]
     MachineMoveNotLinear { code: f64 },
-    #[error("tool {tool} is not in the tool table: give --tools FILE (LinuxCNC tool.tbl) with a line T{tool} ... Z<length>")]
+    #[error("tool {tool} is not in the tool table: add a line T{tool} ... Z<length> to the machine file's [program] tool_table, or give --tools FILE (LinuxCNC tool.tbl)")]
     UnknownTool { tool: u32 },
     #[error("the tool length changes ({from} -> {to} mm) on a {motion} block: change it on a G00/G01 (posts write G43 Z.. H..)")]
     LengthChangeOnCurve { motion: Motion, from: f64, to: f64 },

@@ -71,9 +71,14 @@ pub(super) struct Modal {
     pub inch: bool,
     pub incremental: bool,
     pub inverse_time: bool,
-    /// Active work offset (0 = G54) and its value.
+    /// Active work offset (0 = G54), and where the program's zero is (mm, workpiece frame):
+    /// the work offset plus `g92`.
     pub work: u8,
     pub offset: [f64; 3],
+    /// The `G92` offset in effect (mm), and the one its parameters 5211..5213 hold (`G92.3`
+    /// restores it).
+    pub g92: [f64; 3],
+    pub g92_saved: [f64; 3],
     pub comp: LengthComp,
     /// Tool length in effect (mm).
     pub tool_length: f64,
@@ -101,6 +106,8 @@ impl Default for Modal {
             inverse_time: false,
             work: 0,
             offset: [0.0; 3],
+            g92: [0.0; 3],
+            g92_saved: [0.0; 3],
             comp: LengthComp::Off,
             tool_length: 0.0,
             blend: true,

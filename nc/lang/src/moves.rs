@@ -22,6 +22,9 @@ const AXES: [char; 3] = ['X', 'Y', 'Z'];
 impl Parser<'_> {
     /// The motion of a line that is not a dwell.
     pub(super) fn motion(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
+            return self.coord_offset(line, kind, pos);
+        }
         if let Some((code @ (Code::Home | Code::MachineCoords), pos)) = line.code_of_group(1) {
             if let Some((m, _)) = line.motion {
                 self.mode = Some(m);

@@ -214,7 +214,7 @@ impl<'s> Parser<'s> {
                         .get(usize::from(i))
                         .copied()
                         .flatten();
-                    self.modal.offset = match (defined, i) {
+                    let work = match (defined, i) {
                         (Some(o), _) => o,
                         (None, 0) => [0.0; 3],
                         (None, _) => {
@@ -222,6 +222,7 @@ impl<'s> Parser<'s> {
                             return Err(ParseErrorKind::UnknownWorkOffset { code }.at(pos));
                         }
                     };
+                    self.modal.offset = std::array::from_fn(|k| work[k] + self.modal.g92[k]);
                     self.modal.work = i;
                 }
                 Code::LengthComp(comp) => self.length_comp(line, comp, pos, motion)?,

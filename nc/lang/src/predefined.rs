@@ -1,10 +1,12 @@
 //! The parameters the modal state gives the interpreter ([`State`] for the parser): the
 //! position `#5420`.. and `#<_x>`.., the tool `#5400`.., the work offsets `#5220`..
-//! `#5221`.., the reference position `#5161`.., and the modes `#<_metric>`,
-//! `#<_motion_mode>`, ... as LinuxCNC names and numbers them. Lengths are in the program's
-//! units (G20/G21 in effect), positions in the active work coordinate system, as LinuxCNC's
-//! `#5420` reads. All of them are read-only: the offsets, the reference and the tools come
-//! from the machine file.
+//! `#5221`.., the `G92` offset `#5210`.., the reference position `#5161`.., and the modes
+//! `#<_metric>`, `#<_motion_mode>`, ... as LinuxCNC names and numbers them. Positions and
+//! the tool length are in the program's units (G20/G21 in effect), positions in the active
+//! coordinate system, as LinuxCNC's `#5420` reads; the stored offsets and positions
+//! (`#5161`.., `#5211`.., `#5221`..) are in the machine's units, mm, as LinuxCNC keeps them.
+//! All of them are read-only: the offsets, the reference and the tools come from the machine
+//! file, the `G92` offset from `G92`.
 
 use crate::codes::LengthComp;
 use crate::interp::State;
@@ -49,7 +51,7 @@ impl Parser<'_> {
             .copied()
             .flatten()
             .unwrap_or([0.0; 3]);
-        o.get(i).copied().unwrap_or(0.0) / self.modal.scale()
+        o.get(i).copied().unwrap_or(0.0)
     }
 
     fn motion_mode(&self) -> f64 {
@@ -73,10 +75,17 @@ impl State for Parser<'_> {
     fn computed(&self, n: u32) -> Option<Result<f64, InterpError>> {
         let scale = self.modal.scale();
         Some(Ok(match n {
+            // The stored positions and offsets are in the machine's units (LinuxCNC's rule),
+            // and a dnurbs machine's are mm, whatever the program's.
             5161..=5169 => {
                 let i = (n - 5161) as usize;
                 let r = self.setup.reference.unwrap_or([0.0; 3]);
-                r.get(i).copied().unwrap_or(0.0) / scale
+                r.get(i).copied().unwrap_or(0.0)
+            }
+            5210 => flag(self.modal.g92 != [0.0; 3]),
+            5211..=5219 => {
+                let i = (n - 5211) as usize;
+                self.modal.g92_saved.get(i).copied().unwrap_or(0.0)
             }
             5220 => f64::from(self.modal.work) + 1.0,
             5221..=5390 if (n - 5221) % 20 < 10 => {

@@ -348,3 +348,49 @@ fn canned_cycles_are_refused_with_what_they_miss() {
         [true, true, true, false, true]
     );
 }
+
+#[test]
+fn g92_shifts_the_program_zero_and_its_parameters_are_in_mm() {
+    // G92 X0: here is X0 from now; G92.2 suspends, G92.3 restores, G92.1 cancels.
+    let src = "G0 X5 Y0 Z0\nG92 X0\nG0 X1\nG92.2\nG0 X1\nG92.3\nG0 X2\nG92.1\nG0 X2\nM2";
+    assert_eq!(run(src), [5.0, 6.0, 1.0, 7.0, 2.0]);
+    // Its parameters keep mm (the machine's units) in an inch program; #5210 says it is on.
+    let src = "G20 G0 X1 Y0 Z0\nG92 X0\nG21 G0 X[#5211] Y[#5210]\nG92.2\nG0 Y[#5210] X[#5211]\nM2";
+    let p = parse(src).unwrap();
+    let ends: Vec<[f64; 3]> = p.blocks.iter().map(|b| linear(b).end).collect();
+    assert_eq!(ends[1], [50.8, 1.0, 0.0]);
+    assert_eq!(ends[2], [25.4, 0.0, 0.0]);
+    // A work offset chosen later keeps the G92 offset on top of it.
+    let setup = Setup {
+        work_offsets: [
+            Some([0.0; 3]),
+            Some([100.0, 0.0, 0.0]),
+            None,
+            None,
+            None,
+            None,
+        ],
+        ..Setup::default()
+    };
+    let p = parse_with("G0 X5 Y0 Z0\nG92 X0\nG55 G0 X0\nM2", &setup).unwrap();
+    assert_eq!(xs(&p), [5.0, 105.0]);
+}
+
+#[test]
+fn g92_refuses_what_it_cannot_honour_with_the_column() {
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\nG92 A0\nM2");
+    assert!(matches!(kind, E::OffsetRotary { axis: 'A' }), "{kind}");
+    assert_eq!((line, col), (2, 5));
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG92\nM2");
+    assert!(matches!(kind, E::OffsetWithoutAxes), "{kind}");
+    assert_eq!(line, 2);
+    let (kind, _, col) = fails("G0 X0 Y0 Z0\nG92 G1 X1 F100\nM2");
+    assert!(matches!(kind, E::AxisWordsTwice { .. }), "{kind}");
+    assert_eq!(col, 5);
+    let (kind, _, col) = fails("G0 X0 Y0 Z0\nG92.1 X1\nM2");
+    assert!(
+        matches!(kind, E::WordNotAllowed { letter: 'X', .. }),
+        "{kind}"
+    );
+    assert_eq!(col, 7);
+}
