@@ -192,7 +192,7 @@ fn a_stalled_machine_is_told_from_a_fault() {
 #[test]
 fn run_reports_a_bad_program_with_its_position_before_touching_the_bus() {
     let prog = temp("bad.nc");
-    std::fs::write(&prog, "N10 G01 X0 Y0 Z0 F100\nN20 G01 X1 E5\n").unwrap();
+    std::fs::write(&prog, "N10 G01 X0 Y0 Z0 F100\nN20 G01 X1 D5\n").unwrap();
     let m = machine("paper-ac-table.toml");
     let out = dnurbs(&[
         "run",
@@ -203,8 +203,8 @@ fn run_reports_a_bad_program_with_its_position_before_touching_the_bus() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains(&format!("{}:2:12: word E5", prog.display()))
-            && err.matches("word E5").count() == 1,
+        err.contains(&format!("{}:2:12: word D5", prog.display()))
+            && err.matches("word D5").count() == 1,
         "{err}"
     );
     assert!(!err.contains("CAN interface"), "{err}");

@@ -103,6 +103,15 @@
 //! tool_table = "mill.tbl"   # LinuxCNC tool.tbl, relative to this file
 //! subroutine_path = ["subs"]    # where `o<name> call` finds name.ngc, relative to this file
 //! max_loop_lines = 100000000    # most lines run again in loops and subroutines
+//!
+//! [io]                      # optional, simulated machines only (no [[bus]])
+//! digital_outputs = 4       # M62..M65 P0..P3
+//! digital_inputs = 4        # M66 P0..P3
+//! analog_outputs = 2        # M67/M68 E0..E1
+//! analog_inputs = 2         # M66 E0..E1
+//!
+//! [mcodes]                  # optional: M-codes the machine defines
+//! M428 = "tcp-on"           # "ignore" | "tcp-on" | "tcp-off" | "stop"
 //! ```
 //!
 //! Example files: `config/machines/*.toml`.
@@ -121,8 +130,8 @@ use std::path::Path;
 pub use error::{ConfigError, LineCol, Location};
 // The types a machine file is read into, defined below the file's parsing (crate `machine`).
 pub use machine::{
-    bus, Axes, AxisLimits, Compress, Coolant, Interpolation, Kinematics, Machine, Method, Realtime,
-    RotaryName, Spindle, UnknownMethod,
+    bus, Axes, AxisLimits, Compress, Coolant, Interpolation, IoCounts, Kinematics, Machine,
+    McodeAction, Method, Realtime, RotaryName, Spindle, UnknownMethod,
 };
 
 /// Reads and validates the machine configuration file at `path`.

@@ -35,6 +35,20 @@ pub(crate) struct RawFile {
     pub coolant: Option<RawCoolant>,
     /// `[program]`: how programs are read.
     pub program: Option<RawProgram>,
+    /// `[io]`: simulated inputs and outputs for M62..M68.
+    pub io: Option<RawIo>,
+    /// `[mcodes]`: machine-defined M-codes, `M428 = "tcp-on"`.
+    pub mcodes: Option<std::collections::BTreeMap<String, String>>,
+}
+
+/// `[io]`: how many inputs and outputs of each kind; every key optional (0).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawIo {
+    pub digital_outputs: Option<i64>,
+    pub digital_inputs: Option<i64>,
+    pub analog_outputs: Option<i64>,
+    pub analog_inputs: Option<i64>,
 }
 
 /// `[program]`: start-up modes, tool table, subroutine path, loop limit; every key optional.

@@ -85,7 +85,10 @@ pub(crate) fn machine(
         Some(r) => Some(check.point(&["reference", "position"], r.position)?),
         None => None,
     };
-    let program = program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
+    let mut program =
+        program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
+    program.io = program::io(&check, raw.io, !buses.is_empty())?;
+    program.mcodes = program::mcodes(&check, raw.mcodes.unwrap_or_default())?;
     Ok(Machine {
         program,
         spindle,

@@ -102,3 +102,53 @@ fn the_loop_limit_is_in_range_and_unknown_keys_are_refused() {
     let (_, shown) = fail(&with("startup_code = \"G21\""));
     assert_mentions(&shown, &["startup_code"]);
 }
+
+#[test]
+fn io_counts_and_machine_m_codes() {
+    let m = common::parse(&format!(
+        "{MINIMAL}\n[io]\ndigital_outputs = 4\nanalog_inputs = 2\n\n[mcodes]\nM428 = \"tcp-on\"\nM100 = \"ignore\"\n"
+    ))
+    .unwrap();
+    assert_eq!(m.program.io.digital_outputs, 4);
+    assert_eq!(m.program.io.analog_inputs, 2);
+    assert_eq!(m.program.io.digital_inputs, 0);
+    assert_eq!(m.program.mcodes[&428], config::McodeAction::TcpOn);
+    assert_eq!(m.program.mcodes[&100], config::McodeAction::Ignore);
+    for (text, parts) in [
+        (
+            "[io]\ndigital_outputs = 65\n",
+            &["io.digital_outputs", "0..=64"][..],
+        ),
+        (
+            "[mcodes]\nM3 = \"ignore\"\n",
+            &["mcodes.M3", "the language's own"][..],
+        ),
+        ("[mcodes]\nM70 = \"ignore\"\n", &["mcodes.M70"][..]),
+        (
+            "[mcodes]\nX1 = \"ignore\"\n",
+            &["mcodes.X1", "keys are M-codes"][..],
+        ),
+        (
+            "[mcodes]\nM101 = \"dance\"\n",
+            &["mcodes.M101", "\"dance\"", "ignore, tcp-on, tcp-off, stop"][..],
+        ),
+        (
+            "[mcodes]\nM101 = \"stop\"\nm101 = \"ignore\"\n",
+            &["given twice"][..],
+        ),
+    ] {
+        let (_, shown) = fail(&format!("{MINIMAL}\n{text}"));
+        assert_mentions(&shown, parts);
+    }
+    // A machine with a bus: [io] is refused rather than M62..M68 run without outputs.
+    let with_bus = format!(
+        "{MINIMAL}\n[[bus]]\nname = \"can0\"\ninterface = \"vcan0\"\n{}\n[io]\ndigital_outputs = 1\n",
+        ["x", "y", "z", "a", "c"]
+            .iter()
+            .enumerate()
+            .map(|(i, ax)| format!("\n[axes.{ax}.drive]\nbus = \"can0\"\nnode = {}\ncounts_per_unit = 1000.0\n", i + 1))
+            .collect::<String>()
+    );
+    let (_, shown) = fail(&with_bus);
+    assert_mentions(&shown, &["io", "simulated machine", "M62..M68"]);
+}

@@ -14,7 +14,7 @@ pub mod bus;
 pub mod program;
 pub mod spindle;
 
-pub use program::{ProgramSetup, Tool};
+pub use program::{IoCounts, McodeAction, ProgramSetup, Tool};
 pub use spindle::{Coolant, Spindle};
 
 /// A validated machine configuration.

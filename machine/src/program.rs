@@ -24,6 +24,47 @@ pub struct ProgramSetup {
     pub subroutine_dirs: Vec<PathBuf>,
     /// `max_loop_lines`: most lines a program may run again in loops and subroutines.
     pub max_loop_lines: u64,
+    /// `[io]`: the simulated inputs and outputs `M62`..`M68` may name.
+    pub io: IoCounts,
+    /// `[mcodes]`: the M-codes this machine defines, by number.
+    pub mcodes: BTreeMap<u32, McodeAction>,
+}
+
+/// How many inputs and outputs of each kind (`[io]`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct IoCounts {
+    pub digital_outputs: u8,
+    pub digital_inputs: u8,
+    pub analog_outputs: u8,
+    pub analog_inputs: u8,
+}
+
+/// What a machine-defined M-code does (`[mcodes] M428 = "tcp-on"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum McodeAction {
+    /// `"ignore"`: nothing, reported with a note.
+    Ignore,
+    /// `"tcp-on"`: tool-centre-point control on.
+    TcpOn,
+    /// `"tcp-off"`: tool-centre-point control off (moves keep the rotary axes at 0).
+    TcpOff,
+    /// `"stop"`: a program stop, as `M00`.
+    Stop,
+}
+
+impl McodeAction {
+    /// The names a machine file gives, in the order of the variants.
+    pub const NAMES: [&'static str; 4] = ["ignore", "tcp-on", "tcp-off", "stop"];
+
+    pub fn from_name(name: &str) -> Option<McodeAction> {
+        match name {
+            "ignore" => Some(McodeAction::Ignore),
+            "tcp-on" => Some(McodeAction::TcpOn),
+            "tcp-off" => Some(McodeAction::TcpOff),
+            "stop" => Some(McodeAction::Stop),
+            _ => None,
+        }
+    }
 }
 
 impl Default for ProgramSetup {
@@ -34,6 +75,8 @@ impl Default for ProgramSetup {
             tools: BTreeMap::new(),
             subroutine_dirs: Vec::new(),
             max_loop_lines: DEFAULT_MAX_LOOP_LINES,
+            io: IoCounts::default(),
+            mcodes: BTreeMap::new(),
         }
     }
 }

@@ -105,6 +105,26 @@ pub fn parse_setup(
         max_rpm: machine.spindle.as_ref().map(|s| s.max_rpm),
         subroutine_dirs: program.subroutine_dirs.clone(),
         max_loop_lines: program.max_loop_lines,
+        io: nc_lang::Io {
+            digital_outputs: program.io.digital_outputs,
+            digital_inputs: program.io.digital_inputs,
+            analog_outputs: program.io.analog_outputs,
+            analog_inputs: program.io.analog_inputs,
+        },
+        user_mcodes: program
+            .mcodes
+            .iter()
+            .map(|(&n, &a)| {
+                use nc_geom::program::UserAction;
+                let action = match a {
+                    config::McodeAction::Ignore => UserAction::Ignore,
+                    config::McodeAction::TcpOn => UserAction::TcpOn,
+                    config::McodeAction::TcpOff => UserAction::TcpOff,
+                    config::McodeAction::Stop => UserAction::Stop,
+                };
+                (n, action)
+            })
+            .collect(),
         ..nc_lang::Setup::default()
     };
     if !program.startup.is_empty() {

@@ -2,7 +2,9 @@
 //! lines `simulate` and `run` report. The machines dnurbs drives have no spindle or coolant
 //! drive yet, so these are reported, never silently dropped.
 
-use nc_geom::program::{Action, ActionKind, Coolant, Program, Spindle};
+use nc_geom::program::{
+    Action, ActionKind, Coolant, Input, Program, Spindle, UserAction, WaitMode,
+};
 
 /// One line per action: `line:col  word  what it does`.
 pub fn describe(program: &Program) -> Vec<String> {
@@ -44,6 +46,61 @@ pub fn describe_action(a: &Action) -> String {
                 ActionKind::OptionalStop { taken: false } => {
                     "M01 optional stop (off: passed)".to_owned()
                 }
+                ActionKind::DigitalOutput { index, on, synced } => {
+                    let code = match (on, synced) {
+                        (true, true) => "M62",
+                        (false, true) => "M63",
+                        (true, false) => "M64",
+                        (false, false) => "M65",
+                    };
+                    let state = if on { "on" } else { "off" };
+                    let when = if synced {
+                        "as the next move starts"
+                    } else {
+                        "at once"
+                    };
+                    format!("{code} P{index} digital output {index} {state} {when} (simulated: the machine file's [io])")
+                }
+                ActionKind::AnalogOutput {
+                    index,
+                    value,
+                    synced,
+                } => {
+                    let code = if synced { "M67" } else { "M68" };
+                    format!("{code} E{index} Q{value} analog output {index} set (simulated: the machine file's [io])")
+                }
+                ActionKind::WaitInput {
+                    input,
+                    mode,
+                    timeout_s,
+                } => {
+                    let which = match input {
+                        Input::Digital(n) => format!("P{n} digital input {n}"),
+                        Input::Analog(n) => format!("E{n} analog input {n}"),
+                    };
+                    let how = match mode {
+                        WaitMode::Immediate => "read at once",
+                        WaitMode::Rise => "wait for a rise",
+                        WaitMode::Fall => "wait for a fall",
+                        WaitMode::High => "wait until high",
+                        WaitMode::Low => "wait until low",
+                    };
+                    format!("M66 {which}: {how}, at most {timeout_s} s (simulated: the input answers at once)")
+                }
+                ActionKind::UserM { code, action } => match action {
+                    UserAction::Ignore => {
+                        format!("M{code} ignored, as the machine file's [mcodes] says")
+                    }
+                    UserAction::TcpOn => format!(
+                        "M{code} tool-centre-point control on (the machine file's [mcodes]; dnurbs places the tool tip on its trunnion machines anyway)"
+                    ),
+                    UserAction::TcpOff => format!(
+                        "M{code} tool-centre-point control off (the machine file's [mcodes]): moves keep the rotary axes at 0 from here"
+                    ),
+                    UserAction::Stop => format!(
+                        "M{code} program stop (the machine file's [mcodes]): the path stops for the operator"
+                    ),
+                },
             };
             format!("{}  {what}", a.pos)
         }

@@ -4,8 +4,9 @@
 
 use crate::check::Check;
 use crate::error::ConfigError;
-use crate::raw::RawProgram;
-use machine::ProgramSetup;
+use crate::raw::{RawIo, RawProgram};
+use machine::{IoCounts, McodeAction, ProgramSetup};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Largest `max_loop_lines`.
@@ -76,3 +77,96 @@ pub(crate) fn program(
     }
     Ok(program)
 }
+
+/// Most inputs or outputs of one kind.
+const MAX_IO: i64 = 64;
+
+/// `[io]`: simulated only (a machine with a bus has none yet: its I/O module's inputs and
+/// outputs beyond the coolant valves are not driven).
+pub(crate) fn io(
+    check: &Check<'_, '_>,
+    raw: Option<RawIo>,
+    has_bus: bool,
+) -> Result<IoCounts, ConfigError> {
+    let Some(raw) = raw else {
+        return Ok(IoCounts::default());
+    };
+    if has_bus {
+        return Err(check.invalid(
+            &["io"],
+            None,
+            "is for a simulated machine (no [[bus]]): dnurbs does not drive M62..M68 on a bus yet, \
+             so a program using them is refused there rather than run without them"
+                .into(),
+        ));
+    }
+    let count = |key: &str, v: Option<i64>| -> Result<u8, ConfigError> {
+        match v {
+            None => Ok(0),
+            Some(n) if (0..=MAX_IO).contains(&n) => Ok(n as u8),
+            Some(n) => Err(check.invalid(
+                &["io", key],
+                Some(n.to_string()),
+                format!("must be in 0..={MAX_IO}"),
+            )),
+        }
+    };
+    Ok(IoCounts {
+        digital_outputs: count("digital_outputs", raw.digital_outputs)?,
+        digital_inputs: count("digital_inputs", raw.digital_inputs)?,
+        analog_outputs: count("analog_outputs", raw.analog_outputs)?,
+        analog_inputs: count("analog_inputs", raw.analog_inputs)?,
+    })
+}
+
+/// `[mcodes]`: `M<n> = "<action>"` for M-codes the language does not define itself.
+pub(crate) fn mcodes(
+    check: &Check<'_, '_>,
+    raw: BTreeMap<String, String>,
+) -> Result<BTreeMap<u32, McodeAction>, ConfigError> {
+    let mut out = BTreeMap::new();
+    for (key, value) in raw {
+        let n = key
+            .strip_prefix(['M', 'm'])
+            .and_then(|d| d.parse::<u32>().ok())
+            .filter(|n| (1..=9999).contains(n));
+        let Some(n) = n else {
+            return Err(check.invalid(
+                &["mcodes", &key],
+                Some(key.clone()),
+                "keys are M-codes: M followed by 1..=9999 (M428 = \"tcp-on\")".into(),
+            ));
+        };
+        if BUILT_IN.contains(&n) {
+            return Err(check.invalid(
+                &["mcodes", &key],
+                Some(key.clone()),
+                format!("M{n} is the language's own ({})", nc_lang::M_LIST),
+            ));
+        }
+        if out.contains_key(&n) {
+            return Err(check.invalid(
+                &["mcodes", &key],
+                Some(key.clone()),
+                format!("M{n} is given twice"),
+            ));
+        }
+        let Some(action) = McodeAction::from_name(&value) else {
+            return Err(check.invalid(
+                &["mcodes", &key],
+                Some(format!("{value:?}")),
+                format!("must be one of {}", McodeAction::NAMES.join(", ")),
+            ));
+        };
+        out.insert(n, action);
+    }
+    Ok(out)
+}
+
+/// The M-codes of the language itself, and those LinuxCNC gives a meaning of its own
+/// (overrides M48..M53, M60, M61, the modal state M70..M73), which a machine may not make
+/// something else.
+const BUILT_IN: [u32; 30] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 30, 48, 49, 50, 51, 52, 53, 60, 61, 62, 63, 64, 65, 66, 67, 68,
+    70, 71, 72, 73,
+];

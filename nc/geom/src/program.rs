@@ -250,6 +250,44 @@ pub enum Coolant {
     Off,
 }
 
+/// What `M66` waits for (its `L` word).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WaitMode {
+    /// `L0`: no wait, the input is read at once.
+    Immediate,
+    /// `L1`: a rising edge.
+    Rise,
+    /// `L2`: a falling edge.
+    Fall,
+    /// `L3`: the input high.
+    High,
+    /// `L4`: the input low.
+    Low,
+}
+
+/// An input `M66` reads: digital `P<n>` or analog `E<n>`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Input {
+    Digital(u8),
+    Analog(u8),
+}
+
+/// What the machine file maps a machine-defined M-code to (`[mcodes]`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UserAction {
+    /// Nothing moves or switches: reported with a note.
+    Ignore,
+    /// Tool-centre-point control on (LinuxCNC's `M428` in its trunnion demos): what dnurbs
+    /// does on its `*-trt` machines anyway.
+    TcpOn,
+    /// Tool-centre-point control off (LinuxCNC's `M429`, its trivial kinematics): the
+    /// machine's axes are then the program's, which they are only with the rotary axes at 0,
+    /// so moves are refused unless they are there.
+    TcpOff,
+    /// A program stop: the path stops for the operator, as at `M00`.
+    Stop,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ActionKind {
     /// `M03`/`M04`/`M05` with the speed in effect (rpm, `S`).
@@ -279,5 +317,29 @@ pub enum ActionKind {
     /// `M01`: `taken` when optional stops are on.
     OptionalStop {
         taken: bool,
+    },
+    /// `M62`/`M63` (`synced`: as the next move starts) and `M64`/`M65` (at once): digital
+    /// output `index` on or off.
+    DigitalOutput {
+        index: u8,
+        on: bool,
+        synced: bool,
+    },
+    /// `M67` (`synced`) and `M68`: analog output `index` set to `value`.
+    AnalogOutput {
+        index: u8,
+        value: f64,
+        synced: bool,
+    },
+    /// `M66`: wait for `input` as `mode` says, at most `timeout_s`.
+    WaitInput {
+        input: Input,
+        mode: WaitMode,
+        timeout_s: f64,
+    },
+    /// A machine-defined M-code and what the machine file maps it to.
+    UserM {
+        code: u32,
+        action: UserAction,
     },
 }

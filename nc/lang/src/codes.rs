@@ -44,6 +44,33 @@ impl G92 {
     }
 }
 
+/// The machine's inputs and outputs (`M62`..`M68`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IoCode {
+    /// `M62` (synced) / `M64`: digital output on.
+    DigitalOn { synced: bool },
+    /// `M63` (synced) / `M65`: digital output off.
+    DigitalOff { synced: bool },
+    /// `M66`: wait for an input.
+    Wait,
+    /// `M67` (synced) / `M68`: analog output.
+    Analog { synced: bool },
+}
+
+impl IoCode {
+    pub fn value(self) -> f64 {
+        match self {
+            IoCode::DigitalOn { synced: true } => 62.0,
+            IoCode::DigitalOff { synced: true } => 63.0,
+            IoCode::DigitalOn { synced: false } => 64.0,
+            IoCode::DigitalOff { synced: false } => 65.0,
+            IoCode::Wait => 66.0,
+            IoCode::Analog { synced: true } => 67.0,
+            IoCode::Analog { synced: false } => 68.0,
+        }
+    }
+}
+
 /// Program stops and ends.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopCode {
@@ -92,10 +119,14 @@ pub enum Code {
     Stop(StopCode),
     Spindle(Spindle),
     Coolant(Coolant),
+    /// `M62`..`M68`.
+    Io(IoCode),
+    /// A machine-defined M-code (the machine file's `[mcodes]`).
+    User(u32),
 }
 
 /// Modal groups, as indices of [`super::line::Line`]'s code table.
-pub const GROUPS: usize = 16;
+pub const GROUPS: usize = 18;
 
 impl Code {
     pub fn group(self) -> usize {
@@ -116,6 +147,8 @@ impl Code {
             Code::Coolant(_) => 13,
             Code::ArcCentreAbsolute(_) => 14,
             Code::Retract(_) => 15,
+            Code::Io(_) => 16,
+            Code::User(_) => 17,
         }
     }
 }
@@ -187,7 +220,7 @@ pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
 }
 
 pub fn m_code(value: f64) -> Result<Code, ParseErrorKind> {
-    const M_CODES: [(f64, Code); 11] = [
+    const M_CODES: [(f64, Code); 18] = [
         (0.0, Code::Stop(StopCode::Stop)),
         (1.0, Code::Stop(StopCode::Optional)),
         (2.0, Code::Stop(StopCode::End)),
@@ -199,6 +232,13 @@ pub fn m_code(value: f64) -> Result<Code, ParseErrorKind> {
         (8.0, Code::Coolant(Coolant::Flood)),
         (9.0, Code::Coolant(Coolant::Off)),
         (30.0, Code::Stop(StopCode::End)),
+        (62.0, Code::Io(IoCode::DigitalOn { synced: true })),
+        (63.0, Code::Io(IoCode::DigitalOff { synced: true })),
+        (64.0, Code::Io(IoCode::DigitalOn { synced: false })),
+        (65.0, Code::Io(IoCode::DigitalOff { synced: false })),
+        (66.0, Code::Io(IoCode::Wait)),
+        (67.0, Code::Io(IoCode::Analog { synced: true })),
+        (68.0, Code::Io(IoCode::Analog { synced: false })),
     ];
     M_CODES
         .iter()

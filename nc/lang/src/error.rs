@@ -124,7 +124,7 @@ pub enum ParseErrorKind {
     NoSuchAxis { letter: char },
     #[error("unsupported G-code {}: dnurbs accepts {G_LIST}", Code('G', *.code))]
     UnsupportedGCode { code: f64 },
-    #[error("unsupported M-code {}: dnurbs accepts {M_LIST}", Code('M', *.code))]
+    #[error("unsupported M-code {}: dnurbs accepts {M_LIST}, and the M-codes the machine file's [mcodes] maps (M100..M199 and others: \"ignore\", \"tcp-on\", \"tcp-off\", \"stop\")", Code('M', *.code))]
     UnsupportedMCode { code: f64 },
     #[error("cutter radius compensation {} is not supported: post the tool-centre path (compensation in the computer) with G40", Code('G', *.code))]
     CutterCompensation { code: f64 },
@@ -177,6 +177,34 @@ pub enum ParseErrorKind {
     UnknownWorkOffset { code: f64 },
     #[error("{} and {motion} on one line both take the axis words: put them on lines of their own", Code('G', *.code))]
     AxisWordsTwice { code: f64, motion: Motion },
+    #[error("{} and {} on one line both take the {letter} word: put them on lines of their own", Code(*.first_letter, *.first), Code(*.second_letter, *.second))]
+    WordShared {
+        letter: char,
+        first_letter: char,
+        first: f64,
+        second_letter: char,
+        second: f64,
+    },
+    #[error("{} {letter}{value}: the machine has {count} {what} ({what} of the machine file's [io])", Code('M', *.code))]
+    NoSuchIo {
+        code: f64,
+        letter: char,
+        value: f64,
+        count: u8,
+        what: &'static str,
+    },
+    #[error("{} needs {letter}", Code('M', *.code))]
+    IoWordMissing { code: f64, letter: char },
+    #[error(
+        "M66 L{value}: the wait mode is 0 (read at once), 1 (rise), 2 (fall), 3 (high) or 4 (low)"
+    )]
+    BadWaitMode { value: f64 },
+    #[error("M66 Q{value}: the timeout is 0..=3600 s")]
+    BadWaitTimeout { value: f64 },
+    #[error("M66 L{mode} with E (an analog input) waits for a digital input's edge or level: give P, or L0")]
+    AnalogWait { mode: u8 },
+    #[error("M{code} switched tool-centre-point control off ([mcodes] of the machine file): the machine's axes are then the program's, which they are only with the rotary axes at 0 (here {r1}, {r2} deg)")]
+    TcpOffTurned { code: u32, r1: f64, r2: f64 },
     #[error("G92 {axis}: dnurbs offsets X Y Z only (a rotary axis offset would turn the part to another angle than the program's)")]
     OffsetRotary { axis: char },
     #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]

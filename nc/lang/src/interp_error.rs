@@ -54,6 +54,8 @@ pub enum InterpError {
     ReadOnlyNamed { name: Name, why: &'static str },
     #[error("#<{name}> is not defined: assign it first (#<{name}> = ...); a name without a leading _ is local to its subroutine")]
     UndefinedNamed { name: Name },
+    #[error("#5399: what M66 reads is known only when the machine gets there, and dnurbs plans ahead of the machine (LinuxCNC waits for it)")]
+    InputUnknown,
     #[error("#<{name}>: the position is not known before the program's first move")]
     PositionUnknown { name: Name },
     #[error("a named parameter `#<` needs its closing `>`")]

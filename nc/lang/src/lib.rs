@@ -99,7 +99,9 @@ mod expr;
 mod flow;
 mod interp;
 mod interp_error;
+mod io;
 mod line;
+mod machine_move;
 mod modal;
 mod moves;
 mod name;
@@ -125,7 +127,7 @@ pub use word::continues;
 pub use arc::{arc, ArcNet, ArcTol, Centre};
 pub use error::{Context, ParseError, ParseErrorKind};
 pub use interp_error::InterpError;
-pub use modal::{Setup, MAX_ERRORS, MM_PER_INCH};
+pub use modal::{Io, Setup, MAX_ERRORS, MM_PER_INCH};
 pub use name::Name;
 pub use rules::{
     ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_IN, ARC_RADIUS_TOL_MM, ARC_REACH_TOL_IN, ARC_REACH_TOL_MM,

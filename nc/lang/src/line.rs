@@ -11,7 +11,7 @@ use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].
-pub(super) const KNOWN: &str = "ABCFGHIJKLMNOPQRSTUVWXYZ";
+pub(super) const KNOWN: &str = "ABCEFGHIJKLMNOPQRSTUVWXYZ";
 
 /// Words that make a line move the machine (in the modal motion mode if no G word is given).
 pub(super) const MOVE_WORDS: &str = "XYZABCIJKR";
@@ -40,7 +40,11 @@ pub(super) struct Line<'w> {
 
 impl<'w> Line<'w> {
     /// Classifies a logical line. `words` must not be empty.
-    pub fn classify(words: &'w [Word]) -> Result<Self, ParseError> {
+    /// `user`: the M-codes the machine defines (`[mcodes]`).
+    pub fn classify(
+        words: &'w [Word],
+        user: &std::collections::BTreeMap<u32, nc_geom::program::UserAction>,
+    ) -> Result<Self, ParseError> {
         let first = words.first().map(|w| w.pos).unwrap_or_default();
         let (n, body) = match words.split_first() {
             Some((w, rest)) if w.letter == 'N' => (Some(sequence_number(w)?), rest),
@@ -66,7 +70,12 @@ impl<'w> Line<'w> {
                 }),
                 'N' => Err(ParseErrorKind::MisplacedSequenceNumber { value: w.value }),
                 'G' => code_number(w.value, 10.0, 0.001).and_then(g_code),
-                'M' => code_number(w.value, 1.0, 1e-4).and_then(m_code),
+                'M' => code_number(w.value, 1.0, 1e-4).and_then(|v| {
+                    m_code(v).or_else(|e| match super::word::as_uint(v) {
+                        Some(n) if user.contains_key(&n) => Ok(Code::User(n)),
+                        _ => Err(e),
+                    })
+                }),
                 _ => {
                     if !line.knots_only {
                         line.insert(w)?;

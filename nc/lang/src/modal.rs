@@ -45,6 +45,21 @@ pub struct Setup {
     /// Modes in effect before the program's first line (the machine file's
     /// `[program] startup`).
     pub startup: crate::startup::Startup,
+    /// The inputs and outputs `M62`..`M68` may name (the machine file's `[io]`); none by
+    /// default.
+    pub io: Io,
+    /// The M-codes the machine defines and what each does (the machine file's `[mcodes]`).
+    pub user_mcodes: BTreeMap<u32, nc_geom::program::UserAction>,
+}
+
+/// How many inputs and outputs of each kind the machine has: `M62 P<n>` needs
+/// `n < digital_outputs`, and so on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Io {
+    pub digital_outputs: u8,
+    pub digital_inputs: u8,
+    pub analog_outputs: u8,
+    pub analog_inputs: u8,
 }
 
 impl Default for Setup {
@@ -60,6 +75,8 @@ impl Default for Setup {
             subroutine_dirs: Vec::new(),
             max_loop_lines: crate::rules::MAX_LOOP_LINES,
             startup: crate::startup::Startup::default(),
+            io: Io::default(),
+            user_mcodes: BTreeMap::new(),
         }
     }
 }
@@ -84,6 +101,13 @@ pub(super) struct Modal {
     pub tool_length: f64,
     /// `G64` (true) or `G61`; dnurbs follows the programmed path exactly in both.
     pub blend: bool,
+    /// Tool-centre-point control switched off by a machine-defined M-code (`tcp-off`): the
+    /// code, while moves must keep the rotary axes at 0.
+    pub tcp_off: Option<u32>,
+    /// Tool-centre-point control switched on by a machine-defined M-code (`tcp-on`, LinuxCNC's
+    /// `M428`): `G43` then places the tool tip as `G43.4` does, as LinuxCNC's kinematics
+    /// switched to TCP do.
+    pub tcp_on: bool,
     /// `G90.1`: arc centres `I J K` are absolute coordinates (else offsets from the start).
     pub arc_absolute: bool,
     /// The canned cycles' sticky words and `G98`/`G99`.
@@ -112,6 +136,8 @@ impl Default for Modal {
             tool_length: 0.0,
             blend: true,
             arc_absolute: false,
+            tcp_off: None,
+            tcp_on: false,
             // LinuxCNC's rs274 starts in G99.
             cycle: CycleState {
                 retract_to_r: true,

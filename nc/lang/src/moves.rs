@@ -68,7 +68,7 @@ impl Parser<'_> {
     }
 
     /// `base` plus `H` on a tool-length line and `P` on a `G64` line.
-    fn extra_letters(&self, line: &Line<'_>, base: &str) -> String {
+    pub(super) fn extra_letters(&self, line: &Line<'_>, base: &str) -> String {
         let mut s = base.to_owned();
         if line.code_of_group(7).is_some() {
             s.push('H');
@@ -81,12 +81,15 @@ impl Parser<'_> {
         if matches!(line.code_of_group(1), Some((Code::Dwell, _))) {
             s.push('P');
         }
+        if let Some((Code::Io(io), _)) = line.code_of_group(16) {
+            s.push_str(io.letters());
+        }
         s
     }
 
     /// The feed of a feed move (mm/min): the modal feed, or under `G93` the line's `F` (1/min)
     /// times the move's length (mm, or degrees for a move that only turns the tool).
-    fn move_feed(
+    pub(super) fn move_feed(
         &self,
         line: &Line<'_>,
         motion: Motion,
@@ -135,7 +138,11 @@ impl Parser<'_> {
 
     /// The end point of a move: each given axis resolved (units, G91, work offset), the
     /// others kept.
-    fn end_point(&mut self, line: &Line<'_>, pos: SrcPos) -> Result<[f64; 3], ParseError> {
+    pub(super) fn end_point(
+        &mut self,
+        line: &Line<'_>,
+        pos: SrcPos,
+    ) -> Result<[f64; 3], ParseError> {
         let missing = AXES.into_iter().find(|a| line.get(*a).is_none());
         let here = match (self.here, missing, self.modal.incremental) {
             (Some(h), _, _) => Some(h),
@@ -328,103 +335,8 @@ impl Parser<'_> {
         Ok(())
     }
 
-    /// `G53` (a straight move to machine coordinates) and `G28` (a rapid move through the
-    /// line's intermediate point to the reference position). Both need the workpiece frame
-    /// to be the machine's along the axes they move: see [`Parser::machine_frame`].
-    fn machine_move(&mut self, line: &Line<'_>, code: Code, pos: SrcPos) -> Result<(), ParseError> {
-        line.only(
-            &self.extra_letters(line, "GMFSTXYZ"),
-            Context::Move(self.mode.unwrap_or(Motion::G00)),
-        )?;
-        let home = code == Code::Home;
-        let value = if home { 28.0 } else { 53.0 };
-        let rapid = match (home, self.mode) {
-            (true, _) | (false, Some(Motion::G00)) => true,
-            (false, Some(Motion::G01)) => false,
-            (false, _) => return Err(ParseErrorKind::MachineMoveNotLinear { code: value }.at(pos)),
-        };
-        let given: Vec<usize> = (0..3).filter(|&i| line.get(AXES[i]).is_some()).collect();
-        let target = if home {
-            let reference = self
-                .setup
-                .reference
-                .ok_or(ParseErrorKind::NoReference { code: value }.at(pos))?;
-            let via = self.end_point(line, pos)?;
-            if self.here.is_some_and(|h| distance(h, via) > 0.0) {
-                let o = self.orientation;
-                self.push_linear(line, pos, true, via, o, 0.0);
-            }
-            reference
-        } else {
-            let here = self.here_or_reference(line, pos, 'X')?;
-            let mut m = here;
-            for &i in &given {
-                m[i] = line.value(AXES[i]).unwrap_or(0.0) * self.modal.scale();
-            }
-            m
-        };
-        let here = self.here_or_reference(line, pos, 'X')?;
-        let axes: Vec<usize> = if home && given.is_empty() {
-            vec![0, 1, 2]
-        } else {
-            given
-        };
-        let length = self.modal.tool_length;
-        let mut end = here;
-        if let (Some(kin), Orientation::Angles { r1_deg, r2_deg }) =
-            (&self.setup.kinematics, self.orientation)
-        {
-            // Through the machine's kinematics, the table standing where the angles put it:
-            // a straight move in machine coordinates is one in the workpiece frame too.
-            use nalgebra::Vector3;
-            use nc_geom::kinematics::Kinematics;
-            let (a, c) = (r1_deg.to_radians(), r2_deg.to_radians());
-            let mut m = kin.place(&Vector3::from(here), a, c);
-            for &i in &axes {
-                m[i] = target[i] - if i == 2 { length } else { 0.0 };
-            }
-            let p = kin.unplace(&m, a, c);
-            for (i, e) in end.iter_mut().enumerate() {
-                *e = check_domain(AXES[i], p[i], pos)?;
-            }
-        } else {
-            for &i in &axes {
-                if !self.machine_frame(i) {
-                    let kind = ParseErrorKind::MachineMoveRotated {
-                        code: value,
-                        axis: AXES[i],
-                    };
-                    return Err(kind.at(pos));
-                }
-                let l = if i == 2 { length } else { 0.0 };
-                end[i] = check_domain(AXES[i], target[i] - l, pos)?;
-            }
-        }
-        let feed = if rapid {
-            0.0
-        } else {
-            self.move_feed(line, Motion::G01, pos, distance(here, end))?
-        };
-        let o = self.orientation;
-        self.push_linear(line, pos, rapid, end, o, feed);
-        Ok(())
-    }
-
-    /// Whether machine coordinate `axis` equals the workpiece's here: always before any
-    /// orientation is programmed and with both angles 0; only Z with a vertical tool (the
-    /// table may be turned about Z).
-    fn machine_frame(&self, axis: usize) -> bool {
-        if !self.orientation_given {
-            return true;
-        }
-        match self.orientation {
-            Orientation::Angles { r1_deg, r2_deg } => r1_deg == 0.0 && (r2_deg == 0.0 || axis == 2),
-            Orientation::Vector(v) => axis == 2 && v[0] == 0.0 && v[1] == 0.0,
-        }
-    }
-
     /// The orientation at the end of a linear move (modal values resolved).
-    fn orientation(&mut self, line: &Line<'_>) -> Result<Orientation, ParseError> {
+    pub(super) fn orientation(&mut self, line: &Line<'_>) -> Result<Orientation, ParseError> {
         let angle = line.first_of("ABC");
         let vector = line.first_of("IJK");
         match (angle, vector) {

@@ -112,7 +112,7 @@ impl<'s> Parser<'s> {
             };
             return Err(kind.at(first.pos));
         }
-        let line = Line::classify(words)?;
+        let line = Line::classify(words, &self.setup.user_mcodes)?;
         if self.skipping {
             if line.knots_only || (!line.has_codes && line.first_of("KRUVW").is_some()) {
                 return Ok(());
@@ -151,6 +151,7 @@ impl<'s> Parser<'s> {
         self.modes(&line, motion)?;
         self.feed_word(&line)?;
         self.machine_words(&line)?;
+        let moves = self.blocks.len();
         if self.is_dwell(&line) {
             // The dwell first, then a move on the same line (LinuxCNC's order).
             self.dwell(&line)?;
@@ -159,6 +160,9 @@ impl<'s> Parser<'s> {
             }
         } else {
             self.motion(&line)?;
+        }
+        if self.blocks.len() > moves {
+            self.check_tcp_off(line.motion.map_or(line.first, |m| m.1))?;
         }
         if let Some((Code::Stop(stop), pos)) = line.code_of_group(11) {
             match stop {
@@ -361,7 +365,8 @@ impl<'s> Parser<'s> {
                 _ => {}
             }
         }
-        Ok(())
+        self.io(line)?;
+        self.user_m(line)
     }
 
     /// `G04 P<s>` / `G04 X<s>`; with `G00`/`G01` on the line, `P` only (X is the move's).
@@ -426,8 +431,8 @@ impl<'s> Parser<'s> {
             tool_length: self.modal.tool_length,
             mode: match self.modal.comp {
                 LengthComp::Off => LengthMode::None,
-                LengthComp::Length => LengthMode::Length,
-                LengthComp::Rtcp => LengthMode::Rtcp,
+                LengthComp::Length if !self.modal.tcp_on => LengthMode::Length,
+                LengthComp::Length | LengthComp::Rtcp => LengthMode::Rtcp,
             },
             wait: core::mem::take(&mut self.wait),
         }

@@ -82,6 +82,7 @@ impl State for Parser<'_> {
                 let r = self.setup.reference.unwrap_or([0.0; 3]);
                 r.get(i).copied().unwrap_or(0.0)
             }
+            5399 => return Some(Err(InterpError::InputUnknown)),
             5210 => flag(self.modal.g92 != [0.0; 3]),
             5211..=5219 => {
                 let i = (n - 5211) as usize;

@@ -5,6 +5,7 @@
 mod errors;
 mod fuzz;
 mod interp;
+mod io;
 mod posts;
 mod source;
 mod startup;

@@ -37,12 +37,13 @@ fn letter_without_number() {
 fn number_too_large() {
     let src = format!("G00 X{} Y0 Z0", "9".repeat(400));
     assert_eq!(fails(&src, 1, 6), E::Interp(crate::InterpError::Infinite));
-    // There are no exponents: `1e999` is X1 followed by the unknown word E999.
+    // There are no exponents: `1e999` is X1 followed by the word E999, which only M66..M68
+    // take.
     assert_eq!(
         fails("G00 X1e999 Y0 Z0", 1, 7),
-        E::UnsupportedWord {
+        E::WordNotAllowed {
             letter: 'E',
-            value: 999.0
+            context: crate::Context::Move(crate::Motion::G00)
         }
     );
 }
@@ -74,9 +75,9 @@ fn tape_mark_not_alone() {
 #[test]
 fn unsupported_word() {
     assert_eq!(
-        fails("G00 X0 Y0 Z0 E1000", 1, 14),
+        fails("G00 X0 Y0 Z0 D1000", 1, 14),
         E::UnsupportedWord {
-            letter: 'E',
+            letter: 'D',
             value: 1000.0
         }
     );
