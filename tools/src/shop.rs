@@ -105,6 +105,7 @@ pub fn parse_setup(
         max_rpm: machine.spindle.as_ref().map(|s| s.max_rpm),
         subroutine_dirs: program.subroutine_dirs.clone(),
         max_loop_lines: program.max_loop_lines,
+        max_feed_mm_min: Some(machine.interpolation.max_feed_mm_min),
         io: nc_lang::Io {
             digital_outputs: program.io.digital_outputs,
             digital_inputs: program.io.digital_inputs,

@@ -87,6 +87,12 @@ pub fn describe_action(a: &Action) -> String {
                     };
                     format!("M66 {which}: {how}, at most {timeout_s} s (simulated: the input answers at once)")
                 }
+                ActionKind::FeedClamped {
+                    programmed_mm_min,
+                    used_mm_min,
+                } => format!(
+                    "F{programmed_mm_min} mm/min is above the machine's max_feed_mm_min: feed moves run at {used_mm_min} mm/min"
+                ),
                 ActionKind::UserM { code, action } => match action {
                     UserAction::Ignore => {
                         format!("M{code} ignored, as the machine file's [mcodes] says")

@@ -337,6 +337,12 @@ pub enum ActionKind {
         mode: WaitMode,
         timeout_s: f64,
     },
+    /// A programmed feed above the machine's highest: feed moves run at `used_mm_min` until
+    /// the next `F`.
+    FeedClamped {
+        programmed_mm_min: f64,
+        used_mm_min: f64,
+    },
     /// A machine-defined M-code and what the machine file maps it to.
     UserM {
         code: u32,

@@ -209,7 +209,7 @@ impl Segment {
 /// A geometric rule the parser could not check.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum BuildErrorKind {
-    #[error("the program has no motion block: the first block must be G00/G01 with X Y Z (the start pose)")]
+    #[error("the program has no move: dnurbs plans and runs programs that move the machine, not one of only words without motion")]
     NoStart,
     #[error("the first block must be a G00/G01 start pose, not a NURBS block")]
     NurbsFirst,

@@ -140,7 +140,7 @@ pub enum ParseErrorKind {
     MissingWord { letter: char, context: Context },
 
     // ---- modal state -------------------------------------------------------------------
-    #[error("feed F{value} must be from {MIN_FEED_MM_MIN} to 1000000 mm/min")]
+    #[error("feed F{value} must be at least {MIN_FEED_MM_MIN} mm/min")]
     BadFeed { value: f64 },
     #[error(
         "{motion} needs a feed but none is in effect: program F<mm/min> on this or an earlier line"

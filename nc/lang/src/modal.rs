@@ -45,6 +45,9 @@ pub struct Setup {
     /// Modes in effect before the program's first line (the machine file's
     /// `[program] startup`).
     pub startup: crate::startup::Startup,
+    /// The machine's highest feed, mm/min: a programmed feed above it is run at it, and an
+    /// action says so where the `F` stands. `None`: not checked.
+    pub max_feed_mm_min: Option<f64>,
     /// The inputs and outputs `M62`..`M68` may name (the machine file's `[io]`); none by
     /// default.
     pub io: Io,
@@ -75,6 +78,7 @@ impl Default for Setup {
             subroutine_dirs: Vec::new(),
             max_loop_lines: crate::rules::MAX_LOOP_LINES,
             startup: crate::startup::Startup::default(),
+            max_feed_mm_min: None,
             io: Io::default(),
             user_mcodes: BTreeMap::new(),
         }

@@ -55,6 +55,8 @@ pub(super) struct Parser<'s> {
     /// The start-up modes did not apply (a setup changed after [`crate::Startup::parse`]
     /// checked them): the first line reports it.
     startup_error: Option<ParseError>,
+    /// The last feed reported as above the machine's highest (mm/min).
+    clamped: Option<f64>,
 }
 
 impl<'s> Parser<'s> {
@@ -82,6 +84,7 @@ impl<'s> Parser<'s> {
             skipping: false,
             end: None,
             startup_error: None,
+            clamped: None,
         };
         let startup = setup.startup.words();
         if !startup.is_empty() {
@@ -258,16 +261,24 @@ impl<'s> Parser<'s> {
         let length = match comp {
             LengthComp::Off => 0.0,
             LengthComp::Length | LengthComp::Rtcp => {
-                let tool = match (line.get('H'), self.modal.loaded) {
+                // Without H, the tool in the spindle (LinuxCNC's rule): the one an `M06` on
+                // this line loads (it comes first), else the one loaded; none is tool 0.
+                let changing = matches!(
+                    line.code_of_group(11),
+                    Some((Code::Stop(StopCode::ToolChange), _))
+                );
+                let loaded = if changing {
+                    match line.get('T') {
+                        Some(t) => Some(tool_number(t)?),
+                        None => self.modal.selected,
+                    }
+                } else {
+                    self.modal.loaded
+                };
+                let tool = match (line.get('H'), loaded) {
                     (Some(h), _) => tool_number(h)?,
                     (None, Some(t)) => t,
-                    (None, None) => {
-                        let kind = ParseErrorKind::MissingWord {
-                            letter: 'H',
-                            context: Context::LengthComp,
-                        };
-                        return Err(kind.at(pos));
-                    }
+                    (None, None) => 0,
                 };
                 match (tool, self.setup.tools.get(&tool)) {
                     (0, _) => 0.0,
@@ -321,7 +332,19 @@ impl<'s> Parser<'s> {
             return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
         }
         if !self.modal.inverse_time {
-            self.feed = Some(f.value * self.modal.scale());
+            let feed = f.value * self.modal.scale();
+            self.feed = Some(feed);
+            if let Some(max) = self.setup.max_feed_mm_min.filter(|&m| feed > m) {
+                // Said once for each feed above the maximum (a post repeats its F).
+                if self.clamped != Some(feed) {
+                    self.clamped = Some(feed);
+                    let kind = ActionKind::FeedClamped {
+                        programmed_mm_min: feed,
+                        used_mm_min: max,
+                    };
+                    self.act(f.pos, kind);
+                }
+            }
         }
         Ok(())
     }

@@ -25,12 +25,15 @@ pub(crate) fn as_uint(v: f64) -> Option<u32> {
 /// Largest magnitude a word's number may have. Coordinates up to 100 m and angles up to
 /// 10^6 degrees cover every machine; beyond them the arithmetic of the planner loses the
 /// micrometre (and far beyond, overflows), so such a number is refused where it is written.
+/// A feed up to 10^9 is taken and run at the machine's highest feed (said where it is
+/// written, as LinuxCNC clamps it to the machine's speed).
 /// The other words have checks of their own: I J K are normalised as a direction (or are
 /// knots, checked by the curve), N is a `u32`, G M P are codes.
 pub const fn word_limit(letter: char) -> f64 {
     match letter {
         'X' | 'Y' | 'Z' | 'U' | 'V' | 'W' => 1e5,
-        'A' | 'B' | 'C' | 'F' | 'R' => 1e6,
+        'A' | 'B' | 'C' | 'R' => 1e6,
+        'F' => 1e9,
         _ => f64::MAX,
     }
 }

@@ -1,7 +1,7 @@
 //! Conformance with LinuxCNC's RS274/NGC interpreter.
 //!
-//! Every program under `tests/conformance/programs/` is read by dnurbs (no offsets, the
-//! reference position at 0 0 0 as LinuxCNC starts there) and its motion compared with the
+//! Every program under `tests/conformance/programs/` is read by dnurbs (G54..G59 at 0 and the
+//! reference position at 0 0 0 as LinuxCNC starts there, rs274's default tool table) and its motion compared with the
 //! reference motion LinuxCNC's interpreter produced for it (`tests/conformance/expected/`,
 //! written by `tests/conformance/regen.py`, which also checks it against `rs274 -g`):
 //!
@@ -119,8 +119,10 @@ fn read(src: &str) -> Read {
         .into_iter()
         .map(|(t, z)| (t, z * 25.4))
         .collect();
+    // G54..G59 at the machine zero, as in rs274's empty parameter file.
     let setup = Setup {
         reference: Some([0.0; 3]),
+        work_offsets: [Some([0.0; 3]); 6],
         tools,
         ..Setup::default()
     };

@@ -394,3 +394,23 @@ fn g92_refuses_what_it_cannot_honour_with_the_column() {
     );
     assert_eq!(col, 7);
 }
+
+#[test]
+fn g43_without_h_takes_the_tool_in_the_spindle() {
+    // `T1 M6 G43` (LinuxCNC's mmount.ngc): M06 comes first, so G43 takes T1's length; a
+    // later G43 alone the tool loaded; none loaded is tool 0, no length.
+    let mut setup = Setup {
+        reference: Some([0.0, 0.0, 100.0]),
+        ..Setup::default()
+    };
+    setup.tools.insert(1, 30.0);
+    setup.tools.insert(2, 45.0);
+    let src = "G43\nG0 X0 Y0 Z0\nT1 M6 G43\nG0 Z1\nT2\nG49\nG43\nG0 Z2\nM2";
+    let p = parse_with(src, &setup).unwrap();
+    let lengths: Vec<f64> = p
+        .blocks
+        .iter()
+        .map(|b| linear(b).tooling.tool_length)
+        .collect();
+    assert_eq!(lengths, [0.0, 30.0, 30.0]);
+}

@@ -32,11 +32,38 @@ fn numbers_outside_the_documented_domain_are_refused_where_written() {
         E::OutsideDomain { letter: 'A', .. }
     ));
     assert!(matches!(
-        fails("G01 X0 Y0 Z0 F1000001", 1, 14),
+        fails("G01 X0 Y0 Z0 F1000000001", 1, 14),
         E::OutsideDomain { letter: 'F', .. }
     ));
     // The bounds themselves are accepted.
-    crate::parse("G01 X100000 Y-100000 Z0 F1000000\n").unwrap();
+    crate::parse("G01 X100000 Y-100000 Z0 F1000000000\n").unwrap();
+}
+
+#[test]
+fn a_feed_above_the_machines_highest_is_said_where_it_stands_once_per_value() {
+    use nc_geom::program::ActionKind;
+    let setup = crate::Setup {
+        max_feed_mm_min: Some(10_000.0),
+        ..crate::Setup::default()
+    };
+    let src = "G01 X0 Y0 Z0 F20000\nX1 F20000\nX2 F9000\nG20 X0.1 F500\nX0.2 F393\nM2";
+    let p = crate::parse_with(src, &setup).unwrap();
+    let said: Vec<(f64, u32, u32)> = p
+        .actions
+        .iter()
+        .filter_map(|a| match a.kind {
+            ActionKind::FeedClamped {
+                programmed_mm_min,
+                used_mm_min,
+            } => {
+                assert_eq!(used_mm_min, 10_000.0);
+                Some((programmed_mm_min, a.pos.line, a.pos.col))
+            }
+            _ => None,
+        })
+        .collect();
+    // F500 inch/min is 12 700 mm/min; F393 (9 982 mm/min) is below.
+    assert_eq!(said, [(20_000.0, 1, 14), (12_700.0, 4, 10)]);
 }
 
 #[test]
