@@ -155,14 +155,20 @@ impl<'s> Parser<'s> {
         self.feed_word(&line)?;
         self.machine_words(&line)?;
         let moves = self.blocks.len();
-        if self.is_dwell(&line) {
+        let moved = if self.is_dwell(&line) {
             // The dwell first, then a move on the same line (LinuxCNC's order).
             self.dwell(&line)?;
             if line.motion.is_some() {
-                self.motion(&line)?;
+                self.motion(&line)
+            } else {
+                Ok(())
             }
         } else {
-            self.motion(&line)?;
+            self.motion(&line)
+        };
+        if let Err(e) = moved {
+            self.assume_end(&line);
+            return Err(e);
         }
         if self.blocks.len() > moves {
             self.check_tcp_off(line.motion.map_or(line.first, |m| m.1))?;
@@ -179,6 +185,23 @@ impl<'s> Parser<'s> {
         }
         self.end = line.end;
         Ok(())
+    }
+
+    /// After a refused move: the position the line programs, as if it had moved there, so
+    /// the lines after it are checked from where the program means them to start (not from
+    /// the stale position before it, which would invent errors the program does not have).
+    fn assume_end(&mut self, line: &Line<'_>) {
+        if self.here.is_none() || self.open.is_some() || line.first_of("XYZ").is_none() {
+            return;
+        }
+        if matches!(line.code_of_group(1), Some((Code::Home | Code::MachineCoords | Code::CoordOffset(_), _)))
+            || matches!(self.mode, Some(crate::vocab::Motion::Cycle(_)))
+        {
+            return;
+        }
+        if let Ok(end) = self.end_point(line, line.first) {
+            self.here = Some(end);
+        }
     }
 
     fn is_dwell(&self, line: &Line<'_>) -> bool {

@@ -189,3 +189,17 @@ fn one_angle_after_a_vector() {
         E::PartialAngles { given: 'A' }
     );
 }
+
+#[test]
+fn after_a_refused_move_the_next_lines_start_where_it_would_have_ended() {
+    // The first arc's end is not on its circle; the second arc, from X10, is right. Checked
+    // from the stale X0 it was refused too, with radii the program does not have.
+    let src = "G0 X0 Y0 Z0\nF100\nG2 X10 Y0 I3 J0\nG2 X20 Y0 I5 J0\nG1 X[30] Y1\nG91 G1 X-1\nM2";
+    let e = crate::parse_with(src, &crate::Setup::default()).unwrap_err();
+    assert_eq!(e.errors.len(), 1, "{:?}", e.errors);
+    assert_eq!(e.errors[0].pos.line, 3);
+    // An incremental move after a refused one adds to the refused line's end too.
+    let src = "G0 X0 Y0 Z0\nG91 F100\nG2 X10 Y0 I3 J0\nG2 X10 Y0 I5 J0\nM2";
+    let e = crate::parse_with(src, &crate::Setup::default()).unwrap_err();
+    assert_eq!(e.errors.len(), 1, "{:?}", e.errors);
+}
