@@ -194,8 +194,10 @@ impl<'s> Parser<'s> {
         if self.here.is_none() || self.open.is_some() || line.first_of("XYZ").is_none() {
             return;
         }
-        if matches!(line.code_of_group(1), Some((Code::Home | Code::MachineCoords | Code::CoordOffset(_), _)))
-            || matches!(self.mode, Some(crate::vocab::Motion::Cycle(_)))
+        if matches!(
+            line.code_of_group(1),
+            Some((Code::Home | Code::MachineCoords | Code::CoordOffset(_), _))
+        ) || matches!(self.mode, Some(crate::vocab::Motion::Cycle(_)))
         {
             return;
         }

@@ -3,7 +3,9 @@
 //! clustered and repeated knots (at the ends too), cusps, sharp turns at high feed, tool axes within 1e-6 of
 //! the vertical, I J K and A C blocks mixed, 180-degree tool turns, moves to and beyond the
 //! travel, coordinates up to 1e300, arcs `G02`/`G03` in all three planes by centre or `R`,
-//! helical, full circles, radii from 1 um to 500 mm). Each program is either refused with a positioned error
+//! helical, full circles, radii from 1 um to 500 mm; moves written through parameters and
+//! expressions, `repeat` loops of incremental moves, canned cycles `G73 G81 G82 G83 G85 G86
+//! G89`). Each program is either refused with a positioned error
 //! (parse, build or plan), or its setpoints, produced by the same interpolator as the
 //! real-time thread's, hold every limit. The check below is written from the setpoints alone
 //! (finite differences at the period, the curve sampled between setpoints), independently
@@ -95,6 +97,24 @@ enum Move {
     },
     /// A coordinate far outside every travel (up to 1e300).
     Huge { exp: i32 },
+    /// A straight move to `to` written through numbered and named parameters and
+    /// expressions, as parametric programs are.
+    Param { to: [f64; 3], feed: f64 },
+    /// `count` rounds of the incremental move `step` in a `repeat` loop.
+    Loop {
+        step: [f64; 3],
+        count: u32,
+        feed: f64,
+    },
+    /// A canned cycle (`G73 G81 G82 G83 G85 G86 G89`, `G99`) at `at`, from `r` down by
+    /// `depth`, then `G80`.
+    Drill {
+        cycle: u8,
+        at: [f64; 2],
+        r: f64,
+        depth: f64,
+        feed: f64,
+    },
 }
 
 fn tool_strategy() -> impl Strategy<Value = Tool> {
@@ -123,7 +143,7 @@ fn move_strategy() -> impl Strategy<Value = Move> {
         2 => 3000.0..20000.0f64,
     ];
     let line = (
-        point,
+        point.clone(),
         tool_strategy(),
         feed.clone(),
         prop::bool::weighted(0.15),
@@ -209,11 +229,38 @@ fn move_strategy() -> impl Strategy<Value = Move> {
                 feed,
             },
         );
+    let param = (point.clone(), feed.clone()).prop_map(|(to, feed)| Move::Param { to, feed });
+    let step = prop_oneof![
+        3 => [-5.0..5.0f64, -5.0..5.0f64, -2.0..2.0f64],
+        1 => [-50.0..50.0f64, -50.0..50.0f64, -20.0..20.0f64],
+    ];
+    let looped = (step, 1u32..40, feed.clone()).prop_map(|(step, count, feed)| Move::Loop {
+        step,
+        count,
+        feed,
+    });
+    let drill = (
+        prop::sample::select(vec![73u8, 81, 82, 83, 85, 86, 89]),
+        [-60.0..60.0f64, -60.0..60.0f64],
+        -20.0..40.0f64,
+        prop_oneof![4 => 0.1..20.0f64, 1 => 20.0..200.0f64],
+        feed.clone(),
+    )
+        .prop_map(|(cycle, at, r, depth, feed)| Move::Drill {
+            cycle,
+            at,
+            r,
+            depth,
+            feed,
+        });
     prop_oneof![
         10 => line,
         9 => nurbs,
         5 => arc,
         1 => (3i32..300).prop_map(|exp| Move::Huge { exp }),
+        2 => param,
+        2 => looped,
+        2 => drill,
     ]
 }
 
@@ -273,6 +320,62 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
             }
             Move::Huge { exp } => {
                 let _ = writeln!(s, "N{n} G01 X1{}", "0".repeat(*exp as usize));
+            }
+            Move::Param { to, feed } => {
+                let _ = writeln!(s, "#101={} #<_y{n}>={}", num(to[0] / 2.0), num(to[1] + 1.0));
+                let _ = writeln!(
+                    s,
+                    "N{n} G01 X[#101 * 2] Y[#<_y{n}> - 1] Z[ABS[{}] * {}] F{}",
+                    num(to[2]),
+                    if to[2] < 0.0 { -1 } else { 1 },
+                    num(*feed)
+                );
+                let read = |v: &str| v.parse::<f64>().unwrap_or(0.0);
+                here = [
+                    read(&num(to[0] / 2.0)) * 2.0,
+                    read(&num(to[1] + 1.0)) - 1.0,
+                    read(&num(to[2])),
+                ];
+            }
+            Move::Loop { step, count, feed } => {
+                let _ = writeln!(s, "N{n} G91\no{n} repeat [{count}]");
+                let _ = writeln!(
+                    s,
+                    "G01 X{} Y{} Z{} F{}\no{n} endrepeat\nG90",
+                    num(step[0]),
+                    num(step[1]),
+                    num(step[2]),
+                    num(*feed)
+                );
+                for (h, d) in here.iter_mut().zip(step) {
+                    *h += f64::from(*count) * num(*d).parse::<f64>().unwrap_or(0.0);
+                }
+            }
+            Move::Drill {
+                cycle,
+                at,
+                r,
+                depth,
+                feed,
+            } => {
+                let bottom = r - depth;
+                let mut words = format!(
+                    "N{n} G99 G{cycle} X{} Y{} Z{} R{} F{}",
+                    num(at[0]),
+                    num(at[1]),
+                    num(bottom),
+                    num(*r),
+                    num(*feed)
+                );
+                if matches!(cycle, 82 | 86 | 89) {
+                    words.push_str(" P0.2");
+                }
+                if matches!(cycle, 73 | 83) {
+                    let _ = write!(words, " Q{}", num(depth / 3.0));
+                }
+                let _ = writeln!(s, "{words}\nG80");
+                let read = |v: &str| v.parse::<f64>().unwrap_or(0.0);
+                here = [read(&num(at[0])), read(&num(at[1])), read(&num(*r))];
             }
             Move::Arc {
                 plane,
@@ -425,6 +528,8 @@ struct Counts {
     arcs: AtomicU64,
     /// Accepted programs with an arc that turns the tool (`A C` words).
     turning_arcs: AtomicU64,
+    /// Accepted programs with parameters, a loop or a canned cycle.
+    interpreted: AtomicU64,
     refused: AtomicU64,
     /// Programs the pre-pass refused for a programmed point outside the travel.
     prepass_travel: AtomicU64,
@@ -600,6 +705,9 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     if src.lines().any(turning) {
         counts.turning_arcs.fetch_add(1, Ordering::Relaxed);
     }
+    if src.contains('#') || src.contains("repeat") || src.contains(" G99 ") {
+        counts.interpreted.fetch_add(1, Ordering::Relaxed);
+    }
     let mut ip = Interpolator::new(
         &path,
         &profile,
@@ -713,13 +821,14 @@ fn run_half(half: u64, cases: u32) {
         counts.long.load(Ordering::Relaxed),
     );
     let pre = counts.prepass_travel.load(Ordering::Relaxed);
+    let interpreted = counts.interpreted.load(Ordering::Relaxed);
     let on_stream = counts.on_stream.load(Ordering::Relaxed);
     let held: Vec<u64> = counts
         .held
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
     if let Err(e) = result {
         panic!("{e}");
     }
