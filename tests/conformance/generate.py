@@ -400,9 +400,43 @@ def offsets_program(r, k):
     return lines
 
 
+def context_program(r, k):
+    """M70/M71/M72 and M73 in subroutines: units, distance mode, plane and feed changed,
+    then moves that read the restored state."""
+    lines = ["(modal state saved and restored %d)" % k]
+    modes = ["G20", "G21", "G90", "G91", "G17", "G18", "G19", "F%d" % r.randint(20, 400)]
+    body = ["G20" if r.random() < 0.5 else "G21", "G91" if r.random() < 0.5 else "G90",
+            r.choice(["G17", "G18", "G19"]), "F%d" % r.randint(20, 400)]
+    lines += ["o<ctx%d> sub" % k, "M73"] + body + [
+        "G1 X%s Y%s" % (num(r, -2, 2), num(r, -2, 2)),
+        "G2 X[#<_x> + 1] Y[#<_y> + 1] R1" if r.random() < 0.3 else "G1 Z%s" % num(r, -1, 1),
+        "o<ctx%d> endsub" % k]
+    lines += ["G21 G90 G17", "G0 X0 Y0 Z0", "F%d" % r.randint(50, 500)]
+    saved = False
+    for _ in range(r.randint(5, 12)):
+        c = r.random()
+        if c < 0.15:
+            lines.append("M70")
+            saved = True
+        elif c < 0.25 and saved:
+            lines.append("M72")
+            saved = False
+        elif c < 0.3:
+            lines.append("M71")
+            saved = False
+        elif c < 0.45:
+            lines.append("o<ctx%d> call" % k)
+        elif c < 0.65:
+            lines.append(r.choice(modes))
+        else:
+            lines.append("G1 X%s Y%s Z%s" % (num(r, -30, 30), num(r, -30, 30), num(r, -5, 5)))
+    lines.append("M2")
+    return lines
+
+
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
             ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
-            ("offsets", offsets_program, 20)]
+            ("offsets", offsets_program, 20), ("context", context_program, 15)]
 
 
 def main():

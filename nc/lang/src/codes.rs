@@ -71,6 +71,19 @@ impl IoCode {
     }
 }
 
+/// `M70`..`M73`: the modal state saved and restored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContextCode {
+    /// `M70`: save.
+    Save,
+    /// `M71`: forget what `M70` saved.
+    Invalidate,
+    /// `M72`: restore what `M70` saved.
+    Restore,
+    /// `M73`: save, and restore when the subroutine returns.
+    AutoRestore,
+}
+
 /// Program stops and ends.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StopCode {
@@ -123,10 +136,12 @@ pub enum Code {
     Io(IoCode),
     /// A machine-defined M-code (the machine file's `[mcodes]`).
     User(u32),
+    /// `M70`..`M73`.
+    Context(ContextCode),
 }
 
 /// Modal groups, as indices of [`super::line::Line`]'s code table.
-pub const GROUPS: usize = 18;
+pub const GROUPS: usize = 19;
 
 impl Code {
     pub fn group(self) -> usize {
@@ -149,6 +164,7 @@ impl Code {
             Code::Retract(_) => 15,
             Code::Io(_) => 16,
             Code::User(_) => 17,
+            Code::Context(_) => 18,
         }
     }
 }
@@ -220,7 +236,7 @@ pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
 }
 
 pub fn m_code(value: f64) -> Result<Code, ParseErrorKind> {
-    const M_CODES: [(f64, Code); 18] = [
+    const M_CODES: [(f64, Code); 22] = [
         (0.0, Code::Stop(StopCode::Stop)),
         (1.0, Code::Stop(StopCode::Optional)),
         (2.0, Code::Stop(StopCode::End)),
@@ -239,6 +255,10 @@ pub fn m_code(value: f64) -> Result<Code, ParseErrorKind> {
         (66.0, Code::Io(IoCode::Wait)),
         (67.0, Code::Io(IoCode::Analog { synced: true })),
         (68.0, Code::Io(IoCode::Analog { synced: false })),
+        (70.0, Code::Context(ContextCode::Save)),
+        (71.0, Code::Context(ContextCode::Invalidate)),
+        (72.0, Code::Context(ContextCode::Restore)),
+        (73.0, Code::Context(ContextCode::AutoRestore)),
     ];
     M_CODES
         .iter()

@@ -195,6 +195,8 @@ pub enum ParseErrorKind {
     },
     #[error("{} needs {letter}", Code('M', *.code))]
     IoWordMissing { code: f64, letter: char },
+    #[error("M72: no modal state is saved (M70 saves it; M71 or a restore forgets it)")]
+    NothingSaved,
     #[error(
         "M66 L{value}: the wait mode is 0 (read at once), 1 (rise), 2 (fall), 3 (high) or 4 (low)"
     )]

@@ -41,6 +41,9 @@ pub(crate) trait State {
     fn predefined(&self, name: &str) -> Option<Result<f64, InterpError>>;
     /// `M02`/`M30` has been executed.
     fn ended(&self) -> bool;
+    /// The call level changed (a call, a return): the program is at `level` now, before
+    /// the next line is evaluated.
+    fn level(&mut self, _level: usize) {}
 }
 
 /// Where a frame's lines come from.
@@ -234,7 +237,11 @@ impl<S: LineSource> Interp<S> {
     /// the program's end, or when the source has no line yet. After an error in the flow
     /// (an O-line), interpretation stops: the lines after it would run in a flow the program
     /// did not mean.
-    pub fn next(&mut self, state: &impl State, words: &mut Vec<Word>) -> Result<bool, ParseError> {
+    pub fn next(
+        &mut self,
+        state: &mut impl State,
+        words: &mut Vec<Word>,
+    ) -> Result<bool, ParseError> {
         words.clear();
         loop {
             if self.finished || state.ended() {
@@ -253,7 +260,12 @@ impl<S: LineSource> Interp<S> {
                 self.finished = true;
                 return Err(e);
             }
-            match self.step(&line, index, state, words) {
+            let levels = self.frames.len();
+            let stepped = self.step(&line, index, &*state, words);
+            if self.frames.len() != levels {
+                state.level(self.level());
+            }
+            match stepped {
                 Ok(true) => return Ok(true),
                 Ok(false) => {}
                 Err(e) => {

@@ -91,6 +91,7 @@
 
 mod arc;
 pub(crate) mod codes;
+mod context;
 mod coord_offset;
 mod cycles;
 mod error;

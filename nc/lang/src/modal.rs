@@ -105,6 +105,9 @@ pub(super) struct Modal {
     pub tool_length: f64,
     /// `G64` (true) or `G61`; dnurbs follows the programmed path exactly in both.
     pub blend: bool,
+    /// Mist and flood coolant on (`M07`, `M08` until `M09`).
+    pub mist: bool,
+    pub flood: bool,
     /// Tool-centre-point control switched off by a machine-defined M-code (`tcp-off`): the
     /// code, while moves must keep the rotary axes at 0.
     pub tcp_off: Option<u32>,
@@ -140,6 +143,8 @@ impl Default for Modal {
             tool_length: 0.0,
             blend: true,
             arc_absolute: false,
+            mist: false,
+            flood: false,
             tcp_off: None,
             tcp_on: false,
             // LinuxCNC's rs274 starts in G99.

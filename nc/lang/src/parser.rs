@@ -57,6 +57,9 @@ pub(super) struct Parser<'s> {
     startup_error: Option<ParseError>,
     /// The last feed reported as above the machine's highest (mm/min).
     clamped: Option<f64>,
+    /// The call level the interpreter is at, and the states `M70` and `M73` saved.
+    pub level: usize,
+    pub saved: crate::context::SavedStates,
 }
 
 impl<'s> Parser<'s> {
@@ -85,6 +88,8 @@ impl<'s> Parser<'s> {
             end: None,
             startup_error: None,
             clamped: None,
+            level: 0,
+            saved: crate::context::SavedStates::default(),
         };
         let startup = setup.startup.words();
         if !startup.is_empty() {
@@ -409,10 +414,19 @@ impl<'s> Parser<'s> {
                     let rpm = self.modal.rpm;
                     self.act(pos, ActionKind::Spindle { dir, rpm });
                 }
-                Code::Coolant(c) => self.act(pos, ActionKind::Coolant(c)),
+                Code::Coolant(c) => {
+                    use nc_geom::program::Coolant;
+                    match c {
+                        Coolant::Mist => self.modal.mist = true,
+                        Coolant::Flood => self.modal.flood = true,
+                        Coolant::Off => (self.modal.mist, self.modal.flood) = (false, false),
+                    }
+                    self.act(pos, ActionKind::Coolant(c));
+                }
                 _ => {}
             }
         }
+        self.context(line)?;
         self.io(line)?;
         self.user_m(line)
     }

@@ -151,4 +151,8 @@ impl State for Parser<'_> {
     fn ended(&self) -> bool {
         self.end().is_some()
     }
+
+    fn level(&mut self, level: usize) {
+        self.at_level(level);
+    }
 }

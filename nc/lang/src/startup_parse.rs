@@ -20,10 +20,10 @@ impl Startup {
             });
         }
         let plain = Setup::default();
-        let parser = Parser::new(&plain);
+        let mut parser = Parser::new(&plain);
         let mut interp = Interp::new(StrLines::new(text), &plain);
         let mut words = Vec::new();
-        let read = interp.next(&parser, &mut words).map_err(from_parse)?;
+        let read = interp.next(&mut parser, &mut words).map_err(from_parse)?;
         if !read {
             words.clear();
         }

@@ -117,7 +117,7 @@ impl<S: LineSource> Entries<'_, S> {
         if self.finished {
             return None;
         }
-        let result = match self.interp.next(&self.parser, &mut self.words) {
+        let result = match self.interp.next(&mut self.parser, &mut self.words) {
             Ok(true) => self.parser.line(&self.words),
             Ok(false) => return None,
             Err(e) => Err(e),

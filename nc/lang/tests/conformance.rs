@@ -389,10 +389,13 @@ fn compare(
     };
     // A reference from rs274's printout has no line numbers (0): where dnurbs stops, its
     // moves must then be the first of LinuxCNC's.
+    // Where LinuxCNC stops too, its moves are those before its error already (in the order
+    // they ran: a subroutine's lines may come before the line that called it).
     let lines_known = want.moves.iter().all(|(line, _)| *line > 0);
+    let cut = if refusal.is_some() { stop_line } else { None };
     let theirs: Vec<_> = theirs
         .into_iter()
-        .filter(|(line, _, _)| stop_line.is_none_or(|s| !lines_known || *line < s))
+        .filter(|(line, _, _)| cut.is_none_or(|s| !lines_known || *line < s))
         .collect();
     if stop_line.is_some() && !lines_known && ours.len() > theirs.len() {
         return Err(format!(

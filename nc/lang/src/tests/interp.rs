@@ -414,3 +414,30 @@ fn g43_without_h_takes_the_tool_in_the_spindle() {
         .collect();
     assert_eq!(lengths, [0.0, 30.0, 30.0]);
 }
+
+#[test]
+fn m72_restores_the_spindle_and_coolant_with_actions_and_needs_an_m70() {
+    use nc_geom::program::{ActionKind as A, Coolant, Spindle};
+    let src = "G0 X0 Y0 Z0\nS1000 M3 M8\nM70\nM5 M9\nG20 F10\nM72\nG1 X1 F100\nM2";
+    let p = parse(src).unwrap();
+    let after: Vec<A> = p
+        .actions
+        .iter()
+        .filter(|a| a.pos.line == 6)
+        .map(|a| a.kind)
+        .collect();
+    assert_eq!(
+        after,
+        [
+            A::Spindle {
+                dir: Spindle::Cw,
+                rpm: 1000.0
+            },
+            A::Coolant(Coolant::Flood)
+        ]
+    );
+    // Back in mm: X1 is 1 mm.
+    assert_eq!(xs(&p), [0.0, 1.0]);
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\nM70\nM71\nM72\nM2");
+    assert_eq!((kind, line, col), (E::NothingSaved, 4, 1));
+}
