@@ -9,35 +9,8 @@ use super::codes::{Code, ContextCode};
 use super::error::{ParseError, ParseErrorKind};
 use super::line::Line;
 use super::parser::Parser;
-use crate::vocab::Plane;
+use crate::saved::Saved;
 use nc_geom::program::{ActionKind, Coolant, Spindle, SrcPos};
-
-/// One saved modal state.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Saved {
-    plane: Plane,
-    inch: bool,
-    incremental: bool,
-    inverse_time: bool,
-    arc_absolute: bool,
-    blend: bool,
-    retract_to_r: bool,
-    work: u8,
-    feed: Option<f64>,
-    spindle: Spindle,
-    rpm: f64,
-    mist: bool,
-    flood: bool,
-    /// Where it was saved (the restore's actions stand there when a return restores).
-    pos: SrcPos,
-}
-
-/// What `M70` saved, and what each `M73` saved with the call level it was at.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct SavedStates {
-    m70: Option<Saved>,
-    m73: Vec<(usize, Saved)>,
-}
 
 impl Parser<'_> {
     fn snapshot(&self, pos: SrcPos) -> Saved {
