@@ -434,9 +434,38 @@ def context_program(r, k):
     return lines
 
 
+def polar_program(r, k):
+    """Polar coordinates (@ radius, ^ angle) in G90 and G91, on moves and in canned cycles
+    with L repeats, in mm and inch."""
+    inch = r.random() < 0.3
+    lines = ["(polar coordinates %d)" % k, "G20" if inch else "G21", "G90 G17 G99",
+             "G0 X%s Y%s Z2" % (num(r, 1, 5), num(r, 1, 5)), "F%d" % r.randint(20, 400)]
+    inc = False
+    for _ in range(r.randint(5, 12)):
+        c = r.random()
+        if c < 0.15:
+            inc = not inc
+            lines.append("G91" if inc else "G90")
+        elif c < 0.3:
+            words = r.choice(["@%s" % num(r, -3, 3), "^%s" % num(r, -90, 90),
+                              "@%s ^%s" % (num(r, -3, 3), num(r, -90, 90))])
+            lines.append("G81 %s R%s Z%s%s" % (words, "0.5" if inc else "1", "-1" if inc else "-0.5",
+                                              " L%d" % r.randint(2, 5) if inc else ""))
+            lines.append("G80")
+        else:
+            words = r.choice(["@%s" % num(r, 0.5, 20), "^%s" % num(r, -180, 180),
+                              "@%s ^%s" % (num(r, 0.5, 20), num(r, -180, 180))])
+            if inc:
+                words = r.choice(["@%s" % num(r, -1, 1), "^%s" % num(r, -45, 45)])
+            lines.append("%s %s" % (r.choice(["G0", "G1"]), words))
+    lines.append("M2")
+    return lines
+
+
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
             ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
-            ("offsets", offsets_program, 20), ("context", context_program, 15)]
+            ("offsets", offsets_program, 20), ("context", context_program, 15),
+            ("polar", polar_program, 10)]
 
 
 def main():

@@ -23,7 +23,7 @@ const PECK_CLEARANCE_IN: f64 = 0.010;
 
 /// Letters a cycle line may carry (besides `G M F S T N`): the plane's two axes and the
 /// cycle axis, `R L P Q`.
-const CYCLE_LETTERS: &str = "GMFSTXYZRLPQ";
+const CYCLE_LETTERS: &str = "GMFSTXYZRLPQ@^";
 
 impl Parser<'_> {
     /// A line of canned cycle `cycle` (its code, or the modal cycle with a hole position).
@@ -93,11 +93,21 @@ impl Parser<'_> {
         let mut level = initial;
         let (mut pa, mut pb) = (here[a], here[b]);
         let (mut da, mut db) = (0.0, 0.0);
+        // Polar words (G17 only, checked with the motion): in G91 a radius and an angle
+        // added each repeat, in G90 the hole's radius and angle (LinuxCNC's rules).
+        let (polar_r, polar_t) = (line.value('@'), line.value('^').map(f64::to_radians));
+        let (mut dr, mut dt) = (0.0, 0.0);
         let (r, bottom) = if self.modal.incremental {
             da = line.value(letter(a)).unwrap_or(0.0);
             db = line.value(letter(b)).unwrap_or(0.0);
+            (dr, dt) = (polar_r.unwrap_or(0.0), polar_t.unwrap_or(0.0));
             let r = r_word + initial;
             (r, r + depth_word)
+        } else if polar_r.is_some() || polar_t.is_some() {
+            let radius = polar_r.unwrap_or_else(|| pb.hypot(pa));
+            let theta = polar_t.unwrap_or_else(|| pb.atan2(pa));
+            (pa, pb) = (radius * theta.cos(), radius * theta.sin());
+            (r_word, depth_word)
         } else {
             pa = line.value(letter(a)).unwrap_or(pa);
             pb = line.value(letter(b)).unwrap_or(pb);
@@ -135,6 +145,16 @@ impl Parser<'_> {
         for k in 0..repeats {
             pa += da;
             pb += db;
+            for (step, turn) in [(dr, 0.0), (0.0, dt)] {
+                if step == 0.0 && turn == 0.0 {
+                    continue;
+                }
+                if pa == 0.0 && pb == 0.0 {
+                    return Err(ParseErrorKind::PolarAtOrigin { incremental: true }.at(pos));
+                }
+                let (radius, theta) = (pb.hypot(pa) + step, pb.atan2(pa) + turn);
+                (pa, pb) = (radius * theta.cos(), radius * theta.sin());
+            }
             if k == 0 && current > r {
                 self.cycle_move(line, pos, true, point(pa, pb, current), feed)?;
                 self.cycle_move(line, pos, true, point(pa, pb, r), feed)?;

@@ -207,6 +207,12 @@ pub enum ParseErrorKind {
     AnalogWait { mode: u8 },
     #[error("M{code} switched tool-centre-point control off ([mcodes] of the machine file): the machine's axes are then the program's, which they are only with the rotary axes at 0 (here {r1}, {r2} deg)")]
     TcpOffTurned { code: u32, r1: f64, r2: f64 },
+    #[error("{letter} with polar coordinates (@ ^) on one line: give X Y or @ ^")]
+    PolarWithXy { letter: char },
+    #[error("{letter}: polar coordinates are for the XY plane (G17), as in LinuxCNC")]
+    PolarPlane { letter: char },
+    #[error("{}", if *.incremental { "G91 motion with polar coordinates is indeterminate at the program's zero: give the angle and radius in G90" } else { "@ without ^ at the program's zero: give the angle" })]
+    PolarAtOrigin { incremental: bool },
     #[error("G92 {axis}: dnurbs offsets X Y Z only (a rotary axis offset would turn the part to another angle than the program's)")]
     OffsetRotary { axis: char },
     #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]

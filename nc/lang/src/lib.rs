@@ -110,6 +110,7 @@ mod name;
 mod nurbs;
 mod params;
 mod parser;
+mod polar;
 mod predefined;
 mod rules;
 mod saved;

@@ -11,10 +11,10 @@ use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].
-pub(super) const KNOWN: &str = "ABCEFGHIJKLMNOPQRSTUVWXYZ";
+pub(super) const KNOWN: &str = "ABCEFGHIJKLMNOPQRSTUVWXYZ@^";
 
 /// Words that make a line move the machine (in the modal motion mode if no G word is given).
-pub(super) const MOVE_WORDS: &str = "XYZABCIJKR";
+pub(super) const MOVE_WORDS: &str = "XYZABCIJKR@^";
 
 /// A classified, non-empty logical line.
 pub(super) struct Line<'w> {
@@ -35,7 +35,7 @@ pub(super) struct Line<'w> {
     /// The decoded codes by modal group, with their position.
     codes: [Option<(Code, SrcPos)>; GROUPS],
     /// The non-code words, indexed by letter (unused when `knots_only`).
-    slots: [Option<Word>; 26],
+    slots: [Option<Word>; 28],
 }
 
 impl<'w> Line<'w> {
@@ -59,7 +59,7 @@ impl<'w> Line<'w> {
             has_codes: false,
             knots_only: !body.is_empty() && body.iter().all(|w| w.letter == 'K'),
             codes: [None; GROUPS],
-            slots: [None; 26],
+            slots: [None; 28],
         };
         let mut values: [f64; GROUPS] = [0.0; GROUPS];
         for w in body {
@@ -197,5 +197,9 @@ fn sequence_number(w: &Word) -> Result<u32, ParseError> {
 
 /// Slot of an upper-case ASCII letter; anything else maps out of range (and is never stored).
 fn letter_index(letter: char) -> usize {
-    u8::try_from(letter).map_or(usize::MAX, |b| usize::from(b.wrapping_sub(b'A')))
+    match letter {
+        '@' => 26,
+        '^' => 27,
+        _ => u8::try_from(letter).map_or(usize::MAX, |b| usize::from(b.wrapping_sub(b'A'))),
+    }
 }

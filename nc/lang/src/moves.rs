@@ -22,6 +22,9 @@ const AXES: [char; 3] = ['X', 'Y', 'Z'];
 impl Parser<'_> {
     /// The motion of a line that is not a dwell.
     pub(super) fn motion(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
+        if let (Some(w), false) = (line.first_of("@^"), self.modal.plane == Plane::Xy) {
+            return Err(ParseErrorKind::PolarPlane { letter: w.letter }.at(w.pos));
+        }
         if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
             return self.coord_offset(line, kind, pos);
         }
@@ -165,16 +168,19 @@ impl Parser<'_> {
                 }
             };
         }
+        if let Some(w) = line.first_of("@^") {
+            self.polar(line, w.pos, &mut end)?;
+        }
         Ok(end)
     }
 
     /// A G00/G01 line, or a line continuing that modal motion; `pos` is the block's position.
     fn linear(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
         line.only(
-            &self.extra_letters(line, "GMFSTXYZABCIJK"),
+            &self.extra_letters(line, "GMFSTXYZABCIJK@^"),
             Context::Move(motion),
         )?;
-        if line.first_of("XYZABCIJK").is_none() {
+        if line.first_of("XYZABCIJK@^").is_none() {
             return Ok(()); // `G01 F500`: sets the mode, moves nothing
         }
         let rapid = motion == Motion::G00;
@@ -228,7 +234,7 @@ impl Parser<'_> {
     /// A `G02`/`G03` line (or its modal continuation): a rational quadratic NURBS block.
     fn arc(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
         line.only(
-            &self.extra_letters(line, "GMFSTXYZIJKRABC"),
+            &self.extra_letters(line, "GMFSTXYZIJKRABC@^"),
             Context::Move(motion),
         )?;
         if line.first_of("XYZIJKRABC").is_none() {

@@ -196,7 +196,7 @@ fn items(c: &mut Cursor) -> Result<Vec<Item>, ParseError> {
                 };
                 return Err(ParseErrorKind::MisplacedSequenceNumber { value }.at(pos));
             }
-            l if l.is_ascii_alphabetic() => {
+            l if l.is_ascii_alphabetic() || l == '@' || l == '^' => {
                 c.i += 1;
                 if c.at_end() {
                     return Err(ParseErrorKind::MissingNumber {

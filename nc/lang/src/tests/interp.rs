@@ -441,3 +441,38 @@ fn m72_restores_the_spindle_and_coolant_with_actions_and_needs_an_m70() {
     let (kind, line, col) = fails("G0 X0 Y0 Z0\nM70\nM71\nM72\nM2");
     assert_eq!((kind, line, col), (E::NothingSaved, 4, 1));
 }
+
+#[test]
+fn polar_coordinates_as_linuxcnc_reads_them_and_their_refusals() {
+    // G90: radius and angle about the program's zero; a word left out keeps the current
+    // point's. G91: added to the current point's radius and angle.
+    let src = "G0 X0 Y0 Z0\nG0 @10 ^90\nG0 ^0\nG0 @5\nG91 G0 ^90\nG0 @1\nM2";
+    let p = parse(src).unwrap();
+    let ends: Vec<[f64; 2]> = p
+        .blocks
+        .iter()
+        .map(|b| {
+            let e = linear(b).end;
+            [(e[0] * 1e9).round() / 1e9, (e[1] * 1e9).round() / 1e9]
+        })
+        .collect();
+    assert_eq!(
+        ends,
+        [
+            [0.0, 0.0],
+            [0.0, 10.0],
+            [10.0, 0.0],
+            [5.0, 0.0],
+            [0.0, 5.0],
+            [0.0, 6.0]
+        ]
+    );
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\nG0 X1 @2\nM2");
+    assert_eq!((kind, line, col), (E::PolarWithXy { letter: 'X' }, 2, 4));
+    let (kind, line, col) = fails("G0 X0 Y0 Z0\nG18 G0 @2\nM2");
+    assert_eq!((kind, line, col), (E::PolarPlane { letter: '@' }, 2, 8));
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG0 @2\nM2");
+    assert_eq!((kind, line), (E::PolarAtOrigin { incremental: false }, 2));
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG91 G0 ^30\nM2");
+    assert_eq!((kind, line), (E::PolarAtOrigin { incremental: true }, 2));
+}
