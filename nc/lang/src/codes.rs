@@ -16,6 +16,10 @@ pub enum LengthComp {
     Length,
     /// `G43.4 H`: tool length and tool-centre-point control (RTCP).
     Rtcp,
+    /// `G43.1 Z`: the tool length given on the line (LinuxCNC's dynamic offset).
+    Dynamic,
+    /// `G43.2 H` or `G43.2 Z`: a tool's length or the value added to the one in effect.
+    Added,
     /// `G49`.
     Off,
 }
@@ -171,7 +175,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 45] = [
+const G_CODES: [(f64, Code); 47] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -187,6 +191,8 @@ const G_CODES: [(f64, Code); 45] = [
     (28.0, Code::Home),
     (40.0, Code::CompensationOff),
     (43.0, Code::LengthComp(LengthComp::Length)),
+    (43.1, Code::LengthComp(LengthComp::Dynamic)),
+    (43.2, Code::LengthComp(LengthComp::Added)),
     (43.4, Code::LengthComp(LengthComp::Rtcp)),
     (49.0, Code::LengthComp(LengthComp::Off)),
     (53.0, Code::MachineCoords),

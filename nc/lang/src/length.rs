@@ -3,7 +3,7 @@
 //! LinuxCNC (the next move takes the tip to the programmed point).
 
 use super::codes::{Code, LengthComp, StopCode};
-use super::error::{ParseError, ParseErrorKind};
+use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::Line;
 use super::parser::{tool_number, Parser};
 use crate::vocab::Motion;
@@ -19,8 +19,38 @@ impl Parser<'_> {
         pos: SrcPos,
         motion: Option<Motion>,
     ) -> Result<(), ParseError> {
+        let scale = self.modal.scale();
         let length = match comp {
             LengthComp::Off => 0.0,
+            LengthComp::Dynamic => {
+                let z = line.get('Z').ok_or(
+                    ParseErrorKind::MissingWord {
+                        letter: 'Z',
+                        context: Context::LengthComp,
+                    }
+                    .at(pos),
+                )?;
+                z.value * scale
+            }
+            LengthComp::Added => match (line.get('H'), line.get('Z')) {
+                (Some(h), _) => {
+                    let tool = tool_number(h)?;
+                    let add = match (tool, self.setup.tools.get(&tool)) {
+                        (0, _) => 0.0,
+                        (_, Some(l)) => *l,
+                        (_, None) => return Err(ParseErrorKind::UnknownTool { tool }.at(pos)),
+                    };
+                    self.modal.tool_length + add
+                }
+                (None, Some(z)) => self.modal.tool_length + z.value * scale,
+                (None, None) => {
+                    let kind = ParseErrorKind::MissingWord {
+                        letter: 'H',
+                        context: Context::LengthComp,
+                    };
+                    return Err(kind.at(pos));
+                }
+            },
             LengthComp::Length | LengthComp::Rtcp => {
                 // Without H, the tool in the spindle (LinuxCNC's rule): the one an `M06` on
                 // this line loads (it comes first), else the one loaded; none is tool 0.
@@ -48,7 +78,14 @@ impl Parser<'_> {
                 }
             }
         };
-        self.modal.comp = comp;
+        self.modal.comp = match comp {
+            // Offsets on top of the mode in effect (G43.4 stays G43.4).
+            LengthComp::Dynamic | LengthComp::Added if self.modal.comp == LengthComp::Rtcp => {
+                LengthComp::Rtcp
+            }
+            LengthComp::Dynamic | LengthComp::Added => LengthComp::Length,
+            c => c,
+        };
         let from = self.modal.tool_length;
         if length == from {
             return Ok(());

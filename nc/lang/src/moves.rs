@@ -7,7 +7,7 @@
 //! in [`MoveTooling`](nc_geom::program::MoveTooling) and is added by the machine's Z axis).
 
 use super::arc::{self, Centre};
-use super::codes::Code;
+use super::codes::{Code, LengthComp};
 use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
 use super::nurbs::distance;
@@ -27,6 +27,18 @@ impl Parser<'_> {
         }
         if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
             return self.coord_offset(line, kind, pos);
+        }
+        if let Some((Code::LengthComp(c @ (LengthComp::Dynamic | LengthComp::Added)), _)) =
+            line.code_of_group(7)
+        {
+            // The Z word is the offset's, not a move's.
+            if let (Some((motion, at)), Some(_)) = (line.motion, line.get('Z')) {
+                let code = if c == LengthComp::Dynamic { 43.1 } else { 43.2 };
+                return Err(ParseErrorKind::AxisWordsTwice { code, motion }.at(at));
+            }
+            if line.get('Z').is_some() {
+                return line.only(&self.extra_letters(line, "GMFSTZ"), Context::LengthComp);
+            }
         }
         if let Some((code @ (Code::Home | Code::MachineCoords), pos)) = line.code_of_group(1) {
             if let Some((m, _)) = line.motion {

@@ -419,8 +419,12 @@ impl<'s> Parser<'s> {
             tool_length: self.modal.tool_length,
             mode: match self.modal.comp {
                 LengthComp::Off => LengthMode::None,
-                LengthComp::Length if !self.modal.tcp_on => LengthMode::Length,
-                LengthComp::Length | LengthComp::Rtcp => LengthMode::Rtcp,
+                LengthComp::Length | LengthComp::Dynamic | LengthComp::Added
+                    if !self.modal.tcp_on =>
+                {
+                    LengthMode::Length
+                }
+                _ => LengthMode::Rtcp,
             },
             wait: core::mem::take(&mut self.wait),
         }

@@ -476,3 +476,31 @@ fn polar_coordinates_as_linuxcnc_reads_them_and_their_refusals() {
     let (kind, line, _) = fails("G0 X0 Y0 Z0\nG91 G0 ^30\nM2");
     assert_eq!((kind, line), (E::PolarAtOrigin { incremental: true }, 2));
 }
+
+#[test]
+fn g43_1_and_g43_2_set_and_add_tool_lengths() {
+    let mut setup = Setup {
+        reference: Some([0.0, 0.0, 100.0]),
+        ..Setup::default()
+    };
+    setup.tools.insert(1, 30.0);
+    let src = "G0 X0 Y0 Z0\nG43.1 Z10\nG0 Z1\nG43.2 Z5\nG0 Z2\nG43.2 H1\nG0 Z3\nG20 G43.1 Z1\nG0 Z0.2\nG49\nG0 Z4\nM2";
+    let p = parse_with(src, &setup).unwrap();
+    let lengths: Vec<f64> = p
+        .blocks
+        .iter()
+        .map(|b| linear(b).tooling.tool_length)
+        .collect();
+    assert_eq!(lengths, [0.0, 10.0, 15.0, 45.0, 25.4, 0.0]);
+    // The Z word is the offset: no move on its line, and not with a motion code.
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG43.1 X1 Z1\nM2");
+    assert!(
+        matches!(kind, E::WordNotAllowed { letter: 'X', .. }),
+        "{kind}"
+    );
+    assert_eq!(line, 2);
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG1 G43.1 Z1 F100\nM2");
+    assert!(matches!(kind, E::AxisWordsTwice { .. }), "{kind}");
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG43.1\nM2");
+    assert!(matches!(kind, E::MissingWord { letter: 'Z', .. }), "{kind}");
+}
