@@ -6,6 +6,7 @@
 //! for a loop running beside threads that may allocate freely).
 //!
 //! [`generated`]: case counts and seeds of the generated-input suites, from the environment.
+//! [`nurbs`]: a NURBS curve's points, of any length.
 //!
 //! ```ignore
 //! #[global_allocator]
@@ -13,6 +14,7 @@
 //! ```
 
 pub mod generated;
+pub mod nurbs;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;

@@ -13,7 +13,7 @@ interpreter twice:
 
 Usage (Debian package linuxcnc-uspace, system Python):
     /usr/bin/python3 tests/conformance/regen.py            # all programs
-    /usr/bin/python3 tests/conformance/regen.py FILE.ngc   # some
+    /usr/bin/python3 tests/conformance/regen.py FILE.ngc   # some (also tests/corpus/programs/*)
 
 Reference format, one motion per line, lengths in mm (the module reports inches), angles in
 degrees; positions are where the tool goes: the interpreter's program coordinates plus the
@@ -165,7 +165,7 @@ def rs274_error(path, stderr, motion):
 def rs274_run(path):
     """What `rs274 -g` prints: each move (canon name, mm per program unit, plane, numbers),
     its motion in this script's records (to its 4 decimals, in mm), and its error."""
-    run = subprocess.run(["rs274", "-g", path], capture_output=True, text=True,
+    run = subprocess.run(["rs274", "-g"] + TOOLS + [path], capture_output=True, text=True,
                          cwd=os.path.dirname(path))
     scale = 1.0
     plane = "XY"
@@ -236,7 +236,53 @@ def rs274_check(path, motion):
     return motion, error
 
 
+# Machine-defined M-codes of LinuxCNC's trunnion demos, which only switch its kinematics
+# (M428 tool-centre-point, M429 trivial): the stand-alone interpreter has no such codes, and
+# they move nothing, so they are blanked (in a copy, lines kept) for it.
+SWITCHKINS = re.compile(r"\bM\s*4\s*2\s*[89]\b", re.IGNORECASE)
+
+
+# rs274's tool table: its default (T1 T2 T3 T99999) for the conformance suite; the shipped
+# machines' table for the real programs of tests/corpus/, which run on those machines.
+# rs274's machine is an inch machine, whose tool table is in inches: the table's millimetres
+# are converted for it (a G28 under G43 then ends where dnurbs's does).
+TOOLS = []
+MILL_TBL = os.path.join(HERE, "..", "..", "config", "machines", "mill.tbl")
+
+
+def inch_table(tmp):
+    out = os.path.join(tmp, "mill-inch.tbl")
+    with open(MILL_TBL) as f, open(out, "w") as g:
+        for line in f:
+            body, _, comment = line.partition(";")
+            words = [w if w[:1].upper() not in "XYZD" else
+                     "%s%.6f" % (w[0], float(w[1:]) / MM) for w in body.split()]
+            g.write(" ".join(words) + (" ;" + comment if comment else "\n"))
+    return out
+
+
 def write(path, out_path):
+    if os.sep + "corpus" + os.sep not in path:
+        TOOLS[:] = []
+        return write_program(path, out_path)
+    with tempfile.TemporaryDirectory() as tmp:
+        TOOLS[:] = ["-t", inch_table(tmp)]
+        return write_program(path, out_path)
+
+
+def write_program(path, out_path):
+    with open(path, errors="replace") as f:
+        text = f.read()
+    if SWITCHKINS.search(text):
+        with tempfile.TemporaryDirectory() as tmp:
+            copy = os.path.join(tmp, os.path.basename(path))
+            with open(copy, "w") as f:
+                f.write(SWITCHKINS.sub(lambda m: " " * len(m.group(0)), text))
+            return write_from(copy, path, out_path)
+    return write_from(path, path, out_path)
+
+
+def write_from(path, named, out_path):
     full = reference(path)
     motion, error = rs274_check(path, full) if full is not None else (None, None)
     precision = "full"
@@ -252,7 +298,7 @@ def write(path, out_path):
     os.makedirs(os.path.dirname(out_path), exist_ok=True)
     with open(out_path, "w") as f:
         f.write("# LinuxCNC's interpreter on %s (tests/conformance/regen.py); mm, degrees\n"
-                % os.path.relpath(path, HERE))
+                % os.path.relpath(named, HERE))
         f.write("P %s\n" % precision)
         for move in motion:
             # Program coordinates plus the program's zero (the G5x and G92 offsets).
@@ -281,9 +327,17 @@ def main():
         for root, _, files in os.walk(PROGRAMS):
             paths += [os.path.join(root, f) for f in sorted(files) if f.endswith(".ngc")]
     for p in sorted(os.path.abspath(p) for p in paths):
-        rel = os.path.relpath(p, PROGRAMS)
-        write(p, os.path.join(EXPECTED, rel[:-4] + ".txt"))
-    print(f"{len(paths)} references written under {os.path.relpath(EXPECTED)}")
+        # The reference goes to the `expected` folder beside the `programs` folder the
+        # program is under (tests/conformance/ or tests/corpus/), at the same relative path.
+        root = p
+        while os.path.basename(root) != "programs" and os.path.dirname(root) != root:
+            root = os.path.dirname(root)
+        if os.path.basename(root) != "programs":
+            root = PROGRAMS
+        rel = os.path.relpath(p, root)
+        out = os.path.join(os.path.dirname(root), "expected", os.path.splitext(rel)[0] + ".txt")
+        write(p, out)
+    print(f"{len(paths)} references written (each beside its programs folder, in expected/)")
 
 
 if __name__ == "__main__":

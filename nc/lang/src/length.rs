@@ -100,6 +100,9 @@ impl Parser<'_> {
         }
         if let Some(here) = &mut self.here {
             let t = match self.orientation {
+                // LinuxCNC's tool-centre-point kinematics (a machine's `tcp-on` code) keep
+                // the tool length an offset of the program's Z, as its interpreter does.
+                _ if self.modal.tcp_on => [0.0, 0.0, 1.0],
                 Orientation::Vector(v) => v,
                 Orientation::Angles { r1_deg, r2_deg } if r1_deg == 0.0 && r2_deg == 0.0 => {
                     [0.0, 0.0, 1.0]

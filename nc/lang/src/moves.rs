@@ -269,9 +269,14 @@ impl Parser<'_> {
                 Centre::Radius(r.value * self.modal.scale())
             }
             None => {
-                if let Some(w) = line.first_of("IJK").filter(|w| {
-                    w.letter != Plane::offset_letter(a) && w.letter != Plane::offset_letter(b)
-                }) {
+                // Every offset word outside the plane, even after one in it (`I0 J3 K0` in
+                // G17 is refused, as LinuxCNC refuses it).
+                let outside = ['I', 'J', 'K']
+                    .into_iter()
+                    .filter(|&l| l != Plane::offset_letter(a) && l != Plane::offset_letter(b))
+                    .filter_map(|l| line.get(l))
+                    .min_by_key(|w| (w.pos.line, w.pos.col));
+                if let Some(w) = outside {
                     let kind = ParseErrorKind::ArcOffsetOutOfPlane {
                         letter: w.letter,
                         plane,

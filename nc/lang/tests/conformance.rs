@@ -24,6 +24,7 @@ use nc_geom::program::{Block, Orientation};
 use nc_lang::{Entries, Entry, ParseError, Setup, StrLines};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use test_support::nurbs::point as nurbs_point;
 
 /// How far an end point may be from LinuxCNC's (mm).
 const END_TOL_MM: f64 = 1e-6;
@@ -185,42 +186,6 @@ fn axes(plane: &str) -> [usize; 3] {
         "YZ" => [1, 2, 0],
         _ => [2, 0, 1],
     }
-}
-
-/// A point of a NURBS curve of any length (de Boor on homogeneous points).
-fn nurbs_point(
-    degree: usize,
-    ctrl: &[[f64; 3]],
-    weights: &[f64],
-    knots: &[f64],
-    u: f64,
-) -> [f64; 3] {
-    let n = ctrl.len();
-    // The knot span: knots[k] <= u < knots[k + 1], the last span for u at the end.
-    let k = (degree..n).rev().find(|&k| knots[k] <= u).unwrap_or(degree);
-    let mut d: Vec<[f64; 4]> = (0..=degree)
-        .map(|j| {
-            let (p, w) = (ctrl[k - degree + j], weights[k - degree + j]);
-            [p[0] * w, p[1] * w, p[2] * w, w]
-        })
-        .collect();
-    for r in 1..=degree {
-        for j in (r..=degree).rev() {
-            let i = k - degree + j;
-            let den = knots[i + degree + 1 - r] - knots[i];
-            let a = if den == 0.0 {
-                0.0
-            } else {
-                (u - knots[i]) / den
-            };
-            let prev = d[j - 1];
-            for (v, p) in d[j].iter_mut().zip(prev) {
-                *v = (1.0 - a) * p + a * *v;
-            }
-        }
-    }
-    let h = d[degree];
-    [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
 }
 
 /// The largest deviations seen against full-precision references: of an end point, of an

@@ -225,6 +225,13 @@ fn planes_g18_and_g19_take_their_own_offsets() {
         matches!(e.kind, E::ArcOffsetOutOfPlane { letter: 'K', .. }),
         "{e}"
     );
+    // After an offset in the plane too, and K0 as well (FreeCAD's grbl post writes it;
+    // LinuxCNC refuses it).
+    let e = parse("G00 X0 Y10 Z0\nG17 G02 X10 Y0 I0 J-10 K0 F500").unwrap_err();
+    assert!(
+        matches!(e.kind, E::ArcOffsetOutOfPlane { letter: 'K', .. }) && e.pos.col == 24,
+        "{e}"
+    );
 }
 
 #[test]
