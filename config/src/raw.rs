@@ -119,6 +119,8 @@ pub(crate) struct RawWorkOffsets {
 pub(crate) struct RawReference {
     /// Machine coordinates X Y Z, mm.
     pub position: [f64; 3],
+    /// The `G30` position, machine coordinates X Y Z, mm.
+    pub g30: Option<[f64; 3]>,
 }
 
 /// `[control]`: the operator's control socket of `dnurbs run`.

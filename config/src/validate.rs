@@ -81,9 +81,15 @@ pub(crate) fn machine(
             *slot = Some(check.point(&["work_offsets", name], v)?);
         }
     }
-    let reference = match raw.reference {
-        Some(r) => Some(check.point(&["reference", "position"], r.position)?),
-        None => None,
+    let (reference, g30) = match raw.reference {
+        Some(r) => (
+            Some(check.point(&["reference", "position"], r.position)?),
+            match r.g30 {
+                Some(p) => Some(check.point(&["reference", "g30"], p)?),
+                None => None,
+            },
+        ),
+        None => (None, None),
     };
     let mut program =
         program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
@@ -95,6 +101,7 @@ pub(crate) fn machine(
         coolant,
         work_offsets,
         reference,
+        g30,
         name,
         period_s,
         kinematics,

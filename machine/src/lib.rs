@@ -41,6 +41,8 @@ pub struct Machine {
     pub work_offsets: [Option<[f64; 3]>; 6],
     /// `[reference] position`: the G28 position in machine coordinates (mm).
     pub reference: Option<[f64; 3]>,
+    /// `[reference] g30`: the G30 position in machine coordinates (mm).
+    pub g30: Option<[f64; 3]>,
     /// `[spindle]`: the spindle drive, if the machine has one on its bus.
     pub spindle: Option<crate::spindle::Spindle>,
     /// `[coolant]`: the coolant valves' I/O module, if the machine has one on its bus.

@@ -98,6 +98,7 @@ pub fn parse_setup(
     let mut setup = nc_lang::Setup {
         work_offsets: std::array::from_fn(|k| shop.work_offsets[k].or(machine.work_offsets[k])),
         reference: machine.reference,
+        g30: machine.g30,
         tools,
         block_delete: shop.block_delete,
         optional_stop: shop.optional_stop,

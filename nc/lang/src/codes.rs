@@ -109,6 +109,8 @@ pub enum Code {
     Dwell,
     /// `G28` return to the reference position (non-modal).
     Home,
+    /// `G30` to the second reference position (non-modal).
+    Home30,
     /// `G53` move in machine coordinates (non-modal).
     MachineCoords,
     /// `G92`, `G92.1`, `G92.2`, `G92.3` (non-modal).
@@ -151,7 +153,11 @@ impl Code {
     pub fn group(self) -> usize {
         match self {
             Code::Motion(_) => 0,
-            Code::Dwell | Code::Home | Code::MachineCoords | Code::CoordOffset(_) => 1,
+            Code::Dwell
+            | Code::Home
+            | Code::Home30
+            | Code::MachineCoords
+            | Code::CoordOffset(_) => 1,
             Code::Plane(_) => 2,
             Code::Inch(_) => 3,
             Code::Incremental(_) => 4,
@@ -175,7 +181,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 47] = [
+const G_CODES: [(f64, Code); 48] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -189,6 +195,7 @@ const G_CODES: [(f64, Code); 47] = [
     (20.0, Code::Inch(true)),
     (21.0, Code::Inch(false)),
     (28.0, Code::Home),
+    (30.0, Code::Home30),
     (40.0, Code::CompensationOff),
     (43.0, Code::LengthComp(LengthComp::Length)),
     (43.1, Code::LengthComp(LengthComp::Dynamic)),

@@ -217,7 +217,7 @@ pub enum ParseErrorKind {
     OffsetRotary { axis: char },
     #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]
     OffsetWithoutAxes,
-    #[error("{} needs the machine's reference position: define [reference] in the machine file", Code('G', *.code))]
+    #[error("{} needs the machine's {}: define it under [reference] in the machine file", Code('G', *.code), if *.code == 30.0 { "second reference position (g30)" } else { "reference position" })]
     NoReference { code: f64 },
     #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]
     MachineMoveRotated { code: f64, axis: char },

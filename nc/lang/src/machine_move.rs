@@ -22,14 +22,18 @@ impl Parser<'_> {
         code: Code,
         pos: SrcPos,
     ) -> Result<(), ParseError> {
-        let home = code == Code::Home;
+        let home = matches!(code, Code::Home | Code::Home30);
         // G53 turns the rotary axes too (their machine coordinates are the program's angles).
         let letters = if home { "GMFSTXYZ" } else { "GMFSTXYZABC" };
         line.only(
             &self.extra_letters(line, letters),
             Context::Move(self.mode.unwrap_or(Motion::G00)),
         )?;
-        let value = if home { 28.0 } else { 53.0 };
+        let value = match code {
+            Code::Home => 28.0,
+            Code::Home30 => 30.0,
+            _ => 53.0,
+        };
         let rapid = match (home, self.mode) {
             (true, _) | (false, Some(Motion::G00)) => true,
             (false, Some(Motion::G01)) => false,
@@ -37,10 +41,12 @@ impl Parser<'_> {
         };
         let given: Vec<usize> = (0..3).filter(|&i| line.get(AXES[i]).is_some()).collect();
         let target = if home {
-            let reference = self
-                .setup
-                .reference
-                .ok_or(ParseErrorKind::NoReference { code: value }.at(pos))?;
+            let position = if code == Code::Home30 {
+                self.setup.g30
+            } else {
+                self.setup.reference
+            };
+            let reference = position.ok_or(ParseErrorKind::NoReference { code: value }.at(pos))?;
             let via = self.end_point(line, pos)?;
             if self.here.is_some_and(|h| distance(h, via) > 0.0) {
                 let o = self.orientation;

@@ -21,6 +21,8 @@ pub struct Setup {
     /// The `G28` reference position in machine coordinates (mm). A program whose first move
     /// does not give all of X Y Z starts here.
     pub reference: Option<[f64; 3]>,
+    /// The `G30` position in machine coordinates (mm; the machine file's `[reference] g30`).
+    pub g30: Option<[f64; 3]>,
     /// Tool number -> length (mm, along the spindle).
     pub tools: BTreeMap<u32, f64>,
     /// Skip lines that start with `/` (block delete). Off: the `/` is ignored.
@@ -70,6 +72,7 @@ impl Default for Setup {
         Setup {
             work_offsets: [None; 6],
             reference: None,
+            g30: None,
             tools: BTreeMap::new(),
             block_delete: false,
             optional_stop: false,

@@ -40,7 +40,9 @@ impl Parser<'_> {
                 return line.only(&self.extra_letters(line, "GMFSTZ"), Context::LengthComp);
             }
         }
-        if let Some((code @ (Code::Home | Code::MachineCoords), pos)) = line.code_of_group(1) {
+        if let Some((code @ (Code::Home | Code::Home30 | Code::MachineCoords), pos)) =
+            line.code_of_group(1)
+        {
             if let Some((m, _)) = line.motion {
                 self.mode = Some(m);
             }

@@ -201,7 +201,10 @@ impl<'s> Parser<'s> {
         }
         if matches!(
             line.code_of_group(1),
-            Some((Code::Home | Code::MachineCoords | Code::CoordOffset(_), _))
+            Some((
+                Code::Home | Code::Home30 | Code::MachineCoords | Code::CoordOffset(_),
+                _
+            ))
         ) || matches!(self.mode, Some(crate::vocab::Motion::Cycle(_)))
         {
             return;

@@ -82,6 +82,11 @@ impl State for Parser<'_> {
                 let r = self.setup.reference.unwrap_or([0.0; 3]);
                 r.get(i).copied().unwrap_or(0.0)
             }
+            5181..=5189 => {
+                let i = (n - 5181) as usize;
+                let r = self.setup.g30.unwrap_or([0.0; 3]);
+                r.get(i).copied().unwrap_or(0.0)
+            }
             5399 => return Some(Err(InterpError::InputUnknown)),
             5210 => flag(self.modal.g92 != [0.0; 3]),
             5211..=5219 => {

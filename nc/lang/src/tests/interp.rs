@@ -504,3 +504,27 @@ fn g43_1_and_g43_2_set_and_add_tool_lengths() {
     let (kind, _, _) = fails("G0 X0 Y0 Z0\nG43.1\nM2");
     assert!(matches!(kind, E::MissingWord { letter: 'Z', .. }), "{kind}");
 }
+
+#[test]
+fn g30_goes_to_the_second_reference_position() {
+    let setup = Setup {
+        reference: Some([0.0, 0.0, 100.0]),
+        g30: Some([10.0, 20.0, 90.0]),
+        ..Setup::default()
+    };
+    let p = parse_with("G0 X1 Y2 Z3\nG30 Z[#5183]\nG30\nM2", &setup).unwrap();
+    let ends: Vec<[f64; 3]> = p.blocks.iter().map(|b| linear(b).end).collect();
+    // Through Z 90 (the line's point) to the G30 position along Z (there already: a move of
+    // nothing), then along every axis.
+    assert_eq!(
+        ends,
+        [
+            [1.0, 2.0, 3.0],
+            [1.0, 2.0, 90.0],
+            [1.0, 2.0, 90.0],
+            [10.0, 20.0, 90.0]
+        ]
+    );
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG30\nM2");
+    assert_eq!((kind, line), (E::NoReference { code: 30.0 }, 2));
+}
