@@ -477,7 +477,15 @@ struct Counts {
     compressed_s: f64,
     slower: u64,
     slowest: f64,
+    /// Accepted programs whose plan is longer than [`MAX_TEST_PERIODS`]: planned and checked
+    /// by the planner, not interpolated here.
+    long: u64,
 }
+
+/// Above this many periods an accepted plan is not interpolated here (a post's inverse-time
+/// move that only turns the tool, `F` 2 000 000 from its own rounding, may leave C to swing
+/// near the vertical at the crawl its limits allow: 68 110 s of plan once).
+const MAX_TEST_PERIODS: f64 = 1_900_000.0;
 
 fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
     let (cfg, bl, kin) = machine();
@@ -553,6 +561,10 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
             );
         }
     }
+    if profile.duration / PERIOD > MAX_TEST_PERIODS {
+        counts.long += 1;
+        return Ok(());
+    }
     let sps = setpoints(&path, &profile, &cfg, kin);
     prop_assert!(sps.last().is_some_and(|s| s.0.done), "no end\n{src}");
     limits_hold(&cfg, &path, &sps, src)?;
@@ -594,7 +606,7 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
          refused with a position {} ({} of them accepted as posted); {} of {} moves fitted into {} G06.5 blocks; \
          {} compressed programs measured against their posts; accepted both ways: {:.3} s \
          posted, {:.3} s compressed, {} of them more than 1 % slower compressed (the most \
-         {:.2}x)",
+         {:.2}x); too long to interpolate here {}",
         c.accepted,
         c.refused,
         c.regressed,
@@ -605,8 +617,11 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
         c.posted_s,
         c.compressed_s,
         c.slower,
-        c.slowest
+        c.slowest,
+        c.long
     );
+    // Rare, or the suite checks the plans and not the setpoints.
+    assert!(c.long * 20 <= c.accepted.max(1), "{} of {} too long", c.long, c.accepted);
     if let Err(e) = result {
         panic!("{e}");
     }

@@ -207,6 +207,12 @@ pub enum ParseErrorKind {
     AnalogWait { mode: u8 },
     #[error("M{code} switched tool-centre-point control off ([mcodes] of the machine file): the machine's axes are then the program's, which they are only with the rotary axes at 0 (here {r1}, {r2} deg)")]
     TcpOffTurned { code: u32, r1: f64, r2: f64 },
+    #[error("{motion}: LinuxCNC's splines are in the XY plane (G17)")]
+    SplinePlane { motion: Motion },
+    #[error("{motion} under G93 (inverse time): give the feed in G94")]
+    SplineInverseTime { motion: Motion },
+    #[error("G05 without I J needs a G05 just before it (whose P Q it continues)")]
+    SplineWithoutIj,
     #[error("{letter} with polar coordinates (@ ^) on one line: give X Y or @ ^")]
     PolarWithXy { letter: char },
     #[error("{letter}: polar coordinates are for the XY plane (G17), as in LinuxCNC")]

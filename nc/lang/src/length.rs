@@ -90,7 +90,15 @@ impl Parser<'_> {
         if length == from {
             return Ok(());
         }
-        if let Some(m @ (Motion::G02 | Motion::G03 | Motion::G062 | Motion::G065)) = motion {
+        if let Some(
+            m @ (Motion::G02
+            | Motion::G03
+            | Motion::G062
+            | Motion::G065
+            | Motion::G05
+            | Motion::G051),
+        ) = motion
+        {
             let kind = ParseErrorKind::LengthChangeOnCurve {
                 motion: m,
                 from,

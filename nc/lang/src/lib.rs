@@ -115,6 +115,7 @@ mod predefined;
 mod rules;
 mod saved;
 mod source;
+mod splines;
 mod startup;
 mod startup_parse;
 mod stream;

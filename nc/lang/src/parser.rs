@@ -57,6 +57,9 @@ pub(super) struct Parser<'s> {
     startup_error: Option<ParseError>,
     /// The last feed reported as above the machine's highest (mm/min).
     clamped: Option<f64>,
+    /// The `P Q` of the last `G5` when the previous move was one (its `I J` may then be
+    /// left out), mm.
+    pub last_spline_pq: Option<(f64, f64)>,
     /// The call level the interpreter is at, and the states `M70` and `M73` saved.
     pub level: usize,
     pub saved: crate::saved::SavedStates,
@@ -88,6 +91,7 @@ impl<'s> Parser<'s> {
             end: None,
             startup_error: None,
             clamped: None,
+            last_spline_pq: None,
             level: 0,
             saved: crate::saved::SavedStates::default(),
         };
@@ -497,6 +501,8 @@ fn motion_value(m: Motion) -> f64 {
         Motion::G02 => 2.0,
         Motion::G03 => 3.0,
         Motion::G062 => 6.2,
+        Motion::G05 => 5.0,
+        Motion::G051 => 5.1,
         Motion::G065 => 6.5,
         Motion::Cycle(c) => c.code(),
     }

@@ -62,6 +62,8 @@ impl Parser<'_> {
             Some(Motion::G02) => 20.0,
             Some(Motion::G03) => 30.0,
             Some(Motion::G062 | Motion::G065) => 10.0,
+            Some(Motion::G05) => 50.0,
+            Some(Motion::G051) => 51.0,
             Some(Motion::Cycle(c)) => 10.0 * c.code(),
         }
     }

@@ -58,6 +58,10 @@ pub enum Motion {
     G03,
     G062,
     G065,
+    /// `G5`: a cubic spline in XY.
+    G05,
+    /// `G5.1`: a quadratic spline in XY.
+    G051,
     /// A canned cycle (expanded into straight moves).
     Cycle(Cycle),
 }
@@ -121,6 +125,8 @@ impl fmt::Display for Motion {
             Motion::G03 => "G03",
             Motion::G062 => "G06.2",
             Motion::G065 => "G06.5",
+            Motion::G05 => "G05",
+            Motion::G051 => "G05.1",
             Motion::Cycle(c) => return write!(f, "{c}"),
         })
     }

@@ -528,3 +528,67 @@ fn g30_goes_to_the_second_reference_position() {
     let (kind, line, _) = fails("G0 X0 Y0 Z0\nG30\nM2");
     assert_eq!((kind, line), (E::NoReference { code: 30.0 }, 2));
 }
+
+#[test]
+fn g5_and_g5_1_are_the_bezier_curves_linuxcnc_defines() {
+    use nc_geom::nurbs::DoubleNurbs;
+    let src = "G0 X0 Y0 Z1\nG1 F100\nG5.1 X10 Y0 I5 J5\nG5 I2 J3 P-2 Q3 X20 Y0\nG5 P-1 Q1 X25 Y5\nG91 G5.1 X1 Y1 I1 J0\nM2";
+    let p = parse(src).unwrap();
+    let bezier = |pts: &[[f64; 2]], t: f64| -> [f64; 2] {
+        let mut q = pts.to_vec();
+        for k in (1..q.len()).rev() {
+            for i in 0..k {
+                q[i] = [
+                    q[i][0] + t * (q[i + 1][0] - q[i][0]),
+                    q[i][1] + t * (q[i + 1][1] - q[i][1]),
+                ];
+            }
+        }
+        q[0]
+    };
+    // Quadratic: start, start + I J, end. Cubic: start, start + I J, end + P Q, end; the
+    // second G5's I J are the first's P Q negated.
+    let want: [&[[f64; 2]]; 4] = [
+        &[[0.0, 0.0], [5.0, 5.0], [10.0, 0.0]],
+        &[[10.0, 0.0], [12.0, 3.0], [18.0, 3.0], [20.0, 0.0]],
+        &[[20.0, 0.0], [22.0, -3.0], [24.0, 6.0], [25.0, 5.0]],
+        &[[25.0, 5.0], [26.0, 5.0], [26.0, 6.0]],
+    ];
+    let curves: Vec<_> = p
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            nc_geom::program::Block::Nurbs(n) => Some(n),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(curves.len(), 4);
+    for (n, pts) in curves.iter().zip(want) {
+        let c =
+            DoubleNurbs::new(usize::from(n.degree), &n.ctrl, &[], &n.weights, &n.knots).unwrap();
+        for k in 0..=20 {
+            let t = f64::from(k) / 20.0;
+            let (got, w) = (c.cutter(t, 0).p, bezier(pts, t));
+            assert!(
+                (got.x - w[0]).abs() < 1e-12 && (got.y - w[1]).abs() < 1e-12 && got.z == 1.0,
+                "{t}: {got:?} {w:?}"
+            );
+        }
+    }
+    let (kind, line, _) = fails("G0 X0 Y0 Z0\nG18 G5.1 X1 Z1 I1 K1 F100\nM2");
+    assert!(
+        matches!(kind, E::WordNotAllowed { .. } | E::SplinePlane { .. }),
+        "{kind}"
+    );
+    assert_eq!(line, 2);
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5 X1 Y1 P1 Q1 F100\nM2");
+    assert_eq!(kind, E::SplineWithoutIj);
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5.1 X1 Y1 I1 F100\nM2");
+    assert!(matches!(kind, E::MissingWord { letter: 'J', .. }), "{kind}");
+    let (kind, _, col) = fails("G0 X0 Y0 Z0\nG5.1 X1 Y1 Z2 I1 J1 F100\nM2");
+    assert!(
+        matches!(kind, E::WordNotAllowed { letter: 'Z', .. }),
+        "{kind}"
+    );
+    assert_eq!(col, 12);
+}
