@@ -122,23 +122,8 @@ fn arc_on_circle(b: &Block, start: &[f64; 6], m: &Move, end: &[f64; 6]) -> Resul
     let samples = (length / 0.5).clamp(16.0, 4096.0) as usize;
     let mut angle = 0.0;
     let mut prev = (start[s] - centre[1]).atan2(start[f] - centre[0]);
-    let total = {
-        let a1 = (end[s] - centre[1]).atan2(end[f] - centre[0]);
-        let tau = std::f64::consts::TAU;
-        let mut sweep = a1 - prev;
-        if turn > 0 {
-            while sweep <= 1e-12 {
-                sweep += tau;
-            }
-            sweep += f64::from(turn - 1) * tau;
-        } else {
-            while sweep >= -1e-12 {
-                sweep -= tau;
-            }
-            sweep -= f64::from(-turn - 1) * tau;
-        }
-        sweep
-    };
+    let total =
+        test_support::nurbs::sweep(prev, (end[s] - centre[1]).atan2(end[f] - centre[0]), turn);
     for k in 0..=samples {
         let u = u0 + (u1 - u0) * k as f64 / samples as f64;
         let p = test_support::nurbs::point(degree, &n.ctrl, &n.weights, &n.knots, u);

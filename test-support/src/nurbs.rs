@@ -1,6 +1,6 @@
 //! A NURBS curve's points by de Boor's algorithm, for tests that check a curve against
 //! another interpreter's (any number of control points, unlike the real-time evaluator's
-//! pieces).
+//! pieces), and LinuxCNC's reading of an arc's sweep.
 
 /// A point of a NURBS curve of any length (de Boor on homogeneous points).
 pub fn point(degree: usize, ctrl: &[[f64; 3]], weights: &[f64], knots: &[f64], u: f64) -> [f64; 3] {
@@ -30,4 +30,24 @@ pub fn point(degree: usize, ctrl: &[[f64; 3]], weights: &[f64], knots: &[f64], u
     }
     let h = d[degree];
     [h[0] / h[3], h[1] / h[3], h[2] / h[3]]
+}
+
+/// The signed sweep (rad) of a LinuxCNC arc from angle `a0` to `a1` about its centre:
+/// `turn` > 0 counter-clockwise in the plane's (first, second) axes, < 0 clockwise, and
+/// |`turn`| - 1 extra full turns (its `ARC_FEED`'s `rotation`).
+pub fn sweep(a0: f64, a1: f64, turn: i32) -> f64 {
+    let tau = std::f64::consts::TAU;
+    let mut sweep = a1 - a0;
+    if turn > 0 {
+        while sweep <= 1e-12 {
+            sweep += tau;
+        }
+        sweep += f64::from(turn - 1) * tau;
+    } else {
+        while sweep >= -1e-12 {
+            sweep -= tau;
+        }
+        sweep -= f64::from(-turn - 1) * tau;
+    }
+    sweep
 }

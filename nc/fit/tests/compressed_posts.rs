@@ -621,7 +621,12 @@ fn every_compressed_post_holds_every_limit_and_passes_its_points() {
         c.long
     );
     // Rare, or the suite checks the plans and not the setpoints.
-    assert!(c.long * 20 <= c.accepted.max(1), "{} of {} too long", c.long, c.accepted);
+    assert!(
+        c.long * 20 <= c.accepted.max(1),
+        "{} of {} too long",
+        c.long,
+        c.accepted
+    );
     if let Err(e) = result {
         panic!("{e}");
     }

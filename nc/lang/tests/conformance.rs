@@ -231,21 +231,8 @@ fn check_arc(
     };
     let (r0, a0) = polar([start[0], start[1], start[2]]);
     let (r1, a1) = polar([end[0], end[1], end[2]]);
-    // LinuxCNC's sweep: `turn` > 0 counter-clockwise in (first, second), < 0 clockwise,
-    // |turn| - 1 extra full turns.
     let tau = std::f64::consts::TAU;
-    let mut sweep = a1 - a0;
-    if turn > 0 {
-        while sweep <= 1e-12 {
-            sweep += tau;
-        }
-        sweep += f64::from(turn - 1) * tau;
-    } else {
-        while sweep >= -1e-12 {
-            sweep -= tau;
-        }
-        sweep -= f64::from(-turn - 1) * tau;
-    }
+    let sweep = test_support::nurbs::sweep(a0, a1, turn);
     let (u0, u1) = (n.knots[degree], n.knots[n.knots.len() - 1 - degree]);
     let samples = 64 * (1 + (sweep.abs() / tau) as usize);
     let mut angle = 0.0;
