@@ -211,7 +211,7 @@ pub enum ParseErrorKind {
     SplinePlane { motion: Motion },
     #[error("{motion} under G93 (inverse time): give the feed in G94")]
     SplineInverseTime { motion: Motion },
-    #[error("G05 without I J needs a G05 just before it (whose P Q it continues)")]
+    #[error("G05 needs both I and J, or neither (then the last G05's P Q, negated)")]
     SplineWithoutIj,
     #[error("{letter} with polar coordinates (@ ^) on one line: give X Y or @ ^")]
     PolarWithXy { letter: char },

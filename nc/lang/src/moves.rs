@@ -78,9 +78,6 @@ impl Parser<'_> {
             return self.cycle(line, c, pos);
         }
         self.end_cycle();
-        if !matches!(motion, Motion::G05) {
-            self.last_spline_pq = None;
-        }
         match motion {
             Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
             Motion::G05 | Motion::G051 => self.spline(line, motion, pos),

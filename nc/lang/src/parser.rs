@@ -57,8 +57,7 @@ pub(super) struct Parser<'s> {
     startup_error: Option<ParseError>,
     /// The last feed reported as above the machine's highest (mm/min).
     clamped: Option<f64>,
-    /// The `P Q` of the last `G5` when the previous move was one (its `I J` may then be
-    /// left out), mm.
+    /// The `P Q` of the last `G5` (a `G5` without `I J` continues it), mm.
     pub last_spline_pq: Option<(f64, f64)>,
     /// The call level the interpreter is at, and the states `M70` and `M73` saved.
     pub level: usize,

@@ -3,13 +3,13 @@
 //! - `G5.1 X Y I J`: a quadratic B-spline (a quadratic Bezier) from the current point to
 //!   `X Y`, its control point `I J` from the start.
 //! - `G5 X Y I J P Q`: a cubic (a cubic Bezier), its first control point `I J` from the start
-//!   and its second `P Q` from the end. On a `G5` right after another, `I J` may be left out:
-//!   they are then the previous `P Q` negated (the curves join tangent).
+//!   and its second `P Q` from the end. `I J` may be left out (both): they are then the last
+//!   `G5`'s `P Q` negated (the curves join tangent), or 0 before any `G5`, as in LinuxCNC.
 //!
 //! `X Y` are the end point (incremental under `G91`); `I J P Q` are always offsets. Refused
 //! with their column: another plane, a `Z` or angle word (LinuxCNC's splines are planar),
-//! inverse time, and what LinuxCNC refuses (`G5.1` without `I` and `J`, `G5` without `P Q`,
-//! or without `I J` and no `G5` before it).
+//! inverse time (which LinuxCNC takes), and what LinuxCNC refuses (`G5.1` without both `I`
+//! and `J`, `G5` without both `P` and `Q`, or with only one of `I J`).
 
 use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::Line;
@@ -47,22 +47,26 @@ impl Parser<'_> {
         let (x0, y0, z) = (start[0], start[1], start[2]);
         let (x3, y3) = (end[0], end[1]);
         let ctrl = if cubic {
-            let (p, q) = match (word('P'), word('Q')) {
-                (None, None) => {
-                    let kind = ParseErrorKind::MissingWord {
-                        letter: 'P',
-                        context: Context::Move(motion),
-                    };
-                    return Err(kind.at(pos));
-                }
-                (p, q) => (p.unwrap_or(0.0), q.unwrap_or(0.0)),
+            let missing = |letter| {
+                let kind = ParseErrorKind::MissingWord {
+                    letter,
+                    context: Context::Move(motion),
+                };
+                Err(kind.at(pos))
             };
-            let (i, j) = match (word('I'), word('J'), self.last_spline_pq) {
-                (None, None, Some((pp, pq))) => (-pp, -pq),
-                (None, None, None) => {
-                    return Err(ParseErrorKind::SplineWithoutIj.at(pos));
+            let (p, q) = match (word('P'), word('Q')) {
+                (Some(p), Some(q)) => (p, q),
+                (None, _) => return missing('P'),
+                (_, None) => return missing('Q'),
+            };
+            let (i, j) = match (word('I'), word('J')) {
+                (Some(i), Some(j)) => (i, j),
+                (None, None) => {
+                    let (pp, pq) = self.last_spline_pq.unwrap_or((0.0, 0.0));
+                    (-pp, -pq)
                 }
-                (i, j, _) => (i.unwrap_or(0.0), j.unwrap_or(0.0)),
+                (None, _) => return Err(ParseErrorKind::SplineWithoutIj.at(pos)),
+                (_, None) => return Err(ParseErrorKind::SplineWithoutIj.at(pos)),
             };
             self.last_spline_pq = Some((p, q));
             vec![
@@ -83,7 +87,6 @@ impl Parser<'_> {
                     return Err(kind.at(pos));
                 }
             };
-            self.last_spline_pq = None;
             vec![[x0, y0, z], [x0 + i, y0 + j, z], [x3, y3, z]]
         };
         let degree = ctrl.len() - 1;

@@ -581,8 +581,10 @@ fn g5_and_g5_1_are_the_bezier_curves_linuxcnc_defines() {
         "{kind}"
     );
     assert_eq!(line, 2);
-    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5 X1 Y1 P1 Q1 F100\nM2");
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5 X1 Y1 I1 P1 Q1 F100\nM2");
     assert_eq!(kind, E::SplineWithoutIj);
+    let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5 X1 Y1 I1 J1 P1 F100\nM2");
+    assert!(matches!(kind, E::MissingWord { letter: 'Q', .. }), "{kind}");
     let (kind, _, _) = fails("G0 X0 Y0 Z0\nG5.1 X1 Y1 I1 F100\nM2");
     assert!(matches!(kind, E::MissingWord { letter: 'J', .. }), "{kind}");
     let (kind, _, col) = fails("G0 X0 Y0 Z0\nG5.1 X1 Y1 Z2 I1 J1 F100\nM2");
