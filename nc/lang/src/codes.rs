@@ -181,7 +181,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 50] = [
+const G_CODES: [(f64, Code); 52] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -189,6 +189,8 @@ const G_CODES: [(f64, Code); 50] = [
     (4.0, Code::Dwell),
     (5.0, Code::Motion(Motion::G05)),
     (5.1, Code::Motion(Motion::G051)),
+    (5.2, Code::Motion(Motion::G052)),
+    (5.3, Code::Motion(Motion::G053)),
     (6.2, Code::Motion(Motion::G062)),
     (6.5, Code::Motion(Motion::G065)),
     (17.0, Code::Plane(Plane::Xy)),

@@ -211,6 +211,20 @@ pub enum ParseErrorKind {
     SplinePlane { motion: Motion },
     #[error("{motion} under G93 (inverse time): give the feed in G94")]
     SplineInverseTime { motion: Motion },
+    #[error("{letter}: a G05.2 control point needs both X and Y")]
+    NurbsPointXy { letter: char },
+    #[error("P without X Y sets the weight of the first control point only (on the G05.2 line)")]
+    NurbsFirstWeight,
+    #[error("G05.2 L{value}: the order is a whole number, at most 6 (degree 5)")]
+    NurbsOrder { value: f64 },
+    #[error("G05.2 P{value}: a control point's weight must be above 0")]
+    NurbsWeight { value: f64 },
+    #[error("G05.3 without a G05.2 block open")]
+    NurbsCloseWithoutOpen,
+    #[error("G05.3: {count} control points, fewer than the order {order}")]
+    NurbsTooFewPoints { count: usize, order: usize },
+    #[error("the G05.2 block of {opened} is not closed by G05.3 here")]
+    NurbsNotClosed { opened: SrcPos },
     #[error("G05 needs both I and J, or neither (then the last G05's P Q, negated)")]
     SplineWithoutIj,
     #[error("{letter} with polar coordinates (@ ^) on one line: give X Y or @ ^")]

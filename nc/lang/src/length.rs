@@ -96,7 +96,8 @@ impl Parser<'_> {
             | Motion::G062
             | Motion::G065
             | Motion::G05
-            | Motion::G051),
+            | Motion::G051
+            | Motion::G052),
         ) = motion
         {
             let kind = ParseErrorKind::LengthChangeOnCurve {

@@ -78,7 +78,12 @@ impl Parser<'_> {
             return self.cycle(line, c, pos);
         }
         self.end_cycle();
+        if motion != Motion::G052 && motion != Motion::G053 {
+            self.g52_unclosed(pos)?;
+        }
         match motion {
+            Motion::G052 => self.g52_point(line, pos),
+            Motion::G053 => self.g52_close(line, pos),
             Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
             Motion::G05 | Motion::G051 => self.spline(line, motion, pos),
             _ => self.linear(line, motion, pos),

@@ -57,6 +57,8 @@ pub(super) struct Parser<'s> {
     startup_error: Option<ParseError>,
     /// The last feed reported as above the machine's highest (mm/min).
     clamped: Option<f64>,
+    /// A `G5.2` block being read.
+    pub g52: Option<crate::open_g52::OpenG52>,
     /// The `P Q` of the last `G5` (a `G5` without `I J` continues it), mm.
     pub last_spline_pq: Option<(f64, f64)>,
     /// The call level the interpreter is at, and the states `M70` and `M73` saved.
@@ -90,6 +92,7 @@ impl<'s> Parser<'s> {
             end: None,
             startup_error: None,
             clamped: None,
+            g52: None,
             last_spline_pq: None,
             level: 0,
             saved: crate::saved::SavedStates::default(),
@@ -223,6 +226,7 @@ impl<'s> Parser<'s> {
 
     /// At the end of the source: fails if a NURBS block is still open at `eof`.
     pub fn check_end(&self, eof: SrcPos) -> Result<(), ParseError> {
+        self.g52_unclosed(eof)?;
         match &self.open {
             Some(open) => Err(open.incomplete(eof)),
             None => Ok(()),
@@ -502,6 +506,8 @@ fn motion_value(m: Motion) -> f64 {
         Motion::G062 => 6.2,
         Motion::G05 => 5.0,
         Motion::G051 => 5.1,
+        Motion::G052 => 5.2,
+        Motion::G053 => 5.3,
         Motion::G065 => 6.5,
         Motion::Cycle(c) => c.code(),
     }

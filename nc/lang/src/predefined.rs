@@ -64,6 +64,8 @@ impl Parser<'_> {
             Some(Motion::G062 | Motion::G065) => 10.0,
             Some(Motion::G05) => 50.0,
             Some(Motion::G051) => 51.0,
+            Some(Motion::G052) => 52.0,
+            Some(Motion::G053) => 53.0,
             Some(Motion::Cycle(c)) => 10.0 * c.code(),
         }
     }

@@ -62,6 +62,10 @@ pub enum Motion {
     G05,
     /// `G5.1`: a quadratic spline in XY.
     G051,
+    /// `G5.2`: opens LinuxCNC's NURBS block (its lines are control points).
+    G052,
+    /// `G5.3`: closes it.
+    G053,
     /// A canned cycle (expanded into straight moves).
     Cycle(Cycle),
 }
@@ -127,6 +131,8 @@ impl fmt::Display for Motion {
             Motion::G065 => "G06.5",
             Motion::G05 => "G05",
             Motion::G051 => "G05.1",
+            Motion::G052 => "G05.2",
+            Motion::G053 => "G05.3",
             Motion::Cycle(c) => return write!(f, "{c}"),
         })
     }

@@ -594,3 +594,58 @@ fn g5_and_g5_1_are_the_bezier_curves_linuxcnc_defines() {
     );
     assert_eq!(col, 12);
 }
+
+#[test]
+fn g5_2_blocks_are_linuxcncs_nurbs() {
+    // LinuxCNC's construction (checked against its Python interpreter's samples of these
+    // two blocks: 1e-15 in): the current point first, the order 3 unless L > 3, the weights P,
+    // the knots the clamped uniform integers.
+    let src =
+        "G20 G90 G17\nG0 X0 Y0 Z0\nF10\nG5.2 X0 Y1 P1 L3\nX2 Y2 P1\nX2 Y0 P1\nX0 Y0 P2\nG5.3\n\
+               G5.2 P2 L4\nX1 Y1 P1\nX2 Y-1 P3\nX3 Y1 P1\nX4 Y0 P1\nG5.3\nG1 X5\nM2";
+    let p = parse(src).unwrap();
+    let curves: Vec<_> = p
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            nc_geom::program::Block::Nurbs(n) => Some(n),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(curves.len(), 2);
+    let inch = |pts: &[[f64; 2]]| -> Vec<[f64; 3]> {
+        pts.iter()
+            .map(|p| [p[0] * 25.4, p[1] * 25.4, 0.0])
+            .collect()
+    };
+    assert_eq!(curves[0].degree, 2);
+    assert_eq!(
+        curves[0].ctrl,
+        inch(&[[0.0, 0.0], [0.0, 1.0], [2.0, 2.0], [2.0, 0.0], [0.0, 0.0]])
+    );
+    assert_eq!(curves[0].weights, [1.0, 1.0, 1.0, 1.0, 2.0]);
+    assert_eq!(curves[0].knots, [0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 3.0, 3.0]);
+    assert_eq!(curves[1].degree, 3);
+    assert_eq!(curves[1].weights, [2.0, 1.0, 3.0, 1.0, 1.0]);
+    assert_eq!(
+        curves[1].knots,
+        [0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0]
+    );
+    // After G5.3 the point is the block's last; the next move goes on from there.
+    assert_eq!(linear(p.blocks.last().unwrap()).end[0], 5.0 * 25.4);
+    for (src, want) in [
+        ("G5.2 X1 P1\nX2 Y0 P1\nG5.3", "needs both X and Y"),
+        ("G5.2 X1 Y1 P1\nX2 Y0 P0\nG5.3", "above 0"),
+        ("G5.2 X1 Y1 P1\nG5.3", "fewer than the order 3"),
+        ("G5.2 X1 Y1 P1\nX2 Y0 P1\nG1 X3", "not closed by G05.3"),
+        ("G5.3", "without a G05.2"),
+        ("G5.2 X1 Y1 P1 L7\nG5.3", "at most 6"),
+        ("G5.2 X1 Y1 Z1 P1\nG5.3", "Z"),
+    ] {
+        let e = parse(&format!("G0 X0 Y0 Z0\nF100\n{src}\nM2")).unwrap_err();
+        assert!(e.to_string().contains(want), "{src}: {e}");
+    }
+    // Not closed at the end of the program.
+    let e = parse("G0 X0 Y0 Z0\nF100\nG5.2 X1 Y1 P1\nX2 Y0 P1").unwrap_err();
+    assert!(e.to_string().contains("not closed"), "{e}");
+}
