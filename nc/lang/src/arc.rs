@@ -18,7 +18,7 @@
 //! every joint's tangent the true helix's, and leaves the point at angle `phi` off the true
 //! helix along the normal by at most `0.00259 k alpha^5` (`k = |dz / dphi|`, the
 //! coefficient measured over `alpha <= 45 deg`; 0.00239 for small `alpha`). The pieces are
-//! made small enough that this is below [`HELIX_TOL_MM`]: about 43 pieces a turn at a 1 mm
+//! made small enough that this is below [`HELIX_TOL_MM`](crate::rules::HELIX_TOL_MM): about 43 pieces a turn at a 1 mm
 //! pitch. In the plane, the helix's projection is still exactly the circle.
 //!
 //! The centre comes from `I J K` (offsets from the start, in the plane's letters) or from `R`
@@ -35,10 +35,10 @@ mod spiral;
 use super::error::ParseErrorKind;
 use crate::rules::{
     ARC_RADIUS_REL_TOL, ARC_RADIUS_TOL_IN, ARC_RADIUS_TOL_MM, ARC_REACH_TOL_IN, ARC_REACH_TOL_MM,
-    HELIX_TOL_MM, MIN_ARC_RADIUS_MM,
+    MIN_ARC_RADIUS_MM,
 };
 use crate::vocab::Plane;
-use core::f64::consts::{FRAC_PI_2, TAU};
+use core::f64::consts::TAU;
 
 /// `e <= HELIX_ERR * k * alpha^5`: the largest normal error of a degree-4 helix piece of
 /// half-sweep `alpha <= 45 deg` rising `k` mm a radian (measured 0.00259 at 45 deg).
@@ -221,20 +221,8 @@ pub fn arc(
     let rise = at(&end, n) - at(&start, n);
     let helix = rise != 0.0;
     let degree: usize = if helix { 4 } else { 2 };
-    let mut pieces = (sweep.abs() / FRAC_PI_2).ceil().max(1.0);
-    if helix {
-        let k = rise.abs() / sweep.abs();
-        let alpha_max = (HELIX_TOL_MM / (HELIX_ERR * k)).powf(0.2);
-        pieces = pieces.max((sweep.abs() / (2.0 * alpha_max)).ceil());
-    }
-    if pieces.is_nan() || pieces * degree as f64 + 1.0 > MAX_CTRL as f64 {
-        return Err(ParseErrorKind::HelixTooSteep {
-            rise,
-            sweep_deg: sweep.abs().to_degrees(),
-            pieces,
-        });
-    }
-    let pieces = (pieces as usize).max(1);
+    let steep = if helix { rise.abs() / sweep.abs() } else { 0.0 };
+    let pieces = spiral::pieces(sweep, rise, steep, HELIX_ERR, degree, MAX_CTRL)?;
     let alpha = sweep / (2.0 * pieces as f64);
     let w1 = alpha.cos();
     let mid_r = radius / w1;

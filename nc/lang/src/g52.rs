@@ -19,7 +19,7 @@ use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::Line;
 use super::parser::Parser;
 use crate::open_g52::OpenG52;
-use crate::vocab::{Motion, Plane};
+use crate::vocab::Motion;
 use nc_geom::program::{Block, NurbsBlock, NurbsKind, SrcPos};
 
 /// Highest order (degree + 1) dnurbs evaluates.
@@ -33,15 +33,7 @@ impl Parser<'_> {
             &self.extra_letters(line, "GMFSTXYPL"),
             Context::Move(motion),
         )?;
-        if self.modal.plane != Plane::Xy {
-            return Err(ParseErrorKind::SplinePlane { motion }.at(pos));
-        }
-        if self.modal.inverse_time {
-            return Err(ParseErrorKind::SplineInverseTime { motion }.at(pos));
-        }
-        if self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
-        }
+        self.planar_curve_modes(motion, pos)?;
         let (x, y) = (line.get('X'), line.get('Y'));
         if let (Some(w), None) | (None, Some(w)) = (x, y) {
             return Err(ParseErrorKind::NurbsPointXy { letter: w.letter }.at(w.pos));

@@ -18,6 +18,20 @@ use crate::vocab::{Motion, Plane};
 use nc_geom::program::{Block, NurbsBlock, NurbsKind, SrcPos};
 
 impl Parser<'_> {
+    /// The modes LinuxCNC's planar curves (`G5`, `G5.1`, `G5.2`) need: `G17`, `G94`, a feed.
+    pub(super) fn planar_curve_modes(&self, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
+        if self.modal.plane != Plane::Xy {
+            return Err(ParseErrorKind::SplinePlane { motion }.at(pos));
+        }
+        if self.modal.inverse_time {
+            return Err(ParseErrorKind::SplineInverseTime { motion }.at(pos));
+        }
+        if self.feed.is_none() {
+            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+        }
+        Ok(())
+    }
+
     /// A `G5` / `G5.1` line (or its modal continuation).
     pub(super) fn spline(
         &mut self,
@@ -31,15 +45,7 @@ impl Parser<'_> {
         if line.first_of("XYIJPQ").is_none() {
             return Ok(());
         }
-        if self.modal.plane != Plane::Xy {
-            return Err(ParseErrorKind::SplinePlane { motion }.at(pos));
-        }
-        if self.modal.inverse_time {
-            return Err(ParseErrorKind::SplineInverseTime { motion }.at(pos));
-        }
-        if self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
-        }
+        self.planar_curve_modes(motion, pos)?;
         let scale = self.modal.scale();
         let word = |l: char| line.value(l).map(|v| v * scale);
         let start = self.here_or_reference(line, pos, 'X')?;

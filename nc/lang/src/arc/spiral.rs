@@ -44,20 +44,8 @@ pub(super) fn net(
     let rise = end.get(n).copied().unwrap_or(0.0) - z0;
     // Growth of the radius and of the normal coordinate per radian along the sweep.
     let (k, kz) = ((r1 - r0) / sweep, rise / sweep);
-    let mut pieces = (sweep.abs() / FRAC_PI_2).ceil().max(1.0);
     let steep = k.abs().max(kz.abs());
-    if steep > 0.0 {
-        let alpha_max = (HELIX_TOL_MM / (SPIRAL_ERR * steep)).powf(0.2);
-        pieces = pieces.max((sweep.abs() / (2.0 * alpha_max)).ceil());
-    }
-    if pieces.is_nan() || pieces * DEGREE as f64 + 1.0 > max_ctrl as f64 {
-        return Err(ParseErrorKind::HelixTooSteep {
-            rise,
-            sweep_deg: sweep.abs().to_degrees(),
-            pieces,
-        });
-    }
-    let pieces = (pieces as usize).max(1);
+    let pieces = pieces(sweep, rise, steep, SPIRAL_ERR, DEGREE, max_ctrl)?;
     let alpha = sweep / (2.0 * pieces as f64);
     let w1 = alpha.cos();
     let c3 = (alpha.sin() - alpha) / 2.0;
@@ -161,6 +149,34 @@ fn product(x: &[f64], y: &[f64]) -> [f64; 6] {
         }
     }
     out
+}
+
+/// How many pieces an arc of `sweep` radians is cut into: at most a quarter turn each, and,
+/// where its radius or normal coordinate changes by `steep` mm a radian, small enough that
+/// the pieces' error (`err` times `steep` times the half-angle to the fifth) stays below
+/// [`HELIX_TOL_MM`]; refused when the pieces of degree `degree` need more than `max_ctrl`
+/// control points.
+pub(super) fn pieces(
+    sweep: f64,
+    rise: f64,
+    steep: f64,
+    err: f64,
+    degree: usize,
+    max_ctrl: usize,
+) -> Result<usize, ParseErrorKind> {
+    let mut pieces = (sweep.abs() / FRAC_PI_2).ceil().max(1.0);
+    if steep > 0.0 {
+        let alpha_max = (HELIX_TOL_MM / (err * steep)).powf(0.2);
+        pieces = pieces.max((sweep.abs() / (2.0 * alpha_max)).ceil());
+    }
+    if pieces.is_nan() || pieces * degree as f64 + 1.0 > max_ctrl as f64 {
+        return Err(ParseErrorKind::HelixTooSteep {
+            rise,
+            sweep_deg: sweep.abs().to_degrees(),
+            pieces,
+        });
+    }
+    Ok((pieces as usize).max(1))
 }
 
 #[cfg(test)]
