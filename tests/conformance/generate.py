@@ -11,7 +11,8 @@ Deterministic (seeded): running it again writes the same files. Families:
          counter, calls before the definition (after M2);
 - arcs:  G02/G03 in G17, G18 and G19, centre (IJK) and radius (R, both signs) forms,
          helices, full circles, G90 and G91, mm and inch;
-- units: G20/G21 and G90/G91 switched along a program, with parameters and rotary axes.
+- units: G20/G21 and G90/G91 switched along a program, with parameters and rotary axes;
+- comp:  cutter radius compensation on random closed contours of lines and arcs.
 
 Then run regen.py (system Python with LinuxCNC's `gcode` module) for the references.
 """
@@ -462,10 +463,82 @@ def polar_program(r, k):
     return lines
 
 
+def comp_program(r, k):
+    """Cutter radius compensation on random closed contours of lines and arcs (convex and
+    concave corners, tangent and sharp), G41/G42 by tool number (rs274's default table) and
+    G41.1/G42.1 by diameter, entries by a line or an arc, Z moves, feeds and dwells between
+    compensated moves, in mm and inch; some tools are too big for a corner on purpose."""
+    inch = r.random() < 0.3
+    unit = 25.4 if inch else 1.0
+    lines = ["(cutter compensation %d)" % k, "G20" if inch else "G21", "G17 G90 G40",
+             "G0 X0 Y0 Z5", "F%d" % r.randint(50, 500)]
+    size = r.uniform(10, 30) / unit
+    n = r.randint(3, 8)
+    angles = sorted(r.uniform(0, 2 * math.pi) for _ in range(n))
+    pts = []
+    for a in angles:
+        rad = size * r.uniform(0.4, 1.0)
+        pts.append((round(rad * math.cos(a), 4), round(rad * math.sin(a), 4)))
+    # The start: outside the contour, so the entry move is long.
+    a0 = angles[0] + r.uniform(-0.3, 0.3)
+    start = (round(2.2 * size * math.cos(a0), 4), round(2.2 * size * math.sin(a0), 4))
+    lines.append("G0 X%s Y%s" % (fmt(start[0]), fmt(start[1])))
+    lines.append("G1 Z%s" % fmt(-1 / unit))
+    if r.random() < 0.5:
+        dia = r.choice([0.5, 1, 2, 3, 6, 10]) / unit
+        if r.random() < 0.1:
+            dia = -dia
+        code = "%s.1 D%s" % (r.choice(["G41", "G42"]), fmt(dia))
+    else:
+        code = "%s D%d" % (r.choice(["G41", "G42"]), r.choice([1, 2, 3]))
+    lines.append(code)
+    first = pts[0]
+    if r.random() < 0.25:
+        # An entry arc to the first point.
+        mx, my = (start[0] + first[0]) / 2, (start[1] + first[1]) / 2
+        dx, dy = first[0] - start[0], first[1] - start[1]
+        h = r.uniform(0.3, 1.5) * math.hypot(dx, dy) / 2
+        cx, cy = mx - dy / math.hypot(dx, dy) * h, my + dx / math.hypot(dx, dy) * h
+        lines.append("%s X%s Y%s I%s J%s" % (r.choice(["G2", "G3"]), fmt(first[0]), fmt(first[1]),
+                                            fmt(cx - start[0]), fmt(cy - start[1])))
+    else:
+        lines.append("G1 X%s Y%s" % (fmt(first[0]), fmt(first[1])))
+    here = first
+    for i in range(1, n + 1):
+        nxt = pts[i % n]
+        c = r.random()
+        if c < 0.08:
+            lines.append("G0 Z%s" % fmt(r.uniform(-1, 2) / unit))
+        elif c < 0.12:
+            lines.append("F%d" % r.randint(50, 500))
+        elif c < 0.15:
+            lines.append("G4 P0.%d" % r.randint(1, 9))
+        if r.random() < 0.55:
+            lines.append("G1 X%s Y%s" % (fmt(nxt[0]), fmt(nxt[1])))
+        else:
+            dx, dy = nxt[0] - here[0], nxt[1] - here[1]
+            chord = math.hypot(dx, dy)
+            if chord < 1e-3:
+                continue
+            h = r.uniform(-2.0, 2.0) * chord / 2
+            cx = here[0] + dx / 2 - dy / chord * h
+            cy = here[1] + dy / 2 + dx / chord * h
+            lines.append("%s X%s Y%s I%s J%s" % (r.choice(["G2", "G3"]), fmt(nxt[0]), fmt(nxt[1]),
+                                                fmt(cx - here[0]), fmt(cy - here[1])))
+        here = nxt
+    # Leave the contour outward, then turn compensation off and move clear.
+    lines.append("G1 X%s Y%s" % (fmt(here[0] * 1.8), fmt(here[1] * 1.8)))
+    lines.append("G40")
+    lines.append("G0 Z5")
+    lines.append("G0 X0 Y0")
+    lines.append("M2")
+    return lines
+
+
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
             ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
             ("offsets", offsets_program, 20), ("context", context_program, 15),
-            ("polar", polar_program, 10)]
+            ("polar", polar_program, 10), ("comp", comp_program, 40)]
 
 
 def main():

@@ -40,8 +40,9 @@ pub struct ShopArgs {
 /// The shop's options as values (tool lengths loaded).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ShopOptions {
-    /// Tool number -> length, mm, from `--tools` (else the machine file's table is used).
-    pub tools: Option<BTreeMap<u32, f64>>,
+    /// Tool number -> length and diameter, mm, from `--tools` (else the machine file's
+    /// table is used).
+    pub tools: Option<BTreeMap<u32, config::Tool>>,
     /// G54..G59 from `--offsets`, over the machine file's.
     pub work_offsets: config::offsets::WorkOffsets,
     pub block_delete: bool,
@@ -54,12 +55,7 @@ impl ShopArgs {
     /// Loads the tool table, if one is given.
     pub fn load(&self) -> Result<ShopOptions, InputError> {
         let tools = match &self.tools {
-            Some(path) => Some(
-                config::tools::load_tools(path)?
-                    .into_iter()
-                    .map(|(n, t)| (n, t.length_mm))
-                    .collect(),
-            ),
+            Some(path) => Some(config::tools::load_tools(path)?),
             None => None,
         };
         let work_offsets = match &self.offsets {
@@ -88,18 +84,18 @@ pub fn parse_setup(
     shop: &ShopOptions,
 ) -> Result<nc_lang::Setup, InputError> {
     let program = &machine.program;
-    let tools = shop.tools.clone().unwrap_or_else(|| {
-        program
-            .tools
-            .iter()
-            .map(|(n, t)| (*n, t.length_mm))
-            .collect()
-    });
+    let table = shop.tools.as_ref().unwrap_or(&program.tools);
+    let tools = table.iter().map(|(n, t)| (*n, t.length_mm)).collect();
+    let tool_diameters = table
+        .iter()
+        .filter_map(|(n, t)| t.diameter_mm.map(|d| (*n, d)))
+        .collect();
     let mut setup = nc_lang::Setup {
         work_offsets: std::array::from_fn(|k| shop.work_offsets[k].or(machine.work_offsets[k])),
         reference: machine.reference,
         g30: machine.g30,
         tools,
+        tool_diameters,
         block_delete: shop.block_delete,
         optional_stop: shop.optional_stop,
         kinematics: Some(crate::setup::MachineSetup::new(machine).kin),

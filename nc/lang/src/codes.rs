@@ -2,9 +2,10 @@
 //!
 //! One code per group on a line (`G00 G01` on one line is an error, `G90 G94 G17 G49 G40 G80`
 //! is six groups). Codes of real posts that dnurbs cannot honour have their own error, never
-//! a silent skip: cutter compensation (`G41`/`G42`), the canned cycles dnurbs does not run
-//! (tapping `G74`/`G84`, back boring `G87`, `G88`).
+//! a silent skip: the canned cycles dnurbs does not run (tapping `G74`/`G84`, back boring
+//! `G87`, `G88`).
 
+use crate::comp::Side;
 use crate::error::ParseErrorKind;
 use crate::vocab::{Cycle, Motion, Plane};
 use nc_geom::program::{Coolant, Spindle};
@@ -124,6 +125,12 @@ pub enum Code {
     InverseTime(bool),
     /// `G40`.
     CompensationOff,
+    /// `G41`/`G42` (`D`: a tool number, or none for the tool in the spindle) and
+    /// `G41.1`/`G42.1` (`direct`: `D` is the diameter).
+    RadiusComp {
+        side: crate::comp::Side,
+        direct: bool,
+    },
     LengthComp(LengthComp),
     /// `G80`: no canned cycle; without another motion code on its line, no motion mode.
     CannedOff,
@@ -162,7 +169,7 @@ impl Code {
             Code::Inch(_) => 3,
             Code::Incremental(_) => 4,
             Code::InverseTime(_) => 5,
-            Code::CompensationOff => 6,
+            Code::CompensationOff | Code::RadiusComp { .. } => 6,
             Code::LengthComp(_) => 7,
             Code::CannedOff => 8,
             Code::WorkOffset(_) => 9,
@@ -181,7 +188,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 52] = [
+const G_CODES: [(f64, Code); 56] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -201,6 +208,34 @@ const G_CODES: [(f64, Code); 52] = [
     (28.0, Code::Home),
     (30.0, Code::Home30),
     (40.0, Code::CompensationOff),
+    (
+        41.0,
+        Code::RadiusComp {
+            side: Side::Left,
+            direct: false,
+        },
+    ),
+    (
+        41.1,
+        Code::RadiusComp {
+            side: Side::Left,
+            direct: true,
+        },
+    ),
+    (
+        42.0,
+        Code::RadiusComp {
+            side: Side::Right,
+            direct: false,
+        },
+    ),
+    (
+        42.1,
+        Code::RadiusComp {
+            side: Side::Right,
+            direct: true,
+        },
+    ),
     (43.0, Code::LengthComp(LengthComp::Length)),
     (43.1, Code::LengthComp(LengthComp::Dynamic)),
     (43.2, Code::LengthComp(LengthComp::Added)),
@@ -243,9 +278,7 @@ pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
     if let Some((_, code)) = G_CODES.iter().find(|(v, _)| *v == value) {
         return Ok(*code);
     }
-    Err(if value == 41.0 || value == 42.0 {
-        ParseErrorKind::CutterCompensation { code: value }
-    } else if (73.0..=89.0).contains(&value) && value.fract() == 0.0 {
+    Err(if (73.0..=89.0).contains(&value) && value.fract() == 0.0 {
         ParseErrorKind::CannedCycle { code: value }
     } else {
         ParseErrorKind::UnsupportedGCode { code: value }

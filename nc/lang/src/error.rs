@@ -126,8 +126,28 @@ pub enum ParseErrorKind {
     UnsupportedGCode { code: f64 },
     #[error("unsupported M-code {}: dnurbs accepts {M_LIST}, and the M-codes the machine file's [mcodes] maps (M100..M199 and others: \"ignore\", \"tcp-on\", \"tcp-off\", \"stop\")", Code('M', *.code))]
     UnsupportedMCode { code: f64 },
-    #[error("cutter radius compensation {} is not supported: post the tool-centre path (compensation in the computer) with G40", Code('G', *.code))]
-    CutterCompensation { code: f64 },
+    #[error("{what} is not allowed while cutter radius compensation is on: turn it off with G40 first (LinuxCNC's rule)")]
+    CompensationForbids { what: &'static str },
+    #[error("{what} while cutter radius compensation is on is not supported by dnurbs: turn it off with G40 first")]
+    CompensationUnsupported { what: &'static str },
+    #[error("{} while cutter radius compensation is already on: turn it off with G40 first", Code('G', *.code))]
+    CompensationTwice { code: f64 },
+    #[error("cutter radius compensation {} works in the XY plane (G17) only; this line is in {}", Code('G', *.code), .plane.name())]
+    CompensationPlane { code: f64, plane: Plane },
+    #[error("{} needs D, the tool diameter", Code('G', *.code))]
+    CompensationWithoutD { code: f64 },
+    #[error("D is the tool (G41/G42) or the diameter (G41.1/G42.1) of cutter radius compensation: it belongs on a G41, G42, G41.1 or G42.1 line")]
+    DWithoutCompensation,
+    #[error("the move after cutter radius compensation is turned on must be longer in XY ({length:.6} mm) than the tool radius ({radius:.6} mm)")]
+    CompensationEntryTooShort { length: f64, radius: f64 },
+    #[error("with the tool inside the arc, the tool radius ({radius:.6} mm) must be smaller than the arc's radius ({arc_radius:.6} mm)")]
+    CompensationToolTooBig { arc_radius: f64, radius: f64 },
+    #[error("cutter radius compensation would gouge: {what}")]
+    CompensationGouge { what: &'static str },
+    #[error("cutter radius compensation failed: {what} (please report this program)")]
+    CompensationInternal { what: &'static str },
+    #[error("the move just after G40 must be straight, not {motion} (the tool is still off the programmed path; LinuxCNC's rule)")]
+    ArcAfterCompensation { motion: Motion },
     #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]
     CannedCycle { code: f64 },
     #[error("program number O{value} must stand alone on its line (after an optional N)")]

@@ -91,6 +91,9 @@
 
 mod arc;
 pub(crate) mod codes;
+mod comp;
+mod comp_corner;
+mod comp_parse;
 mod context;
 mod coord_offset;
 mod cycles;

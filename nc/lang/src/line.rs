@@ -11,7 +11,7 @@ use crate::vocab::Motion;
 use nc_geom::program::SrcPos;
 
 /// Letters the language knows. Anything else is [`ParseErrorKind::UnsupportedWord`].
-pub(super) const KNOWN: &str = "ABCEFGHIJKLMNOPQRSTUVWXYZ@^";
+pub(super) const KNOWN: &str = "ABCDEFGHIJKLMNOPQRSTUVWXYZ@^";
 
 /// Words that make a line move the machine (in the modal motion mode if no G word is given).
 pub(super) const MOVE_WORDS: &str = "XYZABCIJKR@^";

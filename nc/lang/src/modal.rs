@@ -25,6 +25,9 @@ pub struct Setup {
     pub g30: Option<[f64; 3]>,
     /// Tool number -> length (mm, along the spindle).
     pub tools: BTreeMap<u32, f64>,
+    /// Tool number -> diameter (mm), for cutter radius compensation (`G41 D`); a tool of
+    /// `tools` without one has diameter 0 (compensation then moves nothing, as LinuxCNC).
+    pub tool_diameters: BTreeMap<u32, f64>,
     /// Skip lines that start with `/` (block delete). Off: the `/` is ignored.
     pub block_delete: bool,
     /// `M01` stops (optional stop on). Off: `M01` is reported and passed.
@@ -74,6 +77,7 @@ impl Default for Setup {
             reference: None,
             g30: None,
             tools: BTreeMap::new(),
+            tool_diameters: BTreeMap::new(),
             block_delete: false,
             optional_stop: false,
             kinematics: None,

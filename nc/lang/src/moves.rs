@@ -26,6 +26,7 @@ impl Parser<'_> {
             return Err(ParseErrorKind::PolarPlane { letter: w.letter }.at(w.pos));
         }
         if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
+            self.comp_forbids("G92", pos)?;
             return self.coord_offset(line, kind, pos);
         }
         if let Some((Code::LengthComp(c @ (LengthComp::Dynamic | LengthComp::Added)), _)) =
@@ -46,10 +47,18 @@ impl Parser<'_> {
             if let Some((m, _)) = line.motion {
                 self.mode = Some(m);
             }
+            let what = if code == Code::MachineCoords {
+                "G53"
+            } else {
+                "G28/G30"
+            };
+            self.comp_forbids(what, pos)?;
             return self.machine_move(line, code, pos);
         }
         match line.motion {
             Some((motion @ (Motion::G062 | Motion::G065), pos)) => {
+                self.comp_unsupported("a NURBS block", pos)?;
+                self.comp_curve_allowed(motion, pos)?;
                 self.open_nurbs(line, motion, pos)
             }
             Some((motion, pos)) => {
@@ -75,11 +84,19 @@ impl Parser<'_> {
         pos: SrcPos,
     ) -> Result<(), ParseError> {
         if let Motion::Cycle(c) = motion {
+            self.comp_forbids("a canned cycle", pos)?;
             return self.cycle(line, c, pos);
         }
         self.end_cycle();
         if motion != Motion::G052 && motion != Motion::G053 {
             self.g52_unclosed(pos)?;
+        }
+        if matches!(
+            motion,
+            Motion::G05 | Motion::G051 | Motion::G052 | Motion::G053
+        ) {
+            self.comp_forbids("a spline (G05, G05.1, G05.2)", pos)?;
+            self.comp_curve_allowed(motion, pos)?;
         }
         match motion {
             Motion::G052 => self.g52_point(line, pos),
@@ -90,9 +107,13 @@ impl Parser<'_> {
         }
     }
 
-    /// `base` plus `H` on a tool-length line and `P` on a `G64` line.
+    /// `base` plus `H` on a tool-length line, `P` on a `G64` line and `D` on a
+    /// compensation line.
     pub(super) fn extra_letters(&self, line: &Line<'_>, base: &str) -> String {
         let mut s = base.to_owned();
+        if matches!(line.code_of_group(6), Some((Code::RadiusComp { .. }, _))) {
+            s.push('D');
+        }
         if line.code_of_group(7).is_some() {
             s.push('H');
         }
@@ -167,7 +188,9 @@ impl Parser<'_> {
         pos: SrcPos,
     ) -> Result<[f64; 3], ParseError> {
         let missing = AXES.into_iter().find(|a| line.get(*a).is_none());
-        let here = match (self.here, missing, self.modal.incremental) {
+        // Under cutter compensation, from the programmed point (the tool is beside it).
+        let base = self.comp.base().or(self.here);
+        let here = match (base, missing, self.modal.incremental) {
             (Some(h), _, _) => Some(h),
             (None, None, false) => None,
             (None, m, _) => Some(self.here_or_reference(line, pos, m.unwrap_or('X'))?),
@@ -222,6 +245,18 @@ impl Parser<'_> {
             };
             self.move_feed(line, motion, pos, length)?
         };
+        self.comp.arc_not_allowed = false;
+        if self.comp.compensating().is_some() {
+            if let Some(w) = line.first_of("ABCIJK") {
+                return self.comp_unsupported("a tool-axis word", w.pos);
+            }
+            if self.modal.inverse_time {
+                return self.comp_unsupported("G93 inverse-time feed", pos);
+            }
+        }
+        if self.comp_linear(line, pos, rapid, end, feed_mm_min)? {
+            return Ok(());
+        }
         self.orientation_given |= line.first_of("ABCIJK").is_some();
         self.push_linear(line, pos, rapid, end, orientation, feed_mm_min);
         Ok(())
@@ -263,6 +298,7 @@ impl Parser<'_> {
         if !self.modal.inverse_time && self.feed.is_none() {
             return Err(ParseErrorKind::NoFeed { motion }.at(pos));
         }
+        self.comp_curve_allowed(motion, pos)?;
         let plane = self.modal.plane;
         let (a, b, _) = plane.axes();
         let centre = match line.get('R') {
@@ -323,7 +359,7 @@ impl Parser<'_> {
             Some(_) => Some(self.angles(line)?),
             None => None,
         };
-        let start = self.here.unwrap_or(end);
+        let start = self.comp.base().or(self.here).unwrap_or(end);
         let centre = match centre {
             Centre::Offsets(ca, cb) if self.modal.arc_absolute => {
                 let at = |i: usize| start.get(i).copied().unwrap_or(0.0);
@@ -342,6 +378,16 @@ impl Parser<'_> {
         .map_err(|kind| kind.at(pos))?;
         let length = (net.radius * net.sweep.abs()).hypot(rise(start, end, plane));
         let feed_mm_min = self.move_feed(line, motion, pos, length)?;
+        if self.comp.compensating().is_some() {
+            if let Some(w) = line.first_of("ABC") {
+                return self.comp_unsupported("a tool-axis word", w.pos);
+            }
+            if self.modal.inverse_time {
+                return self.comp_unsupported("G93 inverse-time feed", pos);
+            }
+            let clockwise = motion == Motion::G02;
+            return self.comp_arc(line, pos, clockwise, (end, net.centre), feed_mm_min);
+        }
         let tooling = self.tooling();
         let count = net.ctrl.len();
         self.here = Some(end);

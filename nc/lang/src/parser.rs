@@ -64,6 +64,10 @@ pub(super) struct Parser<'s> {
     /// The call level the interpreter is at, and the states `M70` and `M73` saved.
     pub level: usize,
     pub saved: crate::saved::SavedStates,
+    /// Cutter radius compensation and the moves it holds.
+    pub comp: crate::comp::Comp,
+    /// A compensated arc that could not be built when it was released.
+    pub comp_error: Option<ParseError>,
 }
 
 impl<'s> Parser<'s> {
@@ -96,6 +100,8 @@ impl<'s> Parser<'s> {
             last_spline_pq: None,
             level: 0,
             saved: crate::saved::SavedStates::default(),
+            comp: crate::comp::Comp::default(),
+            comp_error: None,
         };
         let startup = setup.startup.words();
         if !startup.is_empty() {
@@ -165,6 +171,7 @@ impl<'s> Parser<'s> {
         self.modes(&line, motion)?;
         self.feed_word(&line)?;
         self.machine_words(&line)?;
+        self.radius_comp(&line)?;
         let moves = self.blocks.len();
         let moved = if self.is_dwell(&line) {
             // The dwell first, then a move on the same line (LinuxCNC's order).
@@ -185,14 +192,22 @@ impl<'s> Parser<'s> {
             self.check_tcp_off(line.motion.map_or(line.first, |m| m.1))?;
         }
         if let Some((Code::Stop(stop), pos)) = line.code_of_group(11) {
+            if stop != StopCode::ToolChange {
+                // A stop releases the moves compensation holds, where they are.
+                self.comp_flush(pos)?;
+            }
             match stop {
                 StopCode::Stop => self.stop(pos, ActionKind::Stop, true),
                 StopCode::Optional => {
                     let taken = self.setup.optional_stop;
                     self.stop(pos, ActionKind::OptionalStop { taken }, taken);
                 }
-                StopCode::ToolChange | StopCode::End => {}
+                StopCode::End => self.comp.active = None,
+                StopCode::ToolChange => {}
             }
+        }
+        if let Some(e) = self.comp_error.take() {
+            return Err(e);
         }
         self.end = line.end;
         Ok(())
@@ -224,11 +239,16 @@ impl<'s> Parser<'s> {
         matches!(line.code_of_group(1), Some((Code::Dwell, _)))
     }
 
-    /// At the end of the source: fails if a NURBS block is still open at `eof`.
-    pub fn check_end(&self, eof: SrcPos) -> Result<(), ParseError> {
+    /// At the end of the source: fails if a NURBS block is still open at `eof`; releases
+    /// the moves compensation holds.
+    pub fn check_end(&mut self, eof: SrcPos) -> Result<(), ParseError> {
         self.g52_unclosed(eof)?;
-        match &self.open {
-            Some(open) => Err(open.incomplete(eof)),
+        if let Some(open) = &self.open {
+            return Err(open.incomplete(eof));
+        }
+        self.comp_flush(eof)?;
+        match self.comp_error.take() {
+            Some(e) => Err(e),
             None => Ok(()),
         }
     }
@@ -242,6 +262,7 @@ impl<'s> Parser<'s> {
     /// effective motion (its code, or the modal one when it has coordinates).
     fn modes(&mut self, line: &Line<'_>, motion: Option<Motion>) -> Result<(), ParseError> {
         for (code, pos) in line.codes() {
+            self.comp_allows(code, pos)?;
             match code {
                 Code::Plane(p) => self.modal.plane = p,
                 Code::Inch(inch) => self.modal.inch = inch,
@@ -341,6 +362,7 @@ impl<'s> Parser<'s> {
         for (code, pos) in line.codes() {
             match code {
                 Code::Stop(StopCode::ToolChange) => {
+                    self.comp_forbids("a tool change (M06)", pos)?;
                     let tool = self.modal.selected;
                     self.modal.loaded = tool;
                     self.stop(pos, ActionKind::ChangeTool { tool }, true);
@@ -363,6 +385,9 @@ impl<'s> Parser<'s> {
             }
         }
         self.context(line)?;
+        if let Some((Code::Io(_), pos)) = line.code_of_group(16) {
+            self.comp_forbids("an output or a wait (M62..M68)", pos)?;
+        }
         self.io(line)?;
         self.user_m(line)
     }
@@ -406,8 +431,18 @@ impl<'s> Parser<'s> {
         Ok(())
     }
 
-    /// Records an action before the next motion block.
+    /// Records an action before the next motion block (held behind the moves cutter
+    /// compensation holds, if any).
     pub(super) fn act(&mut self, pos: SrcPos, kind: ActionKind) {
+        if self.comp.holding() {
+            self.comp.queue.push(crate::comp::Queued::Action(pos, kind));
+        } else {
+            self.act_now(pos, kind);
+        }
+    }
+
+    /// Records an action before the next motion block the parser emits.
+    pub(super) fn act_now(&mut self, pos: SrcPos, kind: ActionKind) {
         self.actions.push(Action {
             pos,
             before_block: self.drained + self.blocks.len(),
@@ -482,6 +517,23 @@ impl<'s> Parser<'s> {
         }
         self.just_closed = Some((block.pos, block.knots.len()));
         self.blocks.push(Block::Nurbs(block));
+    }
+}
+
+impl Parser<'_> {
+    /// Refuses a mode change compensation does not allow (LinuxCNC's rules), or does not
+    /// support in dnurbs.
+    fn comp_allows(&self, code: Code, pos: SrcPos) -> Result<(), ParseError> {
+        match code {
+            Code::Plane(p) if p != self.modal.plane => self.comp_forbids("a plane change", pos),
+            Code::Inch(i) if i != self.modal.inch => self.comp_forbids("a change of units", pos),
+            Code::WorkOffset(i) if i != self.modal.work => {
+                self.comp_forbids("a change of work offset", pos)
+            }
+            Code::Blend(_) => self.comp_forbids("a path-control mode (G61/G64)", pos),
+            Code::InverseTime(true) => self.comp_unsupported("G93 inverse-time feed", pos),
+            _ => Ok(()),
+        }
     }
 }
 

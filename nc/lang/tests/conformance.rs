@@ -121,10 +121,19 @@ fn read(src: &str) -> Read {
         .map(|(t, z)| (t, z * 25.4))
         .collect();
     // G54..G59 at the machine zero, as in rs274's empty parameter file.
+    // rs274's default tool table also gives diameters (inches) for cutter compensation. rs274
+    // converts them with its external length unit, 0.03937007874016 inch per mm (not exactly
+    // 1 / 25.4): a diameter is then 8e-15 below its value, which decides a program whose
+    // entry move is exactly a radius long (useful-subroutines.ngc).
+    let tool_diameters = [(1, 0.125), (2, 0.0625), (3, 0.201)]
+        .into_iter()
+        .map(|(t, d)| (t, d / 0.039_370_078_740_16))
+        .collect();
     let setup = Setup {
         reference: Some([0.0; 3]),
         work_offsets: [Some([0.0; 3]); 6],
         tools,
+        tool_diameters,
         ..Setup::default()
     };
     let mut entries = Entries::new(StrLines::new(src), &setup);
@@ -266,7 +275,10 @@ fn check_arc(
             ));
         }
     }
-    if (angle - sweep).abs() > 1e-6 {
+    // Rounded numbers turn the reference's angles by up to their rounding over the radius
+    // (a corner arc of cutter compensation has the tool's small radius).
+    let sweep_tol = 1e-6 + 4.0 * rounding / r0.min(r1).max(1e-9);
+    if (angle - sweep).abs() > sweep_tol {
         return Err(format!("arc sweeps {angle} rad, LinuxCNC's {sweep} rad"));
     }
     Ok(())

@@ -2,6 +2,7 @@
 //! test per error rule (`errors`), the no-panic property tests (`fuzz`) and reading as a
 //! stream (`source`).
 
+mod comp;
 mod errors;
 mod fuzz;
 mod interp;

@@ -73,14 +73,8 @@ fn tape_mark_not_alone() {
 }
 
 #[test]
-fn unsupported_word() {
-    assert_eq!(
-        fails("G00 X0 Y0 Z0 D1000", 1, 14),
-        E::UnsupportedWord {
-            letter: 'D',
-            value: 1000.0
-        }
-    );
+fn d_belongs_to_cutter_compensation() {
+    assert_eq!(fails("G00 X0 Y0 Z0 D1000", 1, 14), E::DWithoutCompensation);
 }
 
 // ---- line structure ------------------------------------------------------------------------
@@ -170,12 +164,7 @@ fn unsupported_g_code() {
 }
 
 #[test]
-fn cutter_compensation_and_canned_cycles_are_refused_by_name() {
-    assert_eq!(fails("G41 D1", 1, 1), E::CutterCompensation { code: 41.0 });
-    assert_eq!(
-        fails("G00 X0 Y0 Z0\nG42", 2, 1),
-        E::CutterCompensation { code: 42.0 }
-    );
+fn canned_cycles_dnurbs_does_not_run_are_refused_by_name() {
     assert_eq!(
         fails("G84 X0 Y0 Z-5 R2", 1, 1),
         E::CannedCycle { code: 84.0 }
