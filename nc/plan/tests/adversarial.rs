@@ -106,6 +106,15 @@ enum Move {
         count: u32,
         feed: f64,
     },
+    /// A contour of lines and arcs (`R`, both signs, both directions) under cutter radius
+    /// compensation (`G41.1`/`G42.1` by diameter), then `G40` and a line back onto the
+    /// programmed path.
+    Comp {
+        left: bool,
+        diameter: f64,
+        points: Vec<([f64; 2], Option<(bool, f64)>)>,
+        feed: f64,
+    },
     /// A canned cycle (`G73 G81 G82 G83 G85 G86 G89`, `G99`) at `at`, from `r` down by
     /// `depth`, then `G80`.
     Drill {
@@ -253,6 +262,22 @@ fn move_strategy() -> impl Strategy<Value = Move> {
             depth,
             feed,
         });
+    let contour_point = (
+        [-60.0..60.0f64, -60.0..60.0f64],
+        prop::option::of((any::<bool>(), prop_oneof![1.01..3.0f64, -3.0..-1.01f64])),
+    );
+    let comp = (
+        any::<bool>(),
+        prop_oneof![3 => 0.5..12.0f64, 1 => 12.0..60.0f64],
+        prop::collection::vec(contour_point, 1..6),
+        feed.clone(),
+    )
+        .prop_map(|(left, diameter, points, feed)| Move::Comp {
+            left,
+            diameter,
+            points,
+            feed,
+        });
     prop_oneof![
         10 => line,
         9 => nurbs,
@@ -261,6 +286,7 @@ fn move_strategy() -> impl Strategy<Value = Move> {
         2 => param,
         2 => looped,
         2 => drill,
+        2 => comp,
     ]
 }
 
@@ -350,6 +376,36 @@ fn program(start: ([f64; 3], Tool), moves: &[Move]) -> String {
                 for (h, d) in here.iter_mut().zip(step) {
                     *h += f64::from(*count) * num(*d).parse::<f64>().unwrap_or(0.0);
                 }
+            }
+            Move::Comp {
+                left,
+                diameter,
+                points,
+                feed,
+            } => {
+                let side = if *left { "G41.1" } else { "G42.1" };
+                let _ = writeln!(s, "N{n} {side} D{}", num(*diameter));
+                let read = |v: &str| v.parse::<f64>().unwrap_or(0.0);
+                let mut last = [here[0], here[1]];
+                for (k, (p, arc)) in points.iter().enumerate() {
+                    let to = [read(&num(p[0])), read(&num(p[1]))];
+                    let chord = (to[0] - last[0]).hypot(to[1] - last[1]);
+                    let words = format!("X{} Y{} F{}", num(to[0]), num(to[1]), num(*feed));
+                    match arc {
+                        // An entry is a line; an arc needs a chord to span.
+                        Some((cw, f)) if k > 0 && chord > 1e-3 => {
+                            let g = if *cw { "G02" } else { "G03" };
+                            let _ = writeln!(s, "{g} {words} R{}", num(chord / 2.0 * f));
+                        }
+                        _ => {
+                            let _ = writeln!(s, "G01 {words}");
+                        }
+                    }
+                    last = to;
+                }
+                // Off, then back onto the programmed path (the move after G40 is straight).
+                let _ = writeln!(s, "G40\nG01 X{} Y{}", num(last[0]), num(last[1]));
+                here = [last[0], last[1], here[2]];
             }
             Move::Drill {
                 cycle,
@@ -530,6 +586,7 @@ struct Counts {
     turning_arcs: AtomicU64,
     /// Accepted programs with parameters, a loop or a canned cycle.
     interpreted: AtomicU64,
+    compensated: AtomicU64,
     refused: AtomicU64,
     /// Programs the pre-pass refused for a programmed point outside the travel.
     prepass_travel: AtomicU64,
@@ -708,6 +765,9 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     if src.contains('#') || src.contains("repeat") || src.contains(" G99 ") {
         counts.interpreted.fetch_add(1, Ordering::Relaxed);
     }
+    if src.contains("G41.1") || src.contains("G42.1") {
+        counts.compensated.fetch_add(1, Ordering::Relaxed);
+    }
     let mut ip = Interpolator::new(
         &path,
         &profile,
@@ -822,13 +882,14 @@ fn run_half(half: u64, cases: u32) {
     );
     let pre = counts.prepass_travel.load(Ordering::Relaxed);
     let interpreted = counts.interpreted.load(Ordering::Relaxed);
+    let compensated = counts.compensated.load(Ordering::Relaxed);
     let on_stream = counts.on_stream.load(Ordering::Relaxed);
     let held: Vec<u64> = counts
         .held
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
     if let Err(e) = result {
         panic!("{e}");
     }
@@ -844,6 +905,10 @@ fn run_half(half: u64, cases: u32) {
     assert!(
         turning * 50 >= u64::from(cases),
         "only {turning} of {cases} accepted with an arc turning the tool"
+    );
+    assert!(
+        compensated * 50 >= u64::from(cases),
+        "only {compensated} of {cases} accepted with cutter compensation"
     );
     assert!(
         on_stream * 3 >= acc,
