@@ -112,7 +112,7 @@ enum Move {
     Comp {
         left: bool,
         diameter: f64,
-        points: Vec<([f64; 2], Option<(bool, f64)>)>,
+        points: Vec<ContourPoint>,
         feed: f64,
     },
     /// A canned cycle (`G73 G81 G82 G83 G85 G86 G89`, `G99`) at `at`, from `r` down by
@@ -125,6 +125,10 @@ enum Move {
         feed: f64,
     },
 }
+
+/// A point of a compensated contour, reached by a line or by an arc (clockwise, and `R` as a
+/// multiple of half the chord, negative for the longer arc).
+type ContourPoint = ([f64; 2], Option<(bool, f64)>);
 
 fn tool_strategy() -> impl Strategy<Value = Tool> {
     prop_oneof![
