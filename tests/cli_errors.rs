@@ -154,10 +154,10 @@ fn every_program_rule_is_a_positioned_error_with_exit_code_2() {
     check("capacity", &many, "100002", "MAX_BLOCK_CTRL = 100000");
 
     check(
-        "g41",
+        "g41-entry",
         "G41 D1\nG01 X0 Y0 Z0 F100\n",
-        "1:1",
-        "cutter radius compensation G41 is not supported",
+        "2:1",
+        "must be longer in XY",
     );
     check("g84", "G84 X0 Y0 Z-5 R2 F100\n", "1:1", "canned cycle G84");
     check(

@@ -203,8 +203,8 @@ fn run_reports_a_bad_program_with_its_position_before_touching_the_bus() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains(&format!("{}:2:12: word D5", prog.display()))
-            && err.matches("word D5").count() == 1,
+        err.contains(&format!("{}:2:12: D is the tool", prog.display()))
+            && err.matches("D is the tool").count() == 1,
         "{err}"
     );
     assert!(!err.contains("CAN interface"), "{err}");

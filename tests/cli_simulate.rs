@@ -513,6 +513,7 @@ fn a_program_as_linuxcnc_users_write_it_runs_on_every_shipped_machine() {
     std::fs::write(&nc, program).unwrap();
     for name in [
         "paper-ac-table.toml",
+        "xyz-mill.toml",
         "xyzac-trt-mill.toml",
         "xyzbc-trt-mill.toml",
     ] {

@@ -41,7 +41,7 @@
 //! period_ms = 2.0           # optional, default 2.0, allowed 0.1..=100
 //!
 //! [kinematics]
-//! kind = "paper"            # "paper" | "xyzac-trt" | "xyzbc-trt"
+//! kind = "paper"            # "paper" | "xyzac-trt" | "xyzbc-trt" | "xyz" (3 axes, no [axes.a], [axes.c])
 //! # xyzac-trt: a_axis_point = [x, y, z], c_axis_point = [x, y, z]
 //! # xyzbc-trt: b_axis_point = [x, y, z], c_axis_point = [x, y, z]
 //!

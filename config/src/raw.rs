@@ -216,7 +216,8 @@ pub(crate) struct RawAxes {
     pub z: RawAxis,
     pub a: Option<RawAxis>,
     pub b: Option<RawAxis>,
-    pub c: RawAxis,
+    /// Required unless the kinematics is `xyz`.
+    pub c: Option<RawAxis>,
 }
 
 /// One axis. Linear: mm, mm/s, mm/s^2, mm/s^3. Rotary: deg, deg/s, deg/s^2, deg/s^3.

@@ -28,6 +28,12 @@ pub(crate) fn machine(
     let axes = check.axes(&raw.axes, &kinematics)?;
     let interpolation = check.interpolation(&raw.interpolation.unwrap_or_default())?;
     let buses = check.buses(&raw.bus)?;
+    if !kinematics.has_rotary_axes() && !buses.is_empty() {
+        let rule = "runs in simulation only (no [[bus]]): dnurbs's bus machines have five \
+                    axes, each with a drive; a 3-axis machine on a bus is not supported yet"
+            .to_owned();
+        return Err(check.invalid(&["kinematics", "kind"], Some("\"xyz\"".to_owned()), rule));
+    }
     let drives = check.drives(&raw.axes, &axes, &buses)?;
     let spindle = match &raw.spindle {
         Some(r) => Some(spindle::spindle(&check, r, &buses, &drives)?),

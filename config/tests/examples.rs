@@ -140,6 +140,7 @@ fn every_shipped_machine_is_ready_for_real_programs() {
         names,
         [
             "paper-ac-table.toml",
+            "xyz-mill.toml",
             "xyzac-trt-mill.toml",
             "xyzbc-trt-mill.toml"
         ]
@@ -215,6 +216,36 @@ fn xyzbc_trt_uses_the_b_table() {
     assert_eq!(m.axes.tilt_name, RotaryName::B);
     assert_eq!(m.axes.tilt.min, -90.0);
     assert_eq!(m.axes.all()[3].0, "B");
+}
+
+#[test]
+fn xyz_is_a_three_axis_mill_whose_rotary_axes_are_locked() {
+    let three = MINIMAL
+        .split("[axes.a]")
+        .next()
+        .expect("the linear axes")
+        .replace("kind = \"paper\"", "kind = \"xyz\"");
+    let m = parse(&three).unwrap();
+    assert_eq!(m.kinematics, Kinematics::Xyz);
+    assert!(!m.kinematics.has_rotary_axes());
+    for l in [&m.axes.tilt, &m.axes.c] {
+        assert_eq!((l.min, l.max), (0.0, 0.0));
+    }
+    // A rotary table on it is refused by name.
+    let with_c = format!("{three}\n[axes.c]\nvelocity = 1.0\nacceleration = 1.0\njerk = 1.0\n");
+    let (_, shown) = common::fail(&with_c);
+    common::assert_mentions(&shown, &["axes.c", "3-axis mill without rotary axes"]);
+    // So is a bus: dnurbs's bus machines have five axes.
+    let with_bus =
+        format!("{three}\n[[bus]]\nname = \"can0\"\ninterface = \"can0\"\nbitrate = 1000000\n");
+    let (_, shown) = common::fail(&with_bus);
+    common::assert_mentions(&shown, &["kinematics.kind", "simulation only"]);
+    // And the other kinds still need their C table.
+    let (_, shown) = common::fail(&MINIMAL.replace(
+        "[axes.c]\nvelocity = 180.0\nacceleration = 1800.0\njerk = 18000.0\n",
+        "",
+    ));
+    common::assert_mentions(&shown, &["axes.c", "missing"]);
 }
 
 #[test]

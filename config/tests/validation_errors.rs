@@ -53,7 +53,7 @@ fn unknown_kinematics_kind_lists_the_three_kinds() {
         "kinematics",
         "kind",
         "\"xyzac\"",
-        "must be one of \"paper\", \"xyzac-trt\", \"xyzbc-trt\"",
+        "must be one of \"paper\", \"xyzac-trt\", \"xyzbc-trt\", \"xyz\"",
     );
 }
 

@@ -100,11 +100,14 @@ pub enum Kinematics {
         /// A point on the C axis at B = 0.
         c_axis_point: [f64; 3],
     },
+    /// A 3-axis mill: machine XYZ = workpiece XYZ, the tool always vertical. Its rotary axes
+    /// are locked at 0 ([`Axes::locked`]); a program that turns the tool is refused.
+    Xyz,
 }
 
 impl Kinematics {
     /// The `kind` names accepted in `[kinematics]`, in the order of the variants.
-    pub const KINDS: [&'static str; 3] = ["paper", "xyzac-trt", "xyzbc-trt"];
+    pub const KINDS: [&'static str; 4] = ["paper", "xyzac-trt", "xyzbc-trt", "xyz"];
 
     /// The `kind` name as written in the TOML file.
     pub fn kind(&self) -> &'static str {
@@ -112,13 +115,19 @@ impl Kinematics {
             Kinematics::Paper => Self::KINDS[0],
             Kinematics::XyzacTrt { .. } => Self::KINDS[1],
             Kinematics::XyzbcTrt { .. } => Self::KINDS[2],
+            Kinematics::Xyz => Self::KINDS[3],
         }
+    }
+
+    /// Whether the machine has rotary axes (all kinds but `xyz`).
+    pub fn has_rotary_axes(&self) -> bool {
+        *self != Kinematics::Xyz
     }
 
     /// The tilting rotary axis this kinematics has (A or B).
     pub fn tilt_name(&self) -> RotaryName {
         match self {
-            Kinematics::Paper | Kinematics::XyzacTrt { .. } => RotaryName::A,
+            Kinematics::Paper | Kinematics::XyzacTrt { .. } | Kinematics::Xyz => RotaryName::A,
             Kinematics::XyzbcTrt { .. } => RotaryName::B,
         }
     }
@@ -188,6 +197,18 @@ pub struct Axes {
 }
 
 impl Axes {
+    /// The limits of a rotary axis a 3-axis machine does not have: locked at 0 (it never
+    /// moves; rates of 1 deg/s.. are never reached).
+    pub fn locked() -> AxisLimits {
+        AxisLimits {
+            min: 0.0,
+            max: 0.0,
+            velocity: 1.0,
+            acceleration: 1.0,
+            jerk: 1.0,
+        }
+    }
+
     /// All axes with their NC letters, in the order X, Y, Z, A/B, C.
     pub fn all(&self) -> [(&'static str, &AxisLimits); 5] {
         [

@@ -43,7 +43,9 @@ pub fn method_of(m: config::Method) -> Method {
 impl MachineSetup {
     pub fn new(m: &Machine) -> MachineSetup {
         let kin = match &m.kinematics {
-            KinConfig::Paper => MachineKinematics::Paper,
+            // A 3-axis mill is the paper's kinematics with the tool kept vertical (the
+            // parser refuses anything else), so its rotary axes stay at 0.
+            KinConfig::Paper | KinConfig::Xyz => MachineKinematics::Paper,
             KinConfig::XyzacTrt {
                 a_axis_point,
                 c_axis_point,

@@ -96,6 +96,7 @@ pub fn parse_setup(
         g30: machine.g30,
         tools,
         tool_diameters,
+        rotary_axes: machine.kinematics.has_rotary_axes(),
         block_delete: shop.block_delete,
         optional_stop: shop.optional_stop,
         kinematics: Some(crate::setup::MachineSetup::new(machine).kin),

@@ -178,7 +178,7 @@ impl Check<'_, '_> {
             ("y", Some(&raw.y), &axes.y),
             ("z", Some(&raw.z), &axes.z),
             (tilt_key, tilt, &axes.tilt),
-            ("c", Some(&raw.c), &axes.c),
+            ("c", raw.c.as_ref(), &axes.c),
         ];
         let mut out: Vec<Drive> = Vec::new();
         for (axis, (key, raw_axis, limits)) in keyed.iter().enumerate() {

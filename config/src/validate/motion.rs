@@ -22,8 +22,8 @@ impl Check<'_, '_> {
 
     pub(super) fn kinematics(&self, k: &RawKinematics) -> Result<Kinematics, ConfigError> {
         let Some(kind) = Kind::parse(&k.kind) else {
-            let [paper, ac, bc] = Kinematics::KINDS;
-            let rule = format!("must be one of \"{paper}\", \"{ac}\", \"{bc}\"");
+            let [paper, ac, bc, xyz] = Kinematics::KINDS;
+            let rule = format!("must be one of \"{paper}\", \"{ac}\", \"{bc}\", \"{xyz}\"");
             let shown = Some(format!("{:?}", k.kind));
             return Err(self.invalid(&["kinematics", "kind"], shown, rule));
         };
@@ -71,10 +71,34 @@ impl Check<'_, '_> {
                 b_axis_point: point("b_axis_point", k.b_axis_point, "B")?,
                 c_axis_point: point("c_axis_point", k.c_axis_point, "C (at B = 0)")?,
             },
+            Kind::Xyz => Kinematics::Xyz,
         })
     }
 
     pub(super) fn axes(&self, a: &RawAxes, kin: &Kinematics) -> Result<Axes, ConfigError> {
+        if !kin.has_rotary_axes() {
+            let given = [
+                ("a", a.a.is_some()),
+                ("b", a.b.is_some()),
+                ("c", a.c.is_some()),
+            ];
+            if let Some((key, _)) = given.into_iter().find(|(_, g)| *g) {
+                let rule = format!(
+                    "kinematics kind \"{}\" is a 3-axis mill without rotary axes: remove \
+                     [axes.{key}]",
+                    kin.kind()
+                );
+                return Err(self.missing(&["axes", key], rule));
+            }
+            return Ok(Axes {
+                x: self.axis("x", &a.x, LINEAR, false)?,
+                y: self.axis("y", &a.y, LINEAR, false)?,
+                z: self.axis("z", &a.z, LINEAR, false)?,
+                tilt_name: kin.tilt_name(),
+                tilt: Axes::locked(),
+                c: Axes::locked(),
+            });
+        }
         let tilt_name = kin.tilt_name();
         let (tilt, other, other_name) = match tilt_name {
             RotaryName::A => (&a.a, &a.b, RotaryName::B),
@@ -102,7 +126,16 @@ impl Check<'_, '_> {
             z: self.axis("z", &a.z, LINEAR, false)?,
             tilt_name,
             tilt: self.axis(want, tilt, ROTARY, false)?,
-            c: self.axis("c", &a.c, ROTARY, true)?,
+            c: match &a.c {
+                Some(c) => self.axis("c", c, ROTARY, true)?,
+                None => {
+                    let rule = format!(
+                        "missing: kinematics kind \"{kind}\" needs [axes.c] for its rotary \
+                         table (deg, deg/s, deg/s^2, deg/s^3; no min/max: continuous)"
+                    );
+                    return Err(self.missing(&["axes", "c"], rule));
+                }
+            },
         })
     }
 
@@ -243,15 +276,17 @@ enum Kind {
     Paper,
     XyzacTrt,
     XyzbcTrt,
+    Xyz,
 }
 
 impl Kind {
     fn parse(name: &str) -> Option<Kind> {
-        let [paper, ac, bc] = Kinematics::KINDS;
+        let [paper, ac, bc, xyz] = Kinematics::KINDS;
         match name {
             n if n == paper => Some(Kind::Paper),
             n if n == ac => Some(Kind::XyzacTrt),
             n if n == bc => Some(Kind::XyzbcTrt),
+            n if n == xyz => Some(Kind::Xyz),
             _ => None,
         }
     }
@@ -259,7 +294,7 @@ impl Kind {
     /// The point keys this kind requires (and the only ones it accepts).
     fn points(self) -> &'static [&'static str] {
         match self {
-            Kind::Paper => &[],
+            Kind::Paper | Kind::Xyz => &[],
             Kind::XyzacTrt => &["a_axis_point", "c_axis_point"],
             Kind::XyzbcTrt => &["b_axis_point", "c_axis_point"],
         }

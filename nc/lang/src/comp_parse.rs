@@ -53,6 +53,21 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// Refuses a mode change compensation does not allow (LinuxCNC's rules), or does not
+    /// support in dnurbs.
+    pub(super) fn comp_allows(&self, code: Code, pos: SrcPos) -> Result<(), ParseError> {
+        match code {
+            Code::Plane(p) if p != self.modal.plane => self.comp_forbids("a plane change", pos),
+            Code::Inch(i) if i != self.modal.inch => self.comp_forbids("a change of units", pos),
+            Code::WorkOffset(i) if i != self.modal.work => {
+                self.comp_forbids("a change of work offset", pos)
+            }
+            Code::Blend(_) => self.comp_forbids("a path-control mode (G61/G64)", pos),
+            Code::InverseTime(true) => self.comp_unsupported("G93 inverse-time feed", pos),
+            _ => Ok(()),
+        }
+    }
+
     /// A line's `G40`/`G41`/`G42`/`G41.1`/`G42.1` and its `D` word.
     pub(super) fn radius_comp(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
         let code = line.code_of_group(6);

@@ -146,6 +146,8 @@ pub enum ParseErrorKind {
     CompensationGouge { what: &'static str },
     #[error("cutter radius compensation failed: {what} (please report this program)")]
     CompensationInternal { what: &'static str },
+    #[error("{what} needs rotary axes: this machine (kinematics \"xyz\") is a 3-axis mill and keeps the tool vertical")]
+    NoRotaryAxes { what: &'static str },
     #[error("the move just after G40 must be straight, not {motion} (the tool is still off the programmed path; LinuxCNC's rule)")]
     ArcAfterCompensation { motion: Motion },
     #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]

@@ -58,6 +58,9 @@ pub struct Setup {
     pub io: Io,
     /// The M-codes the machine defines and what each does (the machine file's `[mcodes]`).
     pub user_mcodes: BTreeMap<u32, nc_geom::program::UserAction>,
+    /// The machine has rotary axes. Off (a 3-axis mill, kinematics `xyz`): the tool stays
+    /// vertical, and `A B C` words, tool vectors and `G06.5` blocks are refused.
+    pub rotary_axes: bool,
 }
 
 /// How many inputs and outputs of each kind the machine has: `M62 P<n>` needs
@@ -88,6 +91,7 @@ impl Default for Setup {
             max_feed_mm_min: None,
             io: Io::default(),
             user_mcodes: BTreeMap::new(),
+            rotary_axes: true,
         }
     }
 }

@@ -435,7 +435,12 @@ impl Parser<'_> {
                     *slot = line.value(letter).ok_or(missing.at(given.pos))?;
                 }
                 let zero = ParseErrorKind::ZeroVector { ijk }.at(given.pos);
-                Ok(Orientation::Vector(normalise(ijk).ok_or(zero)?))
+                let v = normalise(ijk).ok_or(zero)?;
+                if !self.setup.rotary_axes && v != [0.0, 0.0, 1.0] {
+                    let what = "a tool vector other than I0 J0 K1";
+                    return Err(ParseErrorKind::NoRotaryAxes { what }.at(given.pos));
+                }
+                Ok(Orientation::Vector(v))
             }
             (Some(_), None) => self
                 .angles(line)

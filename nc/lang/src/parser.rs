@@ -133,6 +133,16 @@ impl<'s> Parser<'s> {
             return Err(kind.at(first.pos));
         }
         let line = Line::classify(words, &self.setup.user_mcodes)?;
+        if !self.setup.rotary_axes {
+            if let Some(w) = line.first_of("ABC") {
+                let what = match w.letter {
+                    'A' => "an A word",
+                    'B' => "a B word",
+                    _ => "a C word",
+                };
+                return Err(ParseErrorKind::NoRotaryAxes { what }.at(w.pos));
+            }
+        }
         if self.skipping {
             if line.knots_only || (!line.has_codes && line.first_of("KRUVW").is_some()) {
                 return Ok(());
@@ -482,6 +492,10 @@ impl<'s> Parser<'s> {
         motion: Motion,
         pos: SrcPos,
     ) -> Result<(), ParseError> {
+        if motion == Motion::G065 && !self.setup.rotary_axes {
+            let what = "a G06.5 block (its second curve turns the tool)";
+            return Err(ParseErrorKind::NoRotaryAxes { what }.at(pos));
+        }
         if self.modal.incremental {
             return Err(ParseErrorKind::NurbsIncremental { motion }.at(pos));
         }
@@ -517,23 +531,6 @@ impl<'s> Parser<'s> {
         }
         self.just_closed = Some((block.pos, block.knots.len()));
         self.blocks.push(Block::Nurbs(block));
-    }
-}
-
-impl Parser<'_> {
-    /// Refuses a mode change compensation does not allow (LinuxCNC's rules), or does not
-    /// support in dnurbs.
-    fn comp_allows(&self, code: Code, pos: SrcPos) -> Result<(), ParseError> {
-        match code {
-            Code::Plane(p) if p != self.modal.plane => self.comp_forbids("a plane change", pos),
-            Code::Inch(i) if i != self.modal.inch => self.comp_forbids("a change of units", pos),
-            Code::WorkOffset(i) if i != self.modal.work => {
-                self.comp_forbids("a change of work offset", pos)
-            }
-            Code::Blend(_) => self.comp_forbids("a path-control mode (G61/G64)", pos),
-            Code::InverseTime(true) => self.comp_unsupported("G93 inverse-time feed", pos),
-            _ => Ok(()),
-        }
     }
 }
 

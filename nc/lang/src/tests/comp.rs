@@ -176,3 +176,23 @@ fn a_notch_narrower_than_the_tool_is_a_gouge_at_the_move_that_makes_it() {
     let kind = fails(src, 6, 1);
     assert!(matches!(kind, E::CompensationGouge { .. }), "{kind:?}");
 }
+
+#[test]
+fn a_three_axis_machine_refuses_what_turns_the_tool_at_its_word() {
+    let xyz = Setup {
+        rotary_axes: false,
+        ..Setup::default()
+    };
+    let fails_on = |src: &str| parse_with(src, &xyz).expect_err(src).errors[0];
+    let e = fails_on("G0 X0 Y0 Z0\nG1 X1 C90 F100");
+    assert_eq!(
+        (e.kind, e.pos),
+        (E::NoRotaryAxes { what: "a C word" }, at(2, 7))
+    );
+    let e = fails_on("G0 X0 Y0 Z0 I0 J1 K1");
+    assert!(matches!(e.kind, E::NoRotaryAxes { .. }) && e.pos == at(1, 13));
+    let e = fails_on("G0 X0 Y0 Z0\nG06.5 P1 X0 Y0 Z0 U0 V0 W1 K0");
+    assert!(matches!(e.kind, E::NoRotaryAxes { .. }) && e.pos == at(2, 1));
+    // A vertical tool vector and everything else a 3-axis program writes are read.
+    assert!(parse_with("G0 X0 Y0 Z0 I0 J0 K2\nG1 X5 F100\nG2 X10 I2.5 J0\nM2", &xyz).is_ok());
+}
