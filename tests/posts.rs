@@ -460,8 +460,16 @@ fn spindle_and_coolant_as_programmed(
         v.dedup();
         v
     };
-    assert_eq!(sent(spindle.node), speeds, "{name}: spindle targets");
-    assert_eq!(sent(coolant.node), valves, "{name}: coolant outputs");
+    assert_eq!(
+        sent(spindle.at.expect("the spindle on a bus").node),
+        speeds,
+        "{name}: spindle targets"
+    );
+    assert_eq!(
+        sent(coolant.at.expect("the coolant module on a bus").node),
+        valves,
+        "{name}: coolant outputs"
+    );
 }
 
 /// The axes' targets (counts, in node order) where the program's first feed move starts,
@@ -509,7 +517,7 @@ fn spindle_at_speed_before_the_first_feed_move(
         .find(|&k| axis(k) != rest)
         .unwrap_or_else(|| panic!("{name}: the axes never leave {rest:?}"));
     // Every node records every SYNC in operational, so index k is the same SYNC for all.
-    let sp = &records[usize::from(spindle.node)];
+    let sp = &records[usize::from(spindle.at.expect("the spindle on a bus").node)];
     assert_eq!(sp.len(), n, "{name}: spindle records");
     let before = &sp[leave - 1];
     let want = spindle.velocity(rpm);
@@ -560,7 +568,7 @@ fn coolant_on_for_the_cut_and_off_at_the_end(
     }
     let want = coolant.outputs(aux.mist, aux.flood);
     assert_ne!(want, 0, "{name}: the post turns coolant on before cutting");
-    let io = &records[usize::from(coolant.node)];
+    let io = &records[usize::from(coolant.at.expect("the coolant module on a bus").node)];
     let on: Vec<usize> = (0..io.len())
         .filter(|&k| io[k].target_counts == i32::from(want))
         .collect();

@@ -293,7 +293,8 @@ fn vcan_run_cam_post_with_spindle_and_coolant_on_the_bus() {
             .copied()
             .collect()
     };
-    let (sp, io) = (of(spindle.node), of(coolant.node));
+    let node = |at: Option<config::BusNode>| at.expect("on the bus").node;
+    let (sp, io) = (of(node(spindle.at)), of(node(coolant.at)));
     let want = i64::from(spindle.velocity(rpm));
     assert!(
         sp.iter().any(|r| r[2] == want && (r[3] - want).abs() <= 1),

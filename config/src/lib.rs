@@ -130,8 +130,8 @@ use std::path::Path;
 pub use error::{ConfigError, LineCol, Location};
 // The types a machine file is read into, defined below the file's parsing (crate `machine`).
 pub use machine::{
-    bus, Axes, AxisLimits, Compress, Coolant, Interpolation, IoCounts, Kinematics, Machine,
-    McodeAction, Method, Realtime, RotaryName, Spindle, Tool, UnknownMethod,
+    bus, Axes, AxisLimits, BusNode, Compress, Coolant, Interpolation, IoCounts, Kinematics,
+    Machine, McodeAction, Method, Realtime, RotaryName, Spindle, Tool, UnknownMethod,
 };
 
 /// Reads and validates the machine configuration file at `path`.

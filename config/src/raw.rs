@@ -65,8 +65,9 @@ pub(crate) struct RawProgram {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawSpindle {
-    pub bus: String,
-    pub node: i64,
+    /// Both absent on a simulated machine (no `[[bus]]`).
+    pub bus: Option<String>,
+    pub node: Option<i64>,
     /// Highest programmable speed, rpm.
     pub max_rpm: f64,
     /// Ramp up and down, rpm/s.
@@ -87,8 +88,9 @@ pub(crate) struct RawSpindle {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawCoolant {
-    pub bus: String,
-    pub node: i64,
+    /// Both absent on a simulated machine (no `[[bus]]`).
+    pub bus: Option<String>,
+    pub node: Option<i64>,
     /// Output (1..=8 of 0x6200:01) switched by M07.
     pub mist_output: Option<i64>,
     /// Output switched by M08.

@@ -52,9 +52,9 @@ pub(crate) fn machine(
     let nodes: Vec<bus::Nodes> = (0..buses.len())
         .map(|i| bus::Nodes {
             drives: (drives.iter().filter(|d| d.bus == i).count()
-                + usize::from(spindle.as_ref().is_some_and(|s| s.bus == i)))
+                + usize::from(spindle.as_ref().is_some_and(|s| s.on_bus(i).is_some())))
                 as u32,
-            io: u32::from(coolant.as_ref().is_some_and(|c| c.bus == i)),
+            io: u32::from(coolant.as_ref().is_some_and(|c| c.on_bus(i).is_some())),
         })
         .collect();
     let bus_overload = check.bus_load(&buses, &nodes, period_s);

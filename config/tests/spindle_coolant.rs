@@ -31,7 +31,8 @@ const COOLANT: &str = "[coolant]\nbus = \"can0\"\nnode = 7\nflood_output = 2\n";
 fn spindle_and_coolant_with_their_defaults() {
     let m = common::parse(&machine("4.0", &format!("{SPINDLE}{COOLANT}"))).unwrap();
     let s = m.spindle.as_ref().unwrap();
-    assert_eq!((s.bus, s.node, s.sign), (0, 6, 1));
+    assert_eq!(s.at, Some(config::BusNode { bus: 0, node: 6 }));
+    assert_eq!((s.on_bus(0), s.on_bus(1), s.sign), (Some(6), None, 1));
     assert_eq!(s.quick_stop_rpm_s, 16000.0, "twice the acceleration");
     assert_eq!(s.at_speed_window_rpm, 240.0, "1 % of max_rpm");
     assert_eq!(s.at_speed_timeout_s, 5.0, "the full ramp + 2 s");
@@ -44,6 +45,25 @@ fn spindle_and_coolant_with_their_defaults() {
     assert_eq!((n.drives, n.io), (6, 1));
     assert_eq!(config::bus::cycle_bits(n), 1565);
     assert_eq!(m.check_bus_load(), Ok(()));
+}
+
+#[test]
+fn a_simulated_machine_has_them_without_a_bus() {
+    let sim = |extra: &str| format!("{MINIMAL}\n{extra}");
+    let spindle = "[spindle]\nmax_rpm = 24000\nacceleration_rpm_s = 8000\n";
+    let coolant = "[coolant]\nmist_output = 1\nflood_output = 2\n";
+    let m = common::parse(&sim(&format!("{spindle}{coolant}"))).unwrap();
+    let (s, c) = (m.spindle.clone().unwrap(), m.coolant.clone().unwrap());
+    assert_eq!((s.at, s.max_rpm, c.at), (None, 24000.0, None));
+    assert_eq!(m.bus_nodes(0).drives, 0);
+    // A bus or a node named on a machine without [[bus]] is refused by name.
+    let (_, shown) = fail(&sim(SPINDLE));
+    assert_mentions(&shown, &["spindle.bus", "no [[bus]]"]);
+    let (_, shown) = fail(&sim("[coolant]\nnode = 7\nflood_output = 2\n"));
+    assert_mentions(&shown, &["coolant.node", "omit node"]);
+    // And a machine with a bus needs them on it.
+    let (_, shown) = fail(&machine("4.0", spindle));
+    assert_mentions(&shown, &["spindle.bus", "needs bus and node"]);
 }
 
 #[test]

@@ -15,7 +15,7 @@ pub mod program;
 pub mod spindle;
 
 pub use program::{IoCounts, McodeAction, ProgramSetup, Tool};
-pub use spindle::{Coolant, Spindle};
+pub use spindle::{BusNode, Coolant, Spindle};
 
 /// A validated machine configuration.
 #[derive(Clone, Debug, PartialEq)]
@@ -64,10 +64,18 @@ impl Machine {
     /// What bus `bus` carries each cycle: the axes' drives, the spindle, the coolant module.
     pub fn bus_nodes(&self, bus: usize) -> crate::bus::Nodes {
         let drives = self.drives.iter().filter(|d| d.bus == bus).count()
-            + usize::from(self.spindle.as_ref().is_some_and(|s| s.bus == bus));
+            + usize::from(
+                self.spindle
+                    .as_ref()
+                    .is_some_and(|s| s.on_bus(bus).is_some()),
+            );
         crate::bus::Nodes {
             drives: drives as u32,
-            io: u32::from(self.coolant.as_ref().is_some_and(|c| c.bus == bus)),
+            io: u32::from(
+                self.coolant
+                    .as_ref()
+                    .is_some_and(|c| c.on_bus(bus).is_some()),
+            ),
         }
     }
 

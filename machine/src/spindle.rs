@@ -3,14 +3,22 @@
 //! valves. Both sit on a `[[bus]]` with the axes' drives; node ids are unique per bus.
 //!
 //! A machine without them still runs programs that use `S`, `M03`..`M05`, `M07`..`M09`:
-//! the words are reported in the run's summary and do nothing.
+//! the words are reported in the run's summary and do nothing. A simulated machine (no
+//! `[[bus]]`) may have them without a bus: `simulate` then checks `S` against `max_rpm` and
+//! times the spindle's ramps.
+
+/// Where a device is: its bus (index into [`crate::Machine::buses`]) and CANopen node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BusNode {
+    pub bus: usize,
+    pub node: u8,
+}
 
 /// The spindle drive.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Spindle {
-    /// Index into [`crate::Machine::buses`].
-    pub bus: usize,
-    pub node: u8,
+    /// Its drive on the bus; `None` on a simulated machine.
+    pub at: Option<BusNode>,
     /// Highest programmable speed, rpm: an `S` above it is refused with its line.
     pub max_rpm: f64,
     /// Ramp up and down (0x6083, 0x6084), rpm/s.
@@ -28,6 +36,11 @@ pub struct Spindle {
 }
 
 impl Spindle {
+    /// Its node, if it is on bus `bus`.
+    pub fn on_bus(&self, bus: usize) -> Option<u8> {
+        self.at.filter(|a| a.bus == bus).map(|a| a.node)
+    }
+
     /// Drive velocity units for a signed speed (rpm; `M04` negative). Saturates; the
     /// machine file guarantees `max_rpm` fits.
     pub fn velocity(&self, rpm: f64) -> i32 {
@@ -62,9 +75,8 @@ impl Spindle {
 /// The coolant valves.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Coolant {
-    /// Index into [`crate::Machine::buses`].
-    pub bus: usize,
-    pub node: u8,
+    /// Its I/O module on the bus; `None` on a simulated machine.
+    pub at: Option<BusNode>,
     /// Output 1..=8 switched by `M07`, if the machine has mist.
     pub mist_output: Option<u8>,
     /// Output 1..=8 switched by `M08`, if the machine has flood.
@@ -72,6 +84,11 @@ pub struct Coolant {
 }
 
 impl Coolant {
+    /// Its node, if it is on bus `bus`.
+    pub fn on_bus(&self, bus: usize) -> Option<u8> {
+        self.at.filter(|a| a.bus == bus).map(|a| a.node)
+    }
+
     /// The byte written to 0x6200:01 (bit 0 = output 1). Real-time thread: an output
     /// outside 1..=8 (which the machine file refuses) switches nothing, it does not panic.
     pub fn outputs(&self, mist: bool, flood: bool) -> u8 {

@@ -164,8 +164,8 @@ pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
         .filter(|d| d.bus == bus)
         .filter_map(|d| NodeId::new(d.node).map(NodeSetup::Position))
         .collect();
-    if let Some(s) = machine.spindle.as_ref().filter(|s| s.bus == bus) {
-        if let Some(n) = NodeId::new(s.node) {
+    if let Some(s) = machine.spindle.as_ref() {
+        if let Some(n) = s.on_bus(bus).and_then(NodeId::new) {
             let setup = VelocitySetup {
                 ramp: s.ramp_units(s.acceleration_rpm_s),
                 quick_stop: s.ramp_units(s.quick_stop_rpm_s),
@@ -175,8 +175,8 @@ pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
             v.push(NodeSetup::Velocity(n, setup));
         }
     }
-    if let Some(c) = machine.coolant.as_ref().filter(|c| c.bus == bus) {
-        v.extend(NodeId::new(c.node).map(NodeSetup::Io));
+    if let Some(node) = machine.coolant.as_ref().and_then(|c| c.on_bus(bus)) {
+        v.extend(NodeId::new(node).map(NodeSetup::Io));
     }
     v
 }

@@ -77,17 +77,17 @@ pub fn sim_nodes(
             Some(c)
         })
         .collect();
-    if let Some(s) = m.spindle.as_ref().filter(|s| s.bus == bus) {
-        if let Some(n) = NodeId::new(s.node) {
+    if let Some(node) = m.spindle.as_ref().and_then(|s| s.on_bus(bus)) {
+        if let Some(n) = NodeId::new(node) {
             let mut c = SimNodeConfig::new(n);
-            c.faults = faults.for_node(s.node);
+            c.faults = faults.for_node(node);
             nodes.push(c);
         }
     }
-    if let Some(io) = m.coolant.as_ref().filter(|c| c.bus == bus) {
-        if let Some(n) = NodeId::new(io.node) {
+    if let Some(node) = m.coolant.as_ref().and_then(|c| c.on_bus(bus)) {
+        if let Some(n) = NodeId::new(node) {
             let mut c = SimNodeConfig::io(n);
-            c.faults = faults.for_node(io.node);
+            c.faults = faults.for_node(node);
             nodes.push(c);
         }
     }

@@ -5,7 +5,44 @@ use crate::check::{Check, MAX_POSITIVE};
 use crate::error::ConfigError;
 use crate::raw::{RawCoolant, RawSpindle};
 use machine::bus::{Bus, Drive};
-use machine::{Coolant, Spindle};
+use machine::{BusNode, Coolant, Spindle};
+
+/// Where `[section]` is: on its bus at a free node, or nowhere on a simulated machine (no
+/// `[[bus]]`; then it must not name one).
+fn place(
+    check: &Check<'_, '_>,
+    section: &str,
+    (bus, node): (Option<&str>, Option<i64>),
+    buses: &[Bus],
+    taken: &[(usize, u8)],
+) -> Result<Option<BusNode>, ConfigError> {
+    match (bus, node, buses.is_empty()) {
+        (None, None, true) => Ok(None),
+        (Some(name), Some(node), false) => {
+            let bus = bus_index(check, section, name, buses)?;
+            let node = node_free(check, section, node, bus, buses, taken)?;
+            Ok(Some(BusNode { bus, node }))
+        }
+        (Some(name), _, true) => {
+            let rule = "names no bus: this machine has no [[bus]] (it is simulated); omit bus \
+                        and node, or add the [[bus]]"
+                .to_owned();
+            Err(check.invalid(&[section, "bus"], Some(format!("{name:?}")), rule))
+        }
+        (None, Some(node), true) => {
+            let rule = "a simulated machine (no [[bus]]) has no nodes: omit node".to_owned();
+            Err(check.invalid(&[section, "node"], Some(node.to_string()), rule))
+        }
+        (None, _, false) => Err(check.missing(
+            &[section, "bus"],
+            "missing: a machine with [[bus]] tables needs bus and node".into(),
+        )),
+        (Some(_), None, false) => Err(check.missing(
+            &[section, "node"],
+            "missing: the CANopen node id 1..=127 on its bus".into(),
+        )),
+    }
+}
 
 /// The node on `bus` is not used by an axis (or, for the coolant, by the spindle).
 fn node_free(
@@ -60,9 +97,14 @@ pub(crate) fn spindle(
     buses: &[Bus],
     drives: &[Drive],
 ) -> Result<Spindle, ConfigError> {
-    let bus = bus_index(check, "spindle", &raw.bus, buses)?;
     let taken: Vec<(usize, u8)> = drives.iter().map(|d| (d.bus, d.node)).collect();
-    let node = node_free(check, "spindle", raw.node, bus, buses, &taken)?;
+    let at = place(
+        check,
+        "spindle",
+        (raw.bus.as_deref(), raw.node),
+        buses,
+        &taken,
+    )?;
     let max_rpm = check.positive(&["spindle", "max_rpm"], raw.max_rpm, "rpm")?;
     let acceleration_rpm_s = check.positive(
         &["spindle", "acceleration_rpm_s"],
@@ -128,8 +170,7 @@ pub(crate) fn spindle(
         None => (max_rpm / acceleration_rpm_s + 2.0).min(600.0),
     };
     Ok(Spindle {
-        bus,
-        node,
+        at,
         max_rpm,
         acceleration_rpm_s,
         quick_stop_rpm_s,
@@ -147,10 +188,15 @@ pub(crate) fn coolant(
     drives: &[Drive],
     spindle: Option<&Spindle>,
 ) -> Result<Coolant, ConfigError> {
-    let bus = bus_index(check, "coolant", &raw.bus, buses)?;
     let mut taken: Vec<(usize, u8)> = drives.iter().map(|d| (d.bus, d.node)).collect();
-    taken.extend(spindle.map(|s| (s.bus, s.node)));
-    let node = node_free(check, "coolant", raw.node, bus, buses, &taken)?;
+    taken.extend(spindle.and_then(|s| s.at).map(|a| (a.bus, a.node)));
+    let at = place(
+        check,
+        "coolant",
+        (raw.bus.as_deref(), raw.node),
+        buses,
+        &taken,
+    )?;
     let output = |key: &str, v: Option<i64>| -> Result<Option<u8>, ConfigError> {
         match v {
             None => Ok(None),
@@ -175,8 +221,7 @@ pub(crate) fn coolant(
             "must differ from mist_output".into(),
         )),
         _ => Ok(Coolant {
-            bus,
-            node,
+            at,
             mist_output,
             flood_output,
         }),

@@ -171,11 +171,11 @@ pub fn busload(machine: &Path) -> anyhow::Result<Outcome> {
             .map(|d| format!("{}=node {}", m.axes.all()[d.axis].0, d.node))
             .collect();
         let mut drives = drives;
-        if let Some(s) = m.spindle.as_ref().filter(|s| s.bus == i) {
-            drives.push(format!("spindle=node {}", s.node));
+        if let Some(node) = m.spindle.as_ref().and_then(|s| s.on_bus(i)) {
+            drives.push(format!("spindle=node {node}"));
         }
-        if let Some(c) = m.coolant.as_ref().filter(|c| c.bus == i) {
-            drives.push(format!("coolant I/O=node {}", c.node));
+        if let Some(node) = m.coolant.as_ref().and_then(|c| c.on_bus(i)) {
+            drives.push(format!("coolant I/O=node {node}"));
         }
         let n = m.bus_nodes(i);
         println!(

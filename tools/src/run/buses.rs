@@ -47,10 +47,10 @@ pub(super) fn set_up<L: CanLink, C: Clock>(
         .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives on one bus"))?;
     let mut bus = BusDrives::new(master, &drives)
         .ok_or_else(|| anyhow::anyhow!("{bus_name}: too many drives"))?;
-    if let Some(s) = machine.spindle.as_ref().filter(|s| s.bus == bi) {
+    if let Some(s) = machine.spindle.as_ref().filter(|s| s.on_bus(bi).is_some()) {
         bus = bus.with_spindle(s.clone());
     }
-    if let Some(c) = machine.coolant.as_ref().filter(|c| c.bus == bi) {
+    if let Some(c) = machine.coolant.as_ref().filter(|c| c.on_bus(bi).is_some()) {
         bus = bus.with_coolant(c.clone());
     }
     Ok(bus)

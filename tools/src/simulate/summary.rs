@@ -44,6 +44,8 @@ struct SpindleTally {
     count: u32,
     /// Sum of the speed changes at the waits, rpm.
     steps_rpm: f64,
+    /// The speed the spindle last reached: at the last wait, or 0 once stopped. (Rapids
+    /// after a start do not wait, so the speed they carry is not yet reached.)
     rpm: f64,
 }
 
@@ -52,8 +54,10 @@ impl SpindleTally {
         if seg.wait.spindle {
             self.count += 1;
             self.steps_rpm += (seg.aux.spindle_rpm - self.rpm).abs();
+            self.rpm = seg.aux.spindle_rpm;
+        } else if seg.aux.spindle_rpm == 0.0 {
+            self.rpm = 0.0;
         }
-        self.rpm = seg.aux.spindle_rpm;
     }
 }
 
