@@ -278,7 +278,11 @@ pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
     if let Some((_, code)) = G_CODES.iter().find(|(v, _)| *v == value) {
         return Ok(*code);
     }
-    Err(if (73.0..=89.0).contains(&value) && value.fract() == 0.0 {
+    Err(if [38.2, 38.3, 38.4, 38.5].contains(&value) {
+        ParseErrorKind::Probing { code: value }
+    } else if [33.0, 33.1, 76.0].contains(&value) {
+        ParseErrorKind::SpindleSynchronised { code: value }
+    } else if (73.0..=89.0).contains(&value) && value.fract() == 0.0 {
         ParseErrorKind::CannedCycle { code: value }
     } else {
         ParseErrorKind::UnsupportedGCode { code: value }

@@ -152,6 +152,10 @@ pub enum ParseErrorKind {
     ArcAfterCompensation { motion: Motion },
     #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]
     CannedCycle { code: f64 },
+    #[error("probing {} is not supported: dnurbs plans the whole program before the machine moves, and a probe's result (#5061..#5070) is only known when it touches", Code('G', *.code))]
+    Probing { code: f64 },
+    #[error("spindle-synchronised motion {} (threading, rigid tapping) is not supported: dnurbs's spindle is not an axis the path follows", Code('G', *.code))]
+    SpindleSynchronised { code: f64 },
     #[error("program number O{value} must stand alone on its line (after an optional N)")]
     MisplacedProgramNumber { value: f64 },
     #[error("word {letter} after the program end at {end}: only blank lines, comments and `%` may follow M02/M30")]

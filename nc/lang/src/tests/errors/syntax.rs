@@ -170,6 +170,12 @@ fn canned_cycles_dnurbs_does_not_run_are_refused_by_name() {
         E::CannedCycle { code: 84.0 }
     );
     assert!(message("G87").contains("post the cycle expanded into G00/G01 moves"));
+    assert_eq!(fails("G38.2 Z-10 F100", 1, 1), E::Probing { code: 38.2 });
+    assert_eq!(
+        fails("G33.1 Z-10 K1", 1, 1),
+        E::SpindleSynchronised { code: 33.1 }
+    );
+    assert!(message("G76 P1 Z-1 I-0.1 J0.1 K0.1").contains("threading"));
 }
 
 #[test]
