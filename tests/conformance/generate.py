@@ -463,6 +463,80 @@ def polar_program(r, k):
     return lines
 
 
+def turns_program(r, k):
+    """Arcs of several turns (P), full circles and helices, in every plane, IJK and R forms,
+    G90 and G91, mm and inch."""
+    inch = r.random() < 0.3
+    unit = 25.4 if inch else 1.0
+    lines = ["(multi-turn arcs %d)" % k, "G20" if inch else "G21", "G90", "G0 X0 Y0 Z0",
+             "F%d" % r.randint(50, 500)]
+    for _ in range(r.randint(2, 5)):
+        plane = r.choice([17, 18, 19])
+        lines.append("G%d" % plane)
+        first, second = {17: ("X", "Y"), 18: ("Z", "X"), 19: ("Y", "Z")}[plane]
+        offs = {17: ("I", "J"), 18: ("K", "I"), 19: ("J", "K")}[plane]
+        axis = {17: "Z", 18: "Y", 19: "X"}[plane]
+        rad = r.uniform(1, 20) / unit
+        words = "%s%s %s%s" % (offs[0], fmt(rad), offs[1], fmt(0))
+        g91 = r.random() < 0.3
+        if r.random() < 0.5:
+            # A full circle (or a helix) of several turns back over the start.
+            end = "%s%s" % (axis, fmt(r.uniform(-5, 5) / unit)) if r.random() < 0.6 else ""
+            if g91:
+                lines.append("G91 %s %s %s P%d" % (r.choice(["G2", "G3"]), end, words, r.randint(2, 6)))
+                lines.append("G90")
+            else:
+                lines.append("%s %s %s P%d" % (r.choice(["G2", "G3"]), end, words, r.randint(2, 6)))
+            lines.append("G0 X0 Y0 Z0")
+        else:
+            # To a point a quarter round, then more turns.
+            a = r.choice([1, -1])
+            lines.append("G0 X0 Y0 Z0")
+            lines.append("%s %s%s %s%s %s P%d" % (r.choice(["G2", "G3"]), first, fmt(rad), second,
+                                               fmt(a * rad), words, r.randint(1, 4)))
+            lines.append("G0 X0 Y0 Z0")
+    lines.append("M2")
+    return lines
+
+
+def g10_program(r, k):
+    """G10 L2 and L20 on every work offset (P0 the one in effect), G10 L1 tool lengths and
+    radii used by G43 and G41, in mm and inch."""
+    inch = r.random() < 0.3
+    lines = ["(G10 tables %d)" % k, "G20" if inch else "G21", "G17 G90 G40 G49 G54",
+             "G0 X0 Y0 Z0", "F%d" % r.randint(50, 500)]
+    for _ in range(r.randint(3, 8)):
+        c = r.random()
+        if c < 0.35:
+            p = r.randint(0, 6)
+            axes = [a for a in "XYZ" if r.random() < 0.7] or ["X"]
+            words = " ".join("%s%s" % (a, num(r, -20, 20)) for a in axes)
+            lines.append("G10 L%d P%d %s" % (r.choice([2, 20]), p, words))
+            lines.append("G%d" % r.choice([54, 55, 56, 57, 58, 59]))
+            lines.append("G0 X%s Y%s Z%s" % (num(r, -10, 10), num(r, -10, 10), num(r, 0, 10)))
+            # (The offsets' parameters, #5221.., are in the machine's units: rs274's are inches,
+            # dnurbs's mm, so they are checked by nc-lang's unit tests, not here.)
+            lines.append("G1 X%s Y%s" % (num(r, -10, 10), num(r, -5, 5)))
+        elif c < 0.55:
+            tool = r.randint(1, 3)
+            lines.append("G10 L1 P%d Z%s R%s" % (tool, num(r, 0, 3), num(r, 0.05, 0.4)))
+            lines.append("G43 H%d" % tool)
+            lines.append("G1 Z%s" % num(r, 0, 5))
+        elif c < 0.7:
+            tool = r.randint(1, 3)
+            lines.append("G10 L1 P%d R%s" % (tool, num(r, 0.05, 0.3)))
+            lines.append("G0 X-15 Y-15")
+            lines.append("G41 D%d G1 X0 Y0" % tool)
+            lines.append("G1 X10")
+            lines.append("G1 Y10")
+            lines.append("G40 G1 X15 Y15")
+        else:
+            lines.append("G1 X%s Y%s" % (num(r, -10, 10), num(r, -10, 10)))
+    lines.append("G54")
+    lines.append("M2")
+    return lines
+
+
 def comp_program(r, k):
     """Cutter radius compensation on random closed contours of lines and arcs (convex and
     concave corners, tangent and sharp), G41/G42 by tool number (rs274's default table) and
@@ -538,7 +612,8 @@ def comp_program(r, k):
 FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", subs_program, 30),
             ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
             ("offsets", offsets_program, 20), ("context", context_program, 15),
-            ("polar", polar_program, 10), ("comp", comp_program, 40)]
+            ("polar", polar_program, 10), ("comp", comp_program, 40),
+            ("turns", turns_program, 10), ("g10", g10_program, 15)]
 
 
 def main():

@@ -112,12 +112,13 @@ pub struct ArcNet {
     pub sweep: f64,
 }
 
-/// The net of the arc from `start` to `end` in `plane`, clockwise (`G02`) or not (`G03`).
+/// The net of the arc from `start` to `end` in `plane`, clockwise (`G02`) or not (`G03`),
+/// going round `turns` times (`P`, at least 1: the turns beyond the first are whole circles).
 pub fn arc(
     start: [f64; 3],
     end: [f64; 3],
     plane: Plane,
-    clockwise: bool,
+    (clockwise, turns): (bool, u32),
     centre: Centre,
     tol: ArcTol,
 ) -> Result<ArcNet, ParseErrorKind> {
@@ -188,6 +189,9 @@ pub fn arc(
             sweep = TAU;
         }
     }
+    // `P`: the turns beyond the first, each a whole circle more (LinuxCNC's rule).
+    let more = f64::from(turns.saturating_sub(1)) * TAU;
+    sweep += if clockwise { -more } else { more };
     // A sweep of (nearly) a whole turn between distinct points is a rounding artefact of a
     // tiny arc programmed the other way round: keep it, it is what the words say.
     if let Some(re) = end_radius {

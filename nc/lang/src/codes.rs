@@ -116,6 +116,8 @@ pub enum Code {
     MachineCoords,
     /// `G92`, `G92.1`, `G92.2`, `G92.3` (non-modal).
     CoordOffset(G92),
+    /// `G10`: set a work offset or a tool's length and radius (non-modal).
+    SetTable,
     Plane(Plane),
     /// `G20` (true) / `G21`.
     Inch(bool),
@@ -151,10 +153,13 @@ pub enum Code {
     User(u32),
     /// `M70`..`M73`.
     Context(ContextCode),
+    /// `G08`: lathe radius mode, LinuxCNC's default (X words are radii); a mill has nothing
+    /// to change. (`G07`, diameter mode, is refused.)
+    LatheRadius,
 }
 
 /// Modal groups, as indices of [`super::line::Line`]'s code table.
-pub const GROUPS: usize = 19;
+pub const GROUPS: usize = 20;
 
 impl Code {
     pub fn group(self) -> usize {
@@ -164,7 +169,8 @@ impl Code {
             | Code::Home
             | Code::Home30
             | Code::MachineCoords
-            | Code::CoordOffset(_) => 1,
+            | Code::CoordOffset(_)
+            | Code::SetTable => 1,
             Code::Plane(_) => 2,
             Code::Inch(_) => 3,
             Code::Incremental(_) => 4,
@@ -182,19 +188,22 @@ impl Code {
             Code::Io(_) => 16,
             Code::User(_) => 17,
             Code::Context(_) => 18,
+            Code::LatheRadius => 19,
         }
     }
 }
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 56] = [
+const G_CODES: [(f64, Code); 59] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
     (3.0, Code::Motion(Motion::G03)),
     (4.0, Code::Dwell),
     (5.0, Code::Motion(Motion::G05)),
+    (8.0, Code::LatheRadius),
+    (10.0, Code::SetTable),
     (5.1, Code::Motion(Motion::G051)),
     (5.2, Code::Motion(Motion::G052)),
     (5.3, Code::Motion(Motion::G053)),
@@ -249,6 +258,7 @@ const G_CODES: [(f64, Code); 56] = [
     (58.0, Code::WorkOffset(4)),
     (59.0, Code::WorkOffset(5)),
     (61.0, Code::Blend(false)),
+    (61.1, Code::Blend(false)),
     (64.0, Code::Blend(true)),
     (73.0, Code::Motion(Motion::Cycle(Cycle::G73))),
     (80.0, Code::CannedOff),
@@ -278,7 +288,9 @@ pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {
     if let Some((_, code)) = G_CODES.iter().find(|(v, _)| *v == value) {
         return Ok(*code);
     }
-    Err(if [38.2, 38.3, 38.4, 38.5].contains(&value) {
+    Err(if value == 7.0 {
+        ParseErrorKind::LatheDiameterMode
+    } else if [38.2, 38.3, 38.4, 38.5].contains(&value) {
         ParseErrorKind::Probing { code: value }
     } else if [33.0, 33.1, 76.0].contains(&value) {
         ParseErrorKind::SpindleSynchronised { code: value }

@@ -125,9 +125,9 @@ impl Parser<'_> {
             };
             match tool {
                 None | Some(0) => 0.0,
-                Some(t) => match self.setup.tool_diameters.get(&t) {
+                Some(t) => match self.diameters.get(&t) {
                     Some(&dia) => dia,
-                    None if self.setup.tools.contains_key(&t) => 0.0,
+                    None if self.tools.contains_key(&t) => 0.0,
                     None => {
                         let at = d.map_or(pos, |w| w.pos);
                         return Err(ParseErrorKind::UnknownTool { tool: t }.at(at));
@@ -234,7 +234,7 @@ impl Parser<'_> {
                 } => {
                     let offsets = Centre::Offsets(centre[0] - start[0], centre[1] - start[1]);
                     let tol = arc::ArcTol::for_units(self.modal.inch);
-                    match arc::arc(start, end, Plane::Xy, !ccw, offsets, tol) {
+                    match arc::arc(start, end, Plane::Xy, (!ccw, 1), offsets, tol) {
                         Ok(net) => {
                             let count = net.ctrl.len();
                             self.blocks.push(Block::Nurbs(NurbsBlock {

@@ -72,7 +72,6 @@ impl Parser<'_> {
         if m.work != saved.work {
             // The offset it was saved with is defined (it was selected then).
             let work = self
-                .setup
                 .work_offsets
                 .get(usize::from(saved.work))
                 .copied()

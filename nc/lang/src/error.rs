@@ -43,6 +43,8 @@ pub enum Context {
     NoMotion,
     /// A `G92` line (`tenth` 0), `G92.1`, `G92.2` or `G92.3`.
     CoordOffset { tenth: u8 },
+    /// A `G10 L<l>` line.
+    SetTable { l: u8 },
 }
 
 impl fmt::Display for Context {
@@ -55,6 +57,7 @@ impl fmt::Display for Context {
             Context::LengthComp => f.write_str("a G43/G43.4 (tool length) line"),
             Context::CoordOffset { tenth: 0 } => f.write_str("a G92 line"),
             Context::CoordOffset { tenth } => write!(f, "a G92.{tenth} line"),
+            Context::SetTable { l } => write!(f, "a G10 L{l} line"),
         }
     }
 }
@@ -152,6 +155,10 @@ pub enum ParseErrorKind {
     ArcAfterCompensation { motion: Motion },
     #[error("canned cycle {} is not supported: post the cycle expanded into G00/G01 moves", Code('G', *.code))]
     CannedCycle { code: f64 },
+    #[error("P{value} on an arc is the number of turns: a whole number from 1 to 10000")]
+    ArcTurns { value: f64 },
+    #[error("G07 (lathe diameter mode: X words are diameters) is not supported: dnurbs's machines are mills")]
+    LatheDiameterMode,
     #[error("probing {} is not supported: dnurbs plans the whole program before the machine moves, and a probe's result (#5061..#5070) is only known when it touches", Code('G', *.code))]
     Probing { code: f64 },
     #[error("spindle-synchronised motion {} (threading, rigid tapping) is not supported: dnurbs's spindle is not an axis the path follows", Code('G', *.code))]
@@ -263,6 +270,12 @@ pub enum ParseErrorKind {
     OffsetRotary { axis: char },
     #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]
     OffsetWithoutAxes,
+    #[error("G10 needs L: L1 (a tool's length and radius), L2 (a work offset), L20 (a work offset from the current point); dnurbs does not take L10/L11 (tool tables from the current point)")]
+    G10Kind,
+    #[error("G10 L{l} P{value}: P is {}", if *.l == 1 { "a tool number in the tool table" } else { "a work offset: 0 the one in effect, 1..6 for G54..G59 (dnurbs has no G59.1..G59.3)" })]
+    G10Index { l: u8, value: f64 },
+    #[error("G10 {letter}{value}: dnurbs's work offsets move X Y Z and do not rotate (a rotary offset or a rotation turns the part to another angle than the program's)")]
+    G10Rotary { letter: char, value: f64 },
     #[error("{} needs the machine's {}: define it under [reference] in the machine file", Code('G', *.code), if *.code == 30.0 { "second reference position (g30)" } else { "reference position" })]
     NoReference { code: f64 },
     #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]

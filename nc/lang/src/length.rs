@@ -35,7 +35,7 @@ impl Parser<'_> {
             LengthComp::Added => match (line.get('H'), line.get('Z')) {
                 (Some(h), _) => {
                     let tool = tool_number(h)?;
-                    let add = match (tool, self.setup.tools.get(&tool)) {
+                    let add = match (tool, self.tools.get(&tool)) {
                         (0, _) => 0.0,
                         (_, Some(l)) => *l,
                         (_, None) => return Err(ParseErrorKind::UnknownTool { tool }.at(pos)),
@@ -71,7 +71,7 @@ impl Parser<'_> {
                     (None, Some(t)) => t,
                     (None, None) => 0,
                 };
-                match (tool, self.setup.tools.get(&tool)) {
+                match (tool, self.tools.get(&tool)) {
                     (0, _) => 0.0,
                     (_, Some(l)) => *l,
                     (_, None) => return Err(ParseErrorKind::UnknownTool { tool }.at(pos)),

@@ -90,6 +90,7 @@
 //! property test feeds it arbitrary text and mutations of the paper's example.
 
 mod arc;
+mod arc_move;
 pub(crate) mod codes;
 mod comp;
 mod comp_corner;
@@ -101,6 +102,7 @@ mod error;
 mod evaluate;
 mod expr;
 mod flow;
+mod g10;
 mod g52;
 mod interp;
 mod interp_error;
@@ -112,6 +114,7 @@ mod modal;
 mod moves;
 mod name;
 mod nurbs;
+mod nurbs_open;
 mod open_g52;
 mod params;
 mod parser;

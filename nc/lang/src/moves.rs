@@ -6,7 +6,6 @@
 //! machine frame with the rotary axes at 0; positions are the tool tip (the tool length lives
 //! in [`MoveTooling`](nc_geom::program::MoveTooling) and is added by the machine's Z axis).
 
-use super::arc::{self, Centre};
 use super::codes::{Code, LengthComp};
 use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
@@ -15,7 +14,7 @@ use super::parser::{normalise, Parser};
 use super::word::word_limit;
 use crate::vocab::Motion;
 use crate::vocab::Plane;
-use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, SrcPos};
+use nc_geom::program::{Block, LinearMove, Orientation, SrcPos};
 
 const AXES: [char; 3] = ['X', 'Y', 'Z'];
 
@@ -28,6 +27,9 @@ impl Parser<'_> {
         if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
             self.comp_forbids("G92", pos)?;
             return self.coord_offset(line, kind, pos);
+        }
+        if let Some((Code::SetTable, pos)) = line.code_of_group(1) {
+            return self.set_table(line, pos);
         }
         if let Some((Code::LengthComp(c @ (LengthComp::Dynamic | LengthComp::Added)), _)) =
             line.code_of_group(7)
@@ -101,7 +103,7 @@ impl Parser<'_> {
         match motion {
             Motion::G052 => self.g52_point(line, pos),
             Motion::G053 => self.g52_close(line, pos),
-            Motion::G02 | Motion::G03 => self.arc(line, motion, pos),
+            Motion::G02 | Motion::G03 => self.arc_move(line, motion, pos),
             Motion::G05 | Motion::G051 => self.spline(line, motion, pos),
             _ => self.linear(line, motion, pos),
         }
@@ -286,132 +288,6 @@ impl Parser<'_> {
         }));
     }
 
-    /// A `G02`/`G03` line (or its modal continuation): a rational quadratic NURBS block.
-    fn arc(&mut self, line: &Line<'_>, motion: Motion, pos: SrcPos) -> Result<(), ParseError> {
-        line.only(
-            &self.extra_letters(line, "GMFSTXYZIJKRABC@^"),
-            Context::Move(motion),
-        )?;
-        if line.first_of("XYZIJKRABC").is_none() {
-            return Ok(());
-        }
-        if !self.modal.inverse_time && self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
-        }
-        self.comp_curve_allowed(motion, pos)?;
-        let plane = self.modal.plane;
-        let (a, b, _) = plane.axes();
-        let centre = match line.get('R') {
-            Some(r) => {
-                if let Some(w) = line.first_of("IJK") {
-                    let kind = ParseErrorKind::ArcCentreAndRadius {
-                        motion,
-                        letter: w.letter,
-                    };
-                    return Err(kind.at(w.pos));
-                }
-                Centre::Radius(r.value * self.modal.scale())
-            }
-            None => {
-                // Every offset word outside the plane, even after one in it (`I0 J3 K0` in
-                // G17 is refused, as LinuxCNC refuses it).
-                let outside = ['I', 'J', 'K']
-                    .into_iter()
-                    .filter(|&l| l != Plane::offset_letter(a) && l != Plane::offset_letter(b))
-                    .filter_map(|l| line.get(l))
-                    .min_by_key(|w| (w.pos.line, w.pos.col));
-                if let Some(w) = outside {
-                    let kind = ParseErrorKind::ArcOffsetOutOfPlane {
-                        letter: w.letter,
-                        plane,
-                    };
-                    return Err(kind.at(w.pos));
-                }
-                let off = |i| {
-                    line.value(Plane::offset_letter(i))
-                        .map(|v| v * self.modal.scale())
-                };
-                match (off(a), off(b)) {
-                    (None, None) => {
-                        return Err(ParseErrorKind::ArcWithoutCentre { motion, plane }.at(pos));
-                    }
-                    (Some(i), Some(j)) if self.modal.arc_absolute => {
-                        // G90.1: the centre's coordinates (work offset applied); made
-                        // offsets from the start below.
-                        Centre::Offsets(i + self.modal.offset[a], j + self.modal.offset[b])
-                    }
-                    (i, _) if self.modal.arc_absolute => {
-                        let letter = Plane::offset_letter(if i.is_none() { a } else { b });
-                        let kind = ParseErrorKind::MissingWord {
-                            letter,
-                            context: Context::Move(motion),
-                        };
-                        return Err(kind.at(pos));
-                    }
-                    (i, j) => Centre::Offsets(i.unwrap_or(0.0), j.unwrap_or(0.0)),
-                }
-            }
-        };
-        let end = self.end_point(line, pos)?;
-        // Angle words turn the tool along the arc (I J K are the centre here, never a
-        // tool axis).
-        let turn_to = match line.first_of("ABC") {
-            Some(_) => Some(self.angles(line)?),
-            None => None,
-        };
-        let start = self.comp.base().or(self.here).unwrap_or(end);
-        let centre = match centre {
-            Centre::Offsets(ca, cb) if self.modal.arc_absolute => {
-                let at = |i: usize| start.get(i).copied().unwrap_or(0.0);
-                Centre::Offsets(ca - at(a), cb - at(b))
-            }
-            c => c,
-        };
-        let net = arc::arc(
-            start,
-            end,
-            plane,
-            motion == Motion::G02,
-            centre,
-            arc::ArcTol::for_units(self.modal.inch),
-        )
-        .map_err(|kind| kind.at(pos))?;
-        let length = (net.radius * net.sweep.abs()).hypot(rise(start, end, plane));
-        let feed_mm_min = self.move_feed(line, motion, pos, length)?;
-        if self.comp.compensating().is_some() {
-            if let Some(w) = line.first_of("ABC") {
-                return self.comp_unsupported("a tool-axis word", w.pos);
-            }
-            if self.modal.inverse_time {
-                return self.comp_unsupported("G93 inverse-time feed", pos);
-            }
-            let clockwise = motion == Motion::G02;
-            return self.comp_arc(line, pos, clockwise, (end, net.centre), feed_mm_min);
-        }
-        let tooling = self.tooling();
-        let count = net.ctrl.len();
-        self.here = Some(end);
-        if let Some((r1_deg, r2_deg)) = turn_to {
-            self.orientation = Orientation::Angles { r1_deg, r2_deg };
-            self.orientation_given = true;
-        }
-        self.blocks.push(Block::Nurbs(NurbsBlock {
-            pos,
-            n: line.n,
-            kind: NurbsKind::G062,
-            degree: net.degree,
-            ctrl: net.ctrl,
-            tool_ctrl: Vec::new(),
-            ctrl_pos: vec![pos; count],
-            weights: net.weights,
-            knots: net.knots,
-            feed_mm_min,
-            tooling,
-            turn_to,
-        }));
-        Ok(())
-    }
-
     /// The orientation at the end of a linear move (modal values resolved).
     pub(super) fn orientation(&mut self, line: &Line<'_>) -> Result<Orientation, ParseError> {
         let angle = line.first_of("ABC");
@@ -450,7 +326,7 @@ impl Parser<'_> {
     }
 
     /// The rotary angles of a line with angle words (`G91`: added to the previous ones).
-    fn angles(&mut self, line: &Line<'_>) -> Result<(f64, f64), ParseError> {
+    pub(super) fn angles(&mut self, line: &Line<'_>) -> Result<(f64, f64), ParseError> {
         let r1 = match (line.get('A'), line.get('B')) {
             (Some(a), Some(b)) => {
                 let kind = ParseErrorKind::MixedRotaryAxes {
@@ -512,12 +388,6 @@ pub(crate) fn check_domain(letter: char, value: f64, pos: SrcPos) -> Result<f64,
     } else {
         Err(ParseErrorKind::OutsideDomain { letter, value, max }.at(pos))
     }
-}
-
-/// The change of the normal axis along an arc.
-fn rise(start: [f64; 3], end: [f64; 3], plane: Plane) -> f64 {
-    let (_, _, n) = plane.axes();
-    end.get(n).copied().unwrap_or(0.0) - start.get(n).copied().unwrap_or(0.0)
 }
 
 /// Degrees the tool turns between two orientations (for G93 on moves that only turn it):

@@ -9,12 +9,11 @@ use super::codes::{Code, LengthComp, StopCode};
 use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
 use super::modal::{Modal, Setup};
-use super::nurbs::{Frame, OpenNurbs};
+use super::nurbs::OpenNurbs;
 use crate::rules::{MAX_DWELL_S, MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH};
 use crate::vocab::Motion;
 use nc_geom::program::{
-    Action, ActionKind, Block, LengthMode, MoveTooling, NurbsBlock, NurbsKind, Orientation, SrcPos,
-    Wait,
+    Action, ActionKind, Block, LengthMode, MoveTooling, Orientation, SrcPos, Wait,
 };
 
 /// The tool orientation until a program gives one: vertical.
@@ -46,9 +45,9 @@ pub(super) struct Parser<'s> {
     /// The index of the block that moves to the reference position because the program's
     /// first move does not give a full pose (the machine is there already, homed).
     pub from_reference: Option<usize>,
-    open: Option<OpenNurbs>,
+    pub(super) open: Option<OpenNurbs>,
     /// The NURBS block that ended on the previous line (for a helpful extra-knot error).
-    just_closed: Option<(SrcPos, usize)>,
+    pub(super) just_closed: Option<(SrcPos, usize)>,
     /// After an error inside a NURBS block: skip its remaining control-point and knot lines.
     skipping: bool,
     end: Option<SrcPos>,
@@ -66,6 +65,12 @@ pub(super) struct Parser<'s> {
     pub saved: crate::saved::SavedStates,
     /// Cutter radius compensation and the moves it holds.
     pub comp: crate::comp::Comp,
+    /// G54..G59 as the program has them (the setup's, changed by `G10 L2`/`L20`).
+    pub work_offsets: [Option<[f64; 3]>; 6],
+    /// Tool lengths and diameters as the program has them (the setup's, changed by
+    /// `G10 L1`), mm.
+    pub tools: std::collections::BTreeMap<u32, f64>,
+    pub diameters: std::collections::BTreeMap<u32, f64>,
     /// A compensated arc that could not be built when it was released.
     pub comp_error: Option<ParseError>,
 }
@@ -101,6 +106,9 @@ impl<'s> Parser<'s> {
             level: 0,
             saved: crate::saved::SavedStates::default(),
             comp: crate::comp::Comp::default(),
+            work_offsets: setup.work_offsets,
+            tools: setup.tools.clone(),
+            diameters: setup.tool_diameters.clone(),
             comp_error: None,
         };
         let startup = setup.startup.words();
@@ -233,7 +241,11 @@ impl<'s> Parser<'s> {
         if matches!(
             line.code_of_group(1),
             Some((
-                Code::Home | Code::Home30 | Code::MachineCoords | Code::CoordOffset(_),
+                Code::Home
+                    | Code::Home30
+                    | Code::MachineCoords
+                    | Code::CoordOffset(_)
+                    | Code::SetTable,
                 _
             ))
         ) || matches!(self.mode, Some(crate::vocab::Motion::Cycle(_)))
@@ -286,12 +298,7 @@ impl<'s> Parser<'s> {
                     self.end_cycle();
                 }
                 Code::WorkOffset(i) => {
-                    let defined = self
-                        .setup
-                        .work_offsets
-                        .get(usize::from(i))
-                        .copied()
-                        .flatten();
+                    let defined = self.work_offsets.get(usize::from(i)).copied().flatten();
                     let work = match (defined, i) {
                         (Some(o), _) => o,
                         (None, 0) => [0.0; 3],
@@ -483,54 +490,6 @@ impl<'s> Parser<'s> {
             },
             wait: core::mem::take(&mut self.wait),
         }
-    }
-
-    /// Opens a `G06.2` / `G06.5` block on its first line.
-    pub(super) fn open_nurbs(
-        &mut self,
-        line: &Line<'_>,
-        motion: Motion,
-        pos: SrcPos,
-    ) -> Result<(), ParseError> {
-        if motion == Motion::G065 && !self.setup.rotary_axes {
-            let what = "a G06.5 block (its second curve turns the tool)";
-            return Err(ParseErrorKind::NoRotaryAxes { what }.at(pos));
-        }
-        if self.modal.incremental {
-            return Err(ParseErrorKind::NurbsIncremental { motion }.at(pos));
-        }
-        let Some(here) = self.here else {
-            return Err(ParseErrorKind::NurbsBeforeStart { motion }.at(pos));
-        };
-        let frame = Frame {
-            scale: self.modal.scale(),
-            offset: self.modal.offset,
-        };
-        let tooling = self.tooling();
-        self.open = Some(OpenNurbs::open(
-            line,
-            (motion, pos),
-            here,
-            self.feed,
-            frame,
-            tooling,
-        )?);
-        Ok(())
-    }
-
-    fn close(&mut self, block: NurbsBlock) {
-        self.here = block.ctrl.last().copied().or(self.here);
-        if block.kind == NurbsKind::G065 {
-            if let (Some(xyz), Some(uvw)) = (block.ctrl.last(), block.tool_ctrl.last()) {
-                // Never zero: control points keep at least MIN_TOOL_OFFSET_MM from their tool point.
-                if let Some(v) = normalise([uvw[0] - xyz[0], uvw[1] - xyz[1], uvw[2] - xyz[2]]) {
-                    self.orientation = Orientation::Vector(v);
-                    self.orientation_given = true;
-                }
-            }
-        }
-        self.just_closed = Some((block.pos, block.knots.len()));
-        self.blocks.push(Block::Nurbs(block));
     }
 }
 

@@ -45,7 +45,6 @@ impl Parser<'_> {
     /// Work offset `k` (0: G54), axis `i`, in program units.
     fn offset(&self, k: usize, i: usize) -> f64 {
         let o = self
-            .setup
             .work_offsets
             .get(k)
             .copied()

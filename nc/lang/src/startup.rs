@@ -13,7 +13,7 @@ use crate::word::Word;
 
 /// The G codes start-up modes may hold.
 pub const STARTUP_CODES: &str =
-    "G17 G18 G19 G20 G21 G40 G49 G54-G59 G61 G64 (P Q) G80 G90 G91 G90.1 G91.1 G93 G94 G98 G99";
+    "G08 G17 G18 G19 G20 G21 G40 G49 G54-G59 G61 G61.1 G64 (P Q) G80 G90 G91 G90.1 G91.1 G93 G94 G98 G99";
 
 /// Start-up modes, parsed and checked ([`Startup::parse`], in `startup_parse`); the default sets none.
 #[derive(Clone, Debug, Default, PartialEq)]

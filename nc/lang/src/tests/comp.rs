@@ -4,7 +4,7 @@
 
 use super::{at, linear, nurbs};
 use crate::{parse_with, ParseErrorKind as E, Setup};
-use nc_geom::program::{ActionKind, Block, Coolant};
+use nc_geom::program::{ActionKind, Coolant};
 
 fn setup() -> Setup {
     let mut s = Setup::default();
@@ -15,14 +15,7 @@ fn setup() -> Setup {
 }
 
 fn ends(src: &str) -> Vec<[f64; 3]> {
-    let p = parse_with(src, &setup()).unwrap_or_else(|e| panic!("{src}: {:?}", e.errors));
-    p.blocks
-        .iter()
-        .map(|b| match b {
-            Block::Linear(m) => m.end,
-            Block::Nurbs(n) => *n.ctrl.last().expect("a control point"),
-        })
-        .collect()
+    super::block_ends(src, &setup())
 }
 
 #[track_caller]

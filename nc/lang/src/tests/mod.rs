@@ -5,6 +5,7 @@
 mod comp;
 mod errors;
 mod fuzz;
+mod g10;
 mod interp;
 mod io;
 mod posts;
@@ -17,6 +18,19 @@ use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Orientation, Pr
 const PAPER: &str = include_str!("../../../../tests/data/paper-example.nc");
 const G062: &str = include_str!("../../../../tests/data/g062-example.nc");
 const G01_5AXIS: &str = include_str!("../../../../tests/data/g01-5axis.nc");
+
+/// The end point of each block `src` parses to under `setup`.
+#[track_caller]
+fn block_ends(src: &str, setup: &crate::Setup) -> Vec<[f64; 3]> {
+    let p = crate::parse_with(src, setup).unwrap_or_else(|e| panic!("{src}: {:?}", e.errors));
+    p.blocks
+        .iter()
+        .map(|b| match b {
+            Block::Linear(m) => m.end,
+            Block::Nurbs(n) => *n.ctrl.last().expect("a control point"),
+        })
+        .collect()
+}
 
 fn at(line: u32, col: u32) -> SrcPos {
     SrcPos { line, col }

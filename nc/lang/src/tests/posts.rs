@@ -168,7 +168,7 @@ fn steep_helices_are_on_the_true_helix_or_an_error() {
             [0.01, 0.0, -rise / 2.0],
             [0.01, 0.0, rise / 2.0],
             super::super::vocab::Plane::Xy,
-            false,
+            (false, 1),
             super::super::Centre::Offsets(-0.01, 0.0),
             super::super::ArcTol::for_units(false),
         )

@@ -149,10 +149,9 @@ fn unsupported_g_code() {
         )
     );
     for (src, name) in [
-        ("G07", "G07"),
         ("G43.5", "G43.5"),
         ("G68.2", "G68.2"),
-        ("G10", "G10"),
+        ("G10.5", "G10.5"),
         ("G06.3", "G06.3"),
     ] {
         let msg = message(src);
@@ -176,6 +175,7 @@ fn canned_cycles_dnurbs_does_not_run_are_refused_by_name() {
         E::SpindleSynchronised { code: 33.1 }
     );
     assert!(message("G76 P1 Z-1 I-0.1 J0.1 K0.1").contains("threading"));
+    assert_eq!(fails("G07", 1, 1), E::LatheDiameterMode);
 }
 
 #[test]

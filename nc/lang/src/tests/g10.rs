@@ -1,0 +1,71 @@
+//! `G10 L1`/`L2`/`L20`: tables set from the program, read back through the moves and the
+//! parameters, and each refusal at its word.
+
+use super::at;
+use crate::{parse_with, ParseErrorKind as E, Setup};
+
+fn setup() -> Setup {
+    Setup {
+        work_offsets: [Some([0.0; 3]); 6],
+        reference: Some([0.0, 0.0, 100.0]),
+        ..Setup::default()
+    }
+}
+
+fn ends(src: &str) -> Vec<[f64; 3]> {
+    super::block_ends(src, &setup())
+}
+
+#[test]
+fn l2_sets_an_offset_and_its_parameters_in_mm() {
+    // G55 set in inches; the move lands there; #5241 (G55 X) reads mm, the machine's units.
+    let e = ends("G20\nG10 L2 P2 X1 Z-1\nG55\nG0 X0 Y0 Z0\nG21\nG0 X[#5241] Y[#5243]\nM2");
+    assert_eq!(e[0], [25.4, 0.0, -25.4]);
+    assert_eq!(e[1], [50.8, -25.4, -25.4]);
+    // P0 is the offset in effect, and moves at once.
+    let e = ends("G0 X0 Y0 Z0\nG10 L2 P0 Y5\nG0 X0 Y0 Z0\nM2");
+    assert_eq!(e[1], [0.0, 5.0, 0.0]);
+}
+
+#[test]
+fn l20_makes_the_current_point_the_coordinates_given() {
+    let e = ends("G0 X10 Y20 Z30\nG10 L20 P1 X0 Y0\nG0 X1 Y1\nM2");
+    assert_eq!(e[1], [11.0, 21.0, 30.0]);
+}
+
+#[test]
+fn l1_sets_a_tools_length_and_radius() {
+    let e =
+        ends("G10 L1 P7 Z50 R3\nG0 X-10 Y0 Z0\nG43 H7 G0 Z0\nG42 D7 G1 X0 F100\nG1 X10\nG40\nM2");
+    // The tip stays at Z0 (the length lives in the tooling); right of +X by the radius 3.
+    assert_eq!(e[1][2], 0.0);
+    let want = [[0.0, -3.0, 0.0], [10.0, -3.0, 0.0]];
+    for (g, w) in e[2..].iter().zip(want) {
+        assert!(g.iter().zip(w).all(|(a, b)| (a - b).abs() < 1e-12), "{e:?}");
+    }
+}
+
+#[test]
+fn each_refusal_is_at_its_word() {
+    let fails = |src: &str| {
+        let e = parse_with(src, &setup()).expect_err(src).errors[0];
+        (e.kind, e.pos)
+    };
+    assert_eq!(fails("G10 L10 P1 Z5"), (E::G10Kind, at(1, 5)));
+    assert_eq!(fails("G10 P1 Z5"), (E::G10Kind, at(1, 1)));
+    assert!(matches!(fails("G10 L2 P7 X1"), (E::G10Index { l: 2, .. }, p) if p == at(1, 8)));
+    assert!(matches!(
+        fails("G10 L2 P1 X1 R30"),
+        (E::G10Rotary { letter: 'R', .. }, p) if p == at(1, 14)
+    ));
+    assert!(matches!(
+        fails("G10 L2 P1 A90"),
+        (E::G10Rotary { letter: 'A', .. }, _)
+    ));
+    assert!(matches!(
+        fails("G0 X-10 Y0 Z0\nG41.1 D1\nG10 L2 P1 X1"),
+        (E::CompensationForbids { .. }, p) if p == at(3, 1)
+    ));
+    // A rotation of 0 (a post's habit) is no rotation.
+    assert!(parse_with("G10 L2 P1 X0 Y0 Z0 R0\nG0 X1 Y1 Z1\nM2", &setup()).is_ok());
+}
