@@ -537,6 +537,28 @@ def g10_program(r, k):
     return lines
 
 
+def feedmode_program(r, k):
+    """G93/G94/G95 switched along a program with F and S on and off their lines, and F0: where
+    LinuxCNC has no feed (G94 and G95 set it to 0), the feed move is refused at its line."""
+    lines = ["(feed modes %d)" % k, r.choice(["G20", "G21"]), "G17 G90 G94", "G0 X0 Y0 Z0",
+             "S%d M3" % r.randint(100, 3000), "F%d" % r.randint(10, 300)]
+    for _ in range(r.randint(4, 10)):
+        c = r.random()
+        if c < 0.15:
+            lines.append(r.choice(["G94", "G95", "G93"]))
+        elif c < 0.3:
+            lines.append("%s F%s" % (r.choice(["G94", "G95"]), num(r, 0.01, 100, 3)))
+        elif c < 0.4:
+            lines.append("S%d" % r.choice([0, r.randint(100, 3000)]))
+        elif c < 0.45:
+            lines.append("F0")
+        else:
+            f = " F%s" % num(r, 0.1, 100, 3) if r.random() < 0.5 else ""
+            lines.append("G1 X%s Y%s%s" % (num(r, -10, 10), num(r, -10, 10), f))
+    lines.append("M2")
+    return lines
+
+
 def comp_program(r, k):
     """Cutter radius compensation on random closed contours of lines and arcs (convex and
     concave corners, tangent and sharp), G41/G42 by tool number (rs274's default table) and
@@ -613,7 +635,8 @@ FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", sub
             ("arcs", arcs_program, 40), ("units", units_program, 20), ("cycles", cycles_program, 40),
             ("offsets", offsets_program, 20), ("context", context_program, 15),
             ("polar", polar_program, 10), ("comp", comp_program, 40),
-            ("turns", turns_program, 10), ("g10", g10_program, 15)]
+            ("turns", turns_program, 10), ("g10", g10_program, 15),
+            ("feedmode", feedmode_program, 12)]
 
 
 def main():

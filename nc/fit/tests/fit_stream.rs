@@ -371,8 +371,9 @@ fn a_run_in_inverse_time_keeps_its_time() {
         let (a, c) = (10.0 + 5.0 * (2.0 * t).sin(), t.to_degrees());
         let _ = writeln!(src, "G01 X{x:.3} Y{y:.3} Z5 A{a:.3} C{c:.3} F{f:.1}");
     }
-    // Back in G94, a move at the feed per minute given before the G93 section.
-    src.push_str("G94\nG00 Z50\nG01 X0 Y-20\nM30\n%\n");
+    // Back in G94, which sets the feed to 0 (LinuxCNC's rule): a move at a feed per minute
+    // given again.
+    src.push_str("G94 F600\nG00 Z50\nG01 X0 Y-20\nM30\n%\n");
     let (text, done, a, b) = fit_checked(&src, &kin, &setup, "G93");
     assert_eq!(done.summary.fitted_blocks, 1, "{:?}\n{text}", done.summary);
     assert!(done.summary.moves_fitted >= 297, "{:?}", done.summary);

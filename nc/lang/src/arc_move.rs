@@ -37,7 +37,7 @@ impl Parser<'_> {
             },
         };
         if !self.modal.inverse_time && self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+            return Err(self.no_feed(motion).at(pos));
         }
         self.comp_curve_allowed(motion, pos)?;
         let plane = self.modal.plane;

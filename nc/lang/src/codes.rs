@@ -125,6 +125,8 @@ pub enum Code {
     Incremental(bool),
     /// `G93` (true) / `G94`.
     InverseTime(bool),
+    /// `G95`: feed per spindle revolution.
+    PerRev,
     /// `G40`.
     CompensationOff,
     /// `G41`/`G42` (`D`: a tool number, or none for the tool in the spindle) and
@@ -174,7 +176,7 @@ impl Code {
             Code::Plane(_) => 2,
             Code::Inch(_) => 3,
             Code::Incremental(_) => 4,
-            Code::InverseTime(_) => 5,
+            Code::InverseTime(_) | Code::PerRev => 5,
             Code::CompensationOff | Code::RadiusComp { .. } => 6,
             Code::LengthComp(_) => 7,
             Code::CannedOff => 8,
@@ -195,7 +197,7 @@ impl Code {
 
 /// The G codes, by value. Exact comparisons are sound: `06.5` and `6.5` parse to the same
 /// correctly-rounded f64.
-const G_CODES: [(f64, Code); 59] = [
+const G_CODES: [(f64, Code); 60] = [
     (0.0, Code::Motion(Motion::G00)),
     (1.0, Code::Motion(Motion::G01)),
     (2.0, Code::Motion(Motion::G02)),
@@ -279,6 +281,7 @@ const G_CODES: [(f64, Code); 59] = [
     (91.0, Code::Incremental(true)),
     (91.1, Code::ArcCentreAbsolute(false)),
     (93.0, Code::InverseTime(true)),
+    (95.0, Code::PerRev),
 ];
 
 pub fn g_code(value: f64) -> Result<Code, ParseErrorKind> {

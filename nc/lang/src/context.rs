@@ -20,6 +20,8 @@ impl Parser<'_> {
             inch: m.inch,
             incremental: m.incremental,
             inverse_time: m.inverse_time,
+            per_rev: m.per_rev,
+            feed_per_rev: self.feed_per_rev,
             arc_absolute: m.arc_absolute,
             blend: m.blend,
             retract_to_r: m.cycle.retract_to_r,
@@ -66,6 +68,7 @@ impl Parser<'_> {
         m.inch = saved.inch;
         m.incremental = saved.incremental;
         m.inverse_time = saved.inverse_time;
+        m.per_rev = saved.per_rev;
         m.arc_absolute = saved.arc_absolute;
         m.blend = saved.blend;
         m.cycle.retract_to_r = saved.retract_to_r;
@@ -81,6 +84,7 @@ impl Parser<'_> {
             m.work = saved.work;
         }
         self.feed = saved.feed;
+        self.feed_per_rev = saved.feed_per_rev;
         let (spindle, rpm) = (self.modal.spindle, self.modal.rpm);
         self.modal.spindle = saved.spindle;
         self.modal.rpm = saved.rpm;

@@ -41,7 +41,7 @@ impl Parser<'_> {
         let feed = self
             .feed
             .filter(|f| *f > 0.0)
-            .ok_or(ParseErrorKind::NoFeed { motion }.at(pos))?;
+            .ok_or(self.no_feed(motion).at(pos))?;
         let (a, b, n) = self.modal.plane.axes();
         let letter = |i: usize| ['X', 'Y', 'Z'][i];
         let entering = self.modal.cycle.active != Some(cycle);

@@ -179,6 +179,8 @@ pub enum ParseErrorKind {
         "{motion} needs a feed but none is in effect: program F<mm/min> on this or an earlier line"
     )]
     NoFeed { motion: Motion },
+    #[error("{motion} under G95 (feed per revolution) needs a spindle speed: S is 0")]
+    PerRevWithoutSpeed { motion: Motion },
     #[error(
         "word {letter} moves the machine but no motion mode is in effect: start with G00 or G01"
     )]

@@ -101,6 +101,7 @@ mod cycles;
 mod error;
 mod evaluate;
 mod expr;
+mod feed;
 mod flow;
 mod g10;
 mod g52;

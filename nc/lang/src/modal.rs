@@ -103,6 +103,8 @@ pub(super) struct Modal {
     pub inch: bool,
     pub incremental: bool,
     pub inverse_time: bool,
+    /// `G95`: F is mm (inch) per spindle revolution.
+    pub per_rev: bool,
     /// Active work offset (0 = G54), and where the program's zero is (mm, workpiece frame):
     /// the work offset plus `g92`.
     pub work: u8,
@@ -146,6 +148,7 @@ impl Default for Modal {
             inch: false,
             incremental: false,
             inverse_time: false,
+            per_rev: false,
             work: 0,
             offset: [0.0; 3],
             g92: [0.0; 3],

@@ -148,7 +148,7 @@ impl Parser<'_> {
                 .ok_or(ParseErrorKind::InverseTimeWithoutFeed { motion }.at(pos))?;
             return Ok(f.value * length);
         }
-        self.feed.ok_or(ParseErrorKind::NoFeed { motion }.at(pos))
+        self.feed.ok_or(self.no_feed(motion).at(pos))
     }
 
     /// The current position, starting at the reference position if the program has none
@@ -230,7 +230,7 @@ impl Parser<'_> {
         }
         let rapid = motion == Motion::G00;
         if !rapid && !self.modal.inverse_time && self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+            return Err(self.no_feed(motion).at(pos));
         }
         let start = self.here;
         let end = self.end_point(line, pos)?;

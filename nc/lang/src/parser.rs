@@ -10,7 +10,7 @@ use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::{Line, MOVE_WORDS};
 use super::modal::{Modal, Setup};
 use super::nurbs::OpenNurbs;
-use crate::rules::{MAX_DWELL_S, MIN_FEED_MM_MIN, MIN_VECTOR_LENGTH};
+use crate::rules::{MAX_DWELL_S, MIN_VECTOR_LENGTH};
 use crate::vocab::Motion;
 use nc_geom::program::{
     Action, ActionKind, Block, LengthMode, MoveTooling, Orientation, SrcPos, Wait,
@@ -54,8 +54,10 @@ pub(super) struct Parser<'s> {
     /// The start-up modes did not apply (a setup changed after [`crate::Startup::parse`]
     /// checked them): the first line reports it.
     startup_error: Option<ParseError>,
+    /// `G95`: the programmed feed per revolution, mm.
+    pub feed_per_rev: Option<f64>,
     /// The last feed reported as above the machine's highest (mm/min).
-    clamped: Option<f64>,
+    pub(super) clamped: Option<f64>,
     /// A `G5.2` block being read.
     pub g52: Option<crate::open_g52::OpenG52>,
     /// The `P Q` of the last `G5` (a `G5` without `I J` continues it), mm.
@@ -101,6 +103,7 @@ impl<'s> Parser<'s> {
             end: None,
             startup_error: None,
             clamped: None,
+            feed_per_rev: None,
             g52: None,
             last_spline_pq: None,
             level: 0,
@@ -189,6 +192,7 @@ impl<'s> Parser<'s> {
         self.modes(&line, motion)?;
         self.feed_word(&line)?;
         self.machine_words(&line)?;
+        self.rev_feed(line.first);
         self.radius_comp(&line)?;
         let moves = self.blocks.len();
         let moved = if self.is_dwell(&line) {
@@ -289,7 +293,21 @@ impl<'s> Parser<'s> {
                 Code::Plane(p) => self.modal.plane = p,
                 Code::Inch(inch) => self.modal.inch = inch,
                 Code::Incremental(inc) => self.modal.incremental = inc,
-                Code::InverseTime(it) => self.modal.inverse_time = it,
+                Code::InverseTime(it) => {
+                    self.modal.inverse_time = it;
+                    self.modal.per_rev = false;
+                    if !it {
+                        // LinuxCNC's rule: G94 and G95 set the feed to 0 (an F on the line
+                        // sets it again).
+                        self.feed = None;
+                    }
+                }
+                Code::PerRev => {
+                    self.modal.inverse_time = false;
+                    self.modal.per_rev = true;
+                    self.feed = None;
+                    self.feed_per_rev = None;
+                }
                 Code::Blend(b) => self.modal.blend = b,
                 Code::ArcCentreAbsolute(abs) => self.modal.arc_absolute = abs,
                 Code::Retract(to_r) => self.modal.cycle.retract_to_r = to_r,
@@ -322,32 +340,6 @@ impl<'s> Parser<'s> {
                     context: Context::NoMotion,
                 };
                 return Err(kind.at(h.pos));
-            }
-        }
-        Ok(())
-    }
-
-    /// `F`: mm/min (inch/min under G20); under G93 it belongs to its line only.
-    fn feed_word(&mut self, line: &Line<'_>) -> Result<(), ParseError> {
-        let Some(f) = line.get('F') else {
-            return Ok(());
-        };
-        if f.value < MIN_FEED_MM_MIN {
-            return Err(ParseErrorKind::BadFeed { value: f.value }.at(f.pos));
-        }
-        if !self.modal.inverse_time {
-            let feed = f.value * self.modal.scale();
-            self.feed = Some(feed);
-            if let Some(max) = self.setup.max_feed_mm_min.filter(|&m| feed > m) {
-                // Said once for each feed above the maximum (a post repeats its F).
-                if self.clamped != Some(feed) {
-                    self.clamped = Some(feed);
-                    let kind = ActionKind::FeedClamped {
-                        programmed_mm_min: feed,
-                        used_mm_min: max,
-                    };
-                    self.act(f.pos, kind);
-                }
             }
         }
         Ok(())

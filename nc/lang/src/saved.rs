@@ -10,6 +10,9 @@ pub(crate) struct Saved {
     pub inch: bool,
     pub incremental: bool,
     pub inverse_time: bool,
+    pub per_rev: bool,
+    /// `G95`'s feed per revolution, mm.
+    pub feed_per_rev: Option<f64>,
     pub arc_absolute: bool,
     pub blend: bool,
     pub retract_to_r: bool,

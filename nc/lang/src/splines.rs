@@ -27,7 +27,7 @@ impl Parser<'_> {
             return Err(ParseErrorKind::SplineInverseTime { motion }.at(pos));
         }
         if self.feed.is_none() {
-            return Err(ParseErrorKind::NoFeed { motion }.at(pos));
+            return Err(self.no_feed(motion).at(pos));
         }
         Ok(())
     }

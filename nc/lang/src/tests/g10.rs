@@ -69,3 +69,24 @@ fn each_refusal_is_at_its_word() {
     // A rotation of 0 (a post's habit) is no rotation.
     assert!(parse_with("G10 L2 P1 X0 Y0 Z0 R0\nG0 X1 Y1 Z1\nM2", &setup()).is_ok());
 }
+
+#[test]
+fn g95_feeds_per_revolution_of_the_speed_in_effect() {
+    let p = parse_with(
+        "G0 X0 Y0 Z0\nS1000 M3\nG95 F0.1\nG1 X10\nS2000\nG1 X20\nG20 F0.01 G1 X30\nM2",
+        &setup(),
+    )
+    .unwrap();
+    let feeds: Vec<f64> = p
+        .blocks
+        .iter()
+        .filter_map(|b| match b {
+            nc_geom::program::Block::Linear(m) if !m.rapid => Some(m.feed_mm_min),
+            _ => None,
+        })
+        .collect();
+    // 0.1 mm a revolution at 1000 and 2000 rpm; 0.01 inch at 2000 rpm.
+    assert_eq!(feeds.len(), 3);
+    assert!((feeds[0] - 100.0).abs() < 1e-9 && (feeds[1] - 200.0).abs() < 1e-9);
+    assert!((feeds[2] - 0.254 * 2000.0).abs() < 1e-9, "{feeds:?}");
+}

@@ -8,7 +8,26 @@ use crate::{Motion, ParseErrorKind as E};
 
 #[test]
 fn feed_must_be_positive() {
-    assert_eq!(fails("G01 X0 Y0 Z0 F0", 1, 14), E::BadFeed { value: 0.0 });
+    // F0 is no feed, as LinuxCNC's feed rate 0: the feed move is refused, at its code.
+    assert_eq!(
+        fails("G01 X0 Y0 Z0 F0", 1, 1),
+        E::NoFeed {
+            motion: Motion::G01
+        }
+    );
+    // G94 (and G95) set the feed to 0, as in LinuxCNC, unless F is on its line.
+    assert_eq!(
+        fails("G01 X0 Y0 Z0 F100\nG94 G01 X1", 2, 5),
+        E::NoFeed {
+            motion: Motion::G01
+        }
+    );
+    assert_eq!(
+        fails("G0 X0 Y0 Z0\nG95 F0.1 G01 X1", 2, 10),
+        E::PerRevWithoutSpeed {
+            motion: Motion::G01
+        }
+    );
     assert_eq!(fails("F-5", 1, 1), E::BadFeed { value: -5.0 });
     // Measured: F0.01 over 27 mm ran simulate into its cycle limit at 11.5 GB.
     assert_eq!(
