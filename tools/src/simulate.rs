@@ -337,6 +337,7 @@ impl Summary {
             self.end_position_error_mm,
         ) + &self
             .spindle_waits
+            .filter(|w| w.count > 0)
             .map(|w| {
                 format!(
                     "spindle waits      {} feed moves wait for the spindle's speed: about {:.3} s of ramps, not in the machining time\n",
