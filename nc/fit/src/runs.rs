@@ -102,6 +102,9 @@ pub(super) struct Modes {
     /// The modal feed per minute (mm/min), the last `F` given under `G94`: under `G93` an
     /// `F` is its line's own and leaves it as it was.
     g94_feed: Option<f64>,
+    /// Cutter radius compensation on (`G41`/`G42` until `G40`): its moves are left as they
+    /// are (a G06.5 block is not compensated).
+    comp: bool,
 }
 
 impl Default for Modes {
@@ -113,6 +116,7 @@ impl Default for Modes {
             motion: 0,
             tilt: None,
             g94_feed: None,
+            comp: false,
         }
     }
 }
@@ -121,7 +125,7 @@ impl Modes {
     /// The modes at the start of `line`; then its G codes apply.
     pub(super) fn line(&mut self, line: &str) -> LineModes {
         let at_start = LineModes {
-            plain: self.abs && self.mm && (self.feed == 940 || self.feed == 930),
+            plain: self.abs && self.mm && (self.feed == 940 || self.feed == 930) && !self.comp,
             g01: self.motion == 10,
             g94_feed: self.g94_feed,
         };
@@ -137,6 +141,8 @@ impl Modes {
                 210 => self.mm = true,
                 200 => self.mm = false,
                 930 | 940 | 950 => self.feed = g,
+                400 => self.comp = false,
+                410 | 411 | 420 | 421 => self.comp = true,
                 _ => {}
             }
         }

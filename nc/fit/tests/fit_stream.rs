@@ -476,3 +476,33 @@ fn the_stream_matches_the_whole_text_where_the_window_fills_mid_run() {
     );
     check(&src, "a comment ending in a backslash");
 }
+
+/// Moves under cutter radius compensation are left as written (a G06.5 block is not
+/// compensated, and the parser refuses one under G41/G42); the run after `G40` is fitted.
+#[test]
+fn moves_under_cutter_compensation_are_kept_and_the_run_after_it_fitted() {
+    use std::fmt::Write;
+    let mut src = String::from("%\nG90 G21 G94\nG00 X-10 Y0 Z0\nG42.1 D4\nG01 X0 Y0 F500\n");
+    let curve = |k: i32| {
+        let x = f64::from(k);
+        (x, 0.01 * x * x)
+    };
+    for k in 1..=60 {
+        let (x, y) = curve(k);
+        let _ = writeln!(src, "G01 X{x:.4} Y{y:.4}");
+    }
+    src.push_str("G40\nG01 X60 Y60\n");
+    for k in 1..=60 {
+        let (x, y) = curve(k);
+        let _ = writeln!(src, "G01 X{:.4} Y{:.4}", 60.0 + x, 60.0 + y);
+    }
+    src.push_str("M30\n%\n");
+    let (text, done) = stream(&src, &PAPER, &Options::default());
+    assert_eq!(done.summary.fitted_blocks, 1, "{:?}\n{text}", done.summary);
+    let head: String = src.lines().take(66).collect::<Vec<_>>().join("\n");
+    assert!(text.starts_with(&head), "{text}");
+    assert!(nc_lang::parse(&text).is_ok());
+    let input = nc_lang::parse(&src).expect("parses");
+    let whole = fit_program(&src, &input, &PAPER, &Options::default());
+    assert_eq!(whole.text, text);
+}

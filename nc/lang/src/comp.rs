@@ -153,6 +153,14 @@ impl Comp {
             .map(|a| a.programmed)
     }
 
+    /// How many moves are held.
+    pub fn held_moves(&self) -> usize {
+        self.queue
+            .iter()
+            .filter(|q| !matches!(q, Queued::Action(..)))
+            .count()
+    }
+
     /// Whether actions must be held (a move is held before them).
     pub fn holding(&self) -> bool {
         !self.queue.is_empty()

@@ -82,6 +82,12 @@ impl<'s, S: LineSource> Entries<'s, S> {
         self.interp.tape.kept()
     }
 
+    /// Moves read but held by cutter radius compensation until the next move decides their
+    /// corner: their blocks come with a later line's.
+    pub fn held_moves(&self) -> usize {
+        self.parser.comp.held_moves()
+    }
+
     /// Motion blocks read so far.
     pub fn blocks(&self) -> usize {
         self.parser.drained
