@@ -559,6 +559,27 @@ def feedmode_program(r, k):
     return lines
 
 
+def g92rot_program(r, k):
+    """G92 on the rotary axes (A or B, and C) as a 3D printer's post resets its extruder
+    axis, with G91, G92.1/G92.2/G92.3, and the angles then written."""
+    tilt = r.choice("AB")
+    lines = ["(G92 on rotary axes %d)" % k, "G21 G90", "G0 X0 Y0 Z0 %s0 C0" % tilt, "F%d" % r.randint(100, 900)]
+    for _ in range(r.randint(4, 9)):
+        c = r.random()
+        if c < 0.3:
+            words = " ".join("%s%s" % (a, num(r, -900, 900)) for a in r.sample([tilt, "C", "X"], r.randint(1, 3)))
+            lines.append("G92 %s" % words)
+        elif c < 0.4:
+            lines.append(r.choice(["G92.1", "G92.2", "G92.3"]))
+        elif c < 0.5:
+            lines.append("G91 G1 %s%s C%s" % (tilt, num(r, -5, 5), num(r, -5, 5)))
+            lines.append("G90")
+        else:
+            lines.append("G1 X%s %s%s C%s" % (num(r, -10, 10), tilt, num(r, -900, 900), num(r, -900, 900)))
+    lines.append("M2")
+    return lines
+
+
 def comp_program(r, k):
     """Cutter radius compensation on random closed contours of lines and arcs (convex and
     concave corners, tangent and sharp), G41/G42 by tool number (rs274's default table) and
@@ -636,7 +657,7 @@ FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", sub
             ("offsets", offsets_program, 20), ("context", context_program, 15),
             ("polar", polar_program, 10), ("comp", comp_program, 40),
             ("turns", turns_program, 10), ("g10", g10_program, 15),
-            ("feedmode", feedmode_program, 12)]
+            ("feedmode", feedmode_program, 12), ("g92rot", g92rot_program, 8)]
 
 
 def main():

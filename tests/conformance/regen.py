@@ -52,17 +52,18 @@ class Canon:
         self.plane = 1
         # The program's zero: the G5x and G92 offsets (mm). The interpreter reports program
         # coordinates; the reference is where the tool goes, the program's plus these.
-        self.g5x = [0.0] * 3
-        self.g92 = [0.0] * 3
+        # X Y Z (mm) and A B C (degrees).
+        self.g5x = [0.0] * 6
+        self.g92 = [0.0] * 6
 
     def offset(self):
         return [g + h for g, h in zip(self.g5x, self.g92)]
 
-    def set_g5x_offset(self, index, x, y, z, *rest):
-        self.g5x = [x * MM, y * MM, z * MM]
+    def set_g5x_offset(self, index, x, y, z, a=0.0, b=0.0, c=0.0, *rest):
+        self.g5x = [x * MM, y * MM, z * MM, a, b, c]
 
-    def set_g92_offset(self, x, y, z, *rest):
-        self.g92 = [x * MM, y * MM, z * MM]
+    def set_g92_offset(self, x, y, z, a=0.0, b=0.0, c=0.0, *rest):
+        self.g92 = [x * MM, y * MM, z * MM, a, b, c]
 
     # Queries the interpreter makes: rs274's answers (user units inch, XYZABC, no tools).
     def get_external_length_units(self):
@@ -171,14 +172,17 @@ def rs274_run(path):
     plane = "XY"
     printed = []
     motion = []
-    g5x, g92 = [0.0] * 3, [0.0] * 3
+    g5x, g92 = [0.0] * 6, [0.0] * 6
     for line in run.stdout.splitlines():
+        # X Y Z scaled to mm, A B C in degrees.
         m = re.search(r"SET_G5X_OFFSET\(\d+, (.*)\)", line)
         if m:
-            g5x = [float(t) * scale for t in m.group(1).split(",")[:3]]
+            t = [float(t) for t in m.group(1).split(",")[:6]]
+            g5x = [v * scale for v in t[:3]] + t[3:]
         m = re.search(r"SET_G92_OFFSET\((.*)\)", line)
         if m:
-            g92 = [float(t) * scale for t in m.group(1).split(",")[:3]]
+            t = [float(t) for t in m.group(1).split(",")[:6]]
+            g92 = [v * scale for v in t[:3]] + t[3:]
         offset = [g + h for g, h in zip(g5x, g92)]
         if "USE_LENGTH_UNITS(CANON_UNITS_INCHES)" in line:
             scale = MM
@@ -307,11 +311,12 @@ def write_from(path, named, out_path):
                 _, line, plane, turn, vals, _ = move
                 first, second, _ = {"XY": (0, 1, 2), "YZ": (1, 2, 0), "XZ": (2, 0, 1)}[plane]
                 vals = ([v + o for v, o in zip(vals[0:3], off)]
-                        + [vals[3] + off[first], vals[4] + off[second]] + vals[5:])
+                        + [vals[3] + off[first], vals[4] + off[second]]
+                        + [v + o for v, o in zip(vals[5:8], off[3:6])])
                 f.write("A %d %s %d %s\n" % (line, plane, turn, " ".join(fmt(v) for v in vals)))
             else:
                 kind, line, vals, _ = move
-                vals = [v + o for v, o in zip(vals[0:3], off)] + vals[3:]
+                vals = [v + o for v, o in zip(vals, off)]
                 f.write("%s %d %s\n" % (kind, line, " ".join(fmt(v) for v in vals)))
         if error:
             f.write("E %d %s\n" % (error[0], error[1].replace("\n", " ")))

@@ -268,7 +268,7 @@ pub enum ParseErrorKind {
     PolarPlane { letter: char },
     #[error("{}", if *.incremental { "G91 motion with polar coordinates is indeterminate at the program's zero: give the angle and radius in G90" } else { "@ without ^ at the program's zero: give the angle" })]
     PolarAtOrigin { incremental: bool },
-    #[error("G92 {axis}: dnurbs offsets X Y Z only (a rotary axis offset would turn the part to another angle than the program's)")]
+    #[error("G92 {axis}: an offset of a rotary axis makes the angle in effect read as the one given, but the tool axis in effect was given as a vector (I J K), not as angles")]
     OffsetRotary { axis: char },
     #[error("G92 needs at least one of X Y Z: the coordinates the current point is to have")]
     OffsetWithoutAxes,

@@ -113,6 +113,10 @@ pub(super) struct Modal {
     /// restores it).
     pub g92: [f64; 3],
     pub g92_saved: [f64; 3],
+    /// The `G92` offset of the rotary axes (degrees): the tilting axis (A or B) and C, added
+    /// to the angles a program writes; and the one `G92.3` restores.
+    pub g92_rot: [f64; 2],
+    pub g92_rot_saved: [f64; 2],
     pub comp: LengthComp,
     /// Tool length in effect (mm).
     pub tool_length: f64,
@@ -153,6 +157,8 @@ impl Default for Modal {
             offset: [0.0; 3],
             g92: [0.0; 3],
             g92_saved: [0.0; 3],
+            g92_rot: [0.0; 2],
+            g92_rot_saved: [0.0; 2],
             comp: LengthComp::Off,
             tool_length: 0.0,
             blend: true,

@@ -339,18 +339,7 @@ impl Parser<'_> {
             (r1, None) | (None, r1) => r1,
         };
         if let Some(w) = r1 {
-            match self.rotary {
-                Some((first, first_pos)) if first != w.letter => {
-                    let kind = ParseErrorKind::MixedRotaryAxes {
-                        letter: w.letter,
-                        first,
-                        first_pos,
-                    };
-                    return Err(kind.at(w.pos));
-                }
-                Some(_) => {}
-                None => self.rotary = Some((w.letter, w.pos)),
-            }
+            self.rotary_letter(w)?;
         }
         let r2 = line.get('C');
         let (prev1, prev2) = match self.orientation {
@@ -368,14 +357,37 @@ impl Parser<'_> {
             },
         };
         let inc = self.modal.incremental;
-        let resolve = |w: Option<super::word::Word>, prev: f64| -> Result<f64, ParseError> {
-            match w {
-                None => Ok(prev),
-                Some(w) if inc => check_domain(w.letter, prev + w.value, w.pos),
-                Some(w) => Ok(w.value),
+        // Absolute angles are the program's: the G92 offset makes them the machine's.
+        let [off1, off2] = self.modal.g92_rot;
+        let resolve =
+            |w: Option<super::word::Word>, prev: f64, off: f64| -> Result<f64, ParseError> {
+                match w {
+                    None => Ok(prev),
+                    Some(w) if inc => check_domain(w.letter, prev + w.value, w.pos),
+                    Some(w) if off != 0.0 => check_domain(w.letter, w.value + off, w.pos),
+                    Some(w) => Ok(w.value),
+                }
+            };
+        Ok((resolve(r1, prev1, off1)?, resolve(r2, prev2, off2)?))
+    }
+
+    /// The program's tilting-axis letter is `w`'s (a program uses A or B, not both).
+    pub(super) fn rotary_letter(&mut self, w: super::word::Word) -> Result<(), ParseError> {
+        match self.rotary {
+            Some((first, first_pos)) if first != w.letter => {
+                let kind = ParseErrorKind::MixedRotaryAxes {
+                    letter: w.letter,
+                    first,
+                    first_pos,
+                };
+                Err(kind.at(w.pos))
             }
-        };
-        Ok((resolve(r1, prev1)?, resolve(r2, prev2)?))
+            Some(_) => Ok(()),
+            None => {
+                self.rotary = Some((w.letter, w.pos));
+                Ok(())
+            }
+        }
     }
 }
 

@@ -32,12 +32,17 @@ impl Parser<'_> {
             return Ok((here[i] - self.modal.offset[i]) / self.modal.scale());
         }
         match self.orientation {
+            // In program coordinates: the G92 offset taken off the machine's angles.
             Orientation::Angles { r1_deg, r2_deg } => Ok(match (i, self.rotary) {
-                (5, _) => r2_deg,
-                (3, Some(('A', _)) | None) | (4, Some(('B', _))) => r1_deg,
+                (5, _) => r2_deg - self.modal.g92_rot[1],
+                (3, Some(('A', _)) | None) | (4, Some(('B', _))) => r1_deg - self.modal.g92_rot[0],
                 _ => 0.0,
             }),
-            Orientation::Vector([0.0, 0.0, 1.0]) => Ok(0.0),
+            Orientation::Vector([0.0, 0.0, 1.0]) => Ok(match (i, self.rotary) {
+                (5, _) => -self.modal.g92_rot[1],
+                (3, Some(('A', _)) | None) | (4, Some(('B', _))) => -self.modal.g92_rot[0],
+                _ => 0.0,
+            }),
             Orientation::Vector(_) => Err(unknown()),
         }
     }
@@ -91,11 +96,20 @@ impl State for Parser<'_> {
                 r.get(i).copied().unwrap_or(0.0)
             }
             5399 => return Some(Err(InterpError::InputUnknown)),
-            5210 => flag(self.modal.g92 != [0.0; 3]),
-            5211..=5219 => {
+            5210 => flag(self.modal.g92 != [0.0; 3] || self.modal.g92_rot != [0.0; 2]),
+            5211..=5213 => {
                 let i = (n - 5211) as usize;
                 self.modal.g92_saved.get(i).copied().unwrap_or(0.0)
             }
+            // A B C: the tilting axis is the program's letter (A before any).
+            5214 | 5215 => match (n, self.rotary) {
+                (5214, Some(('A', _)) | None) | (5215, Some(('B', _))) => {
+                    self.modal.g92_rot_saved[0]
+                }
+                _ => 0.0,
+            },
+            5216 => self.modal.g92_rot_saved[1],
+            5217..=5219 => 0.0,
             5220 => f64::from(self.modal.work) + 1.0,
             5221..=5390 if (n - 5221) % 20 < 10 => {
                 let k = ((n - 5221) / 20) as usize;

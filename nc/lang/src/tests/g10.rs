@@ -90,3 +90,30 @@ fn g95_feeds_per_revolution_of_the_speed_in_effect() {
     assert!((feeds[0] - 100.0).abs() < 1e-9 && (feeds[1] - 200.0).abs() < 1e-9);
     assert!((feeds[2] - 0.254 * 2000.0).abs() < 1e-9, "{feeds:?}");
 }
+
+#[test]
+fn g92_on_a_rotary_axis_makes_the_angle_in_effect_read_as_given() {
+    use nc_geom::program::Orientation;
+    // A 3D printer's post: the extruder axis reset, then written on.
+    let p = parse_with(
+        "G0 X0 Y0 Z0 A10 C0\nG92 A881.3\nG1 X1 A881.4 F100\n#1 = #5423\nG1 X2 A[#1 + 0.2]\nG92.1\nG1 X3 A5\nM2",
+        &setup(),
+    )
+    .unwrap();
+    let a: Vec<f64> = p
+        .blocks
+        .iter()
+        .map(|b| match b {
+            nc_geom::program::Block::Linear(m) => match m.orientation {
+                Orientation::Angles { r1_deg, .. } => r1_deg,
+                Orientation::Vector(_) => f64::NAN,
+            },
+            nc_geom::program::Block::Nurbs(_) => f64::NAN,
+        })
+        .collect();
+    let want = [10.0, 10.1, 10.3, 5.0];
+    assert!(
+        a.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-9),
+        "{a:?}"
+    );
+}

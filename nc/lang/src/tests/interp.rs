@@ -378,7 +378,8 @@ fn g92_shifts_the_program_zero_and_its_parameters_are_in_mm() {
 
 #[test]
 fn g92_refuses_what_it_cannot_honour_with_the_column() {
-    let (kind, line, col) = fails("G0 X0 Y0 Z0\nG92 A0\nM2");
+    // A rotary offset needs the angles in effect, not a tool vector.
+    let (kind, line, col) = fails("G0 X0 Y0 Z0 I0 J0.5 K1\nG92 A0\nM2");
     assert!(matches!(kind, E::OffsetRotary { axis: 'A' }), "{kind}");
     assert_eq!((line, col), (2, 5));
     let (kind, line, _) = fails("G0 X0 Y0 Z0\nG92\nM2");
