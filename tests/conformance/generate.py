@@ -580,6 +580,45 @@ def g92rot_program(r, k):
     return lines
 
 
+def rotation_program(r, k):
+    """Rotated coordinate systems (G10 L2 R) on G54..G59: straight moves in G90 and G91,
+    G17 arcs with I J (relative and G90.1 absolute) and R, the rotation switched with the
+    work offset, in mm and inch."""
+    inch = r.random() < 0.3
+    lines = ["(rotated coordinate systems %d)" % k, "G20" if inch else "G21", "G17 G90 G54",
+             "G0 X0 Y0 Z0", "F%d" % r.randint(50, 500)]
+    for p in range(1, 4):
+        lines.append("G10 L2 P%d X%s Y%s Z%s R%s" % (p, num(r, -20, 20), num(r, -20, 20),
+                                                  num(r, -5, 5), num(r, -180, 180)))
+    for _ in range(r.randint(4, 10)):
+        c = r.random()
+        if c < 0.15:
+            lines.append("G%d" % r.choice([54, 55, 56, 57]))
+            lines.append("G0 X%s Y%s" % (num(r, -10, 10), num(r, -10, 10)))
+        elif c < 0.25:
+            lines.append("G91 G1 X%s Y%s" % (num(r, -5, 5), num(r, -5, 5)))
+            lines.append("G90")
+        elif c < 0.35:
+            lines.append("G1 %s%s" % (r.choice("XYZ"), num(r, -10, 10)))
+        elif c < 0.6:
+            # A quarter round from where the program is, about a centre r away.
+            lines.append("G0 X0 Y0")
+            rad = r.uniform(1, 10)
+            if r.random() < 0.5:
+                lines.append("%s X%s Y%s I%s J0" % (r.choice(["G2", "G3"]), fmt(rad), fmt(rad if r.random() < 0.5 else -rad), fmt(rad)))
+            else:
+                lines.append("G90.1 %s X%s Y%s I%s J0" % (r.choice(["G2", "G3"]), fmt(2 * rad), fmt(0), fmt(rad)))
+                lines.append("G91.1")
+        elif c < 0.7:
+            lines.append("G0 X0 Y0")
+            lines.append("%s X%s Y%s R%s" % (r.choice(["G2", "G3"]), num(r, 1, 5), num(r, 1, 5), num(r, 4, 8)))
+        else:
+            lines.append("G1 X%s Y%s" % (num(r, -10, 10), num(r, -10, 10)))
+    lines.append("G54")
+    lines.append("M2")
+    return lines
+
+
 def comp_program(r, k):
     """Cutter radius compensation on random closed contours of lines and arcs (convex and
     concave corners, tangent and sharp), G41/G42 by tool number (rs274's default table) and
@@ -657,7 +696,8 @@ FAMILIES = [("expr", expr_program, 40), ("flow", flow_program, 30), ("subs", sub
             ("offsets", offsets_program, 20), ("context", context_program, 15),
             ("polar", polar_program, 10), ("comp", comp_program, 40),
             ("turns", turns_program, 10), ("g10", g10_program, 15),
-            ("feedmode", feedmode_program, 12), ("g92rot", g92rot_program, 8)]
+            ("feedmode", feedmode_program, 12), ("g92rot", g92rot_program, 8),
+            ("rotation", rotation_program, 12)]
 
 
 def main():

@@ -27,6 +27,7 @@ G5x and G92 offsets it sets (dnurbs's blocks are in that frame):
                                                the module, or rs274's 4 decimals where the
                                                module fails on the program or disagrees
 """
+import math
 import os
 import re
 import subprocess
@@ -42,6 +43,27 @@ EXPECTED = os.path.join(HERE, "expected")
 PLANES = {1: "XY", 2: "YZ", 3: "XZ"}
 
 
+def offset_of(g5x, g92, rot):
+    """How program coordinates become the tool's: LinuxCNC's canon adds the G92 offset,
+    turns X Y by the rotation, adds the G5x offset. Without a rotation: the two offsets'
+    sum (in the order the references were first written with)."""
+    if rot == 0.0:
+        return [g + h for g, h in zip(g5x, g92)]
+    return list(g5x) + list(g92) + [rot]
+
+
+def place(vals, off):
+    """Program X Y Z A B C (mm, degrees) where the tool goes."""
+    if len(off) == 6:
+        return [v + o for v, o in zip(vals, off)]
+    g5x, g92, rot = off[0:6], off[6:12], off[12]
+    x, y = vals[0] + g92[0], vals[1] + g92[1]
+    c, s = math.cos(math.radians(rot)), math.sin(math.radians(rot))
+    x, y = c * x - s * y, s * x + c * y
+    return ([x + g5x[0], y + g5x[1], vals[2] + g92[2] + g5x[2]]
+            + [v + g + h for v, g, h in zip(vals[3:6], g92[3:6], g5x[3:6])])
+
+
 class Canon:
     """Records the motion the interpreter asks for (the module calls these methods)."""
 
@@ -52,12 +74,16 @@ class Canon:
         self.plane = 1
         # The program's zero: the G5x and G92 offsets (mm). The interpreter reports program
         # coordinates; the reference is where the tool goes, the program's plus these.
-        # X Y Z (mm) and A B C (degrees).
+        # X Y Z (mm) and A B C (degrees), and the XY rotation (degrees, G10 L2 R).
         self.g5x = [0.0] * 6
         self.g92 = [0.0] * 6
+        self.rot = 0.0
 
     def offset(self):
-        return [g + h for g, h in zip(self.g5x, self.g92)]
+        return offset_of(self.g5x, self.g92, self.rot)
+
+    def set_xy_rotation(self, r):
+        self.rot = r
 
     def set_g5x_offset(self, index, x, y, z, a=0.0, b=0.0, c=0.0, *rest):
         self.g5x = [x * MM, y * MM, z * MM, a, b, c]
@@ -172,8 +198,11 @@ def rs274_run(path):
     plane = "XY"
     printed = []
     motion = []
-    g5x, g92 = [0.0] * 6, [0.0] * 6
+    g5x, g92, rot = [0.0] * 6, [0.0] * 6, 0.0
     for line in run.stdout.splitlines():
+        m = re.search(r"SET_XY_ROTATION\((.*)\)", line)
+        if m:
+            rot = float(m.group(1))
         # X Y Z scaled to mm, A B C in degrees.
         m = re.search(r"SET_G5X_OFFSET\(\d+, (.*)\)", line)
         if m:
@@ -183,7 +212,7 @@ def rs274_run(path):
         if m:
             t = [float(t) for t in m.group(1).split(",")[:6]]
             g92 = [v * scale for v in t[:3]] + t[3:]
-        offset = [g + h for g, h in zip(g5x, g92)]
+        offset = offset_of(g5x, g92, rot)
         if "USE_LENGTH_UNITS(CANON_UNITS_INCHES)" in line:
             scale = MM
         elif "USE_LENGTH_UNITS(CANON_UNITS_MM)" in line:
@@ -310,13 +339,16 @@ def write_from(path, named, out_path):
             if move[0] == "A":
                 _, line, plane, turn, vals, _ = move
                 first, second, _ = {"XY": (0, 1, 2), "YZ": (1, 2, 0), "XZ": (2, 0, 1)}[plane]
-                vals = ([v + o for v, o in zip(vals[0:3], off)]
-                        + [vals[3] + off[first], vals[4] + off[second]]
-                        + [v + o for v, o in zip(vals[5:8], off[3:6])])
+                # The centre is a point too: the end's, with the plane's two coordinates.
+                centre = list(vals[0:3])
+                centre[first], centre[second] = vals[3], vals[4]
+                centre = place(centre + [0.0, 0.0, 0.0], off)
+                end = place(vals[0:3] + vals[5:8], off)
+                vals = end[0:3] + [centre[first], centre[second]] + end[3:6]
                 f.write("A %d %s %d %s\n" % (line, plane, turn, " ".join(fmt(v) for v in vals)))
             else:
                 kind, line, vals, _ = move
-                vals = [v + o for v, o in zip(vals, off)]
+                vals = place(vals, off)
                 f.write("%s %d %s\n" % (kind, line, " ".join(fmt(v) for v in vals)))
         if error:
             f.write("E %d %s\n" % (error[0], error[1].replace("\n", " ")))

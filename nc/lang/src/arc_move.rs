@@ -41,6 +41,10 @@ impl Parser<'_> {
         }
         self.comp_curve_allowed(motion, pos)?;
         let plane = self.modal.plane;
+        if plane != Plane::Xy {
+            // A turn about Z tilts a ZX or YZ arc out of its plane.
+            self.rotation_forbids("an arc in G18 or G19", pos)?;
+        }
         let (a, b, _) = plane.axes();
         let centre = match line.get('R') {
             Some(r) => {
@@ -79,7 +83,12 @@ impl Parser<'_> {
                     (Some(i), Some(j)) if self.modal.arc_absolute => {
                         // G90.1: the centre's coordinates (work offset applied); made
                         // offsets from the start below.
-                        Centre::Offsets(i + self.modal.offset[a], j + self.modal.offset[b])
+                        if self.rotated() {
+                            let c = self.to_work([i, j, 0.0]);
+                            Centre::Offsets(c[0], c[1])
+                        } else {
+                            Centre::Offsets(i + self.modal.offset[a], j + self.modal.offset[b])
+                        }
                     }
                     (i, _) if self.modal.arc_absolute => {
                         let letter = Plane::offset_letter(if i.is_none() { a } else { b });
@@ -89,7 +98,11 @@ impl Parser<'_> {
                         };
                         return Err(kind.at(pos));
                     }
-                    (i, j) => Centre::Offsets(i.unwrap_or(0.0), j.unwrap_or(0.0)),
+                    (i, j) => {
+                        // Offsets are a vector: turned with the coordinate system (G17).
+                        let [i, j] = self.turn([i.unwrap_or(0.0), j.unwrap_or(0.0)]);
+                        Centre::Offsets(i, j)
+                    }
                 }
             }
         };

@@ -276,8 +276,10 @@ pub enum ParseErrorKind {
     G10Kind,
     #[error("G10 L{l} P{value}: P is {}", if *.l == 1 { "a tool number in the tool table" } else { "a work offset: 0 the one in effect, 1..6 for G54..G59 (dnurbs has no G59.1..G59.3)" })]
     G10Index { l: u8, value: f64 },
-    #[error("G10 {letter}{value}: dnurbs's work offsets move X Y Z and do not rotate (a rotary offset or a rotation turns the part to another angle than the program's)")]
+    #[error("G10 {letter}{value}: dnurbs's work offsets move X Y Z (an offset of a rotary axis is not supported)")]
     G10Rotary { letter: char, value: f64 },
+    #[error("{what} in a rotated coordinate system (G10 L2 R{deg}) is not supported by dnurbs: select a work offset without rotation first")]
+    NotRotated { what: &'static str, deg: f64 },
     #[error("{} needs the machine's {}: define it under [reference] in the machine file", Code('G', *.code), if *.code == 30.0 { "second reference position (g30)" } else { "reference position" })]
     NoReference { code: f64 },
     #[error("{} moves {axis} in machine coordinates, which are the workpiece's only with the rotary axes at 0: the tool is tilted or the table turned here", Code('G', *.code))]

@@ -54,8 +54,14 @@ impl Parser<'_> {
             return Ok(());
         }
         line.only("GMFSTLPXYZABCR", Context::SetTable { l })?;
-        for letter in ['A', 'B', 'C', 'R'] {
-            if let Some(w) = line.get(letter).filter(|w| w.value != 0.0) {
+        let r = line.get('R');
+        let rotary = ['A', 'B', 'C']
+            .into_iter()
+            .filter_map(|l| line.get(l))
+            .chain(r.filter(|_| l == 20));
+        for w in rotary {
+            let letter = w.letter;
+            if w.value != 0.0 {
                 let kind = ParseErrorKind::G10Rotary {
                     letter,
                     value: w.value,
@@ -78,6 +84,7 @@ impl Parser<'_> {
             .flatten()
             .unwrap_or([0.0; 3]);
         let here = if l == 20 {
+            self.rotation_forbids("G10 L20", pos)?;
             Some(self.here_or_reference(line, pos, 'X')?)
         } else {
             None
@@ -95,8 +102,12 @@ impl Parser<'_> {
         if let Some(slot) = self.work_offsets.get_mut(k) {
             *slot = Some(work);
         }
+        if let (Some(r), Some(slot)) = (r, self.rotations.get_mut(k)) {
+            *slot = r.value;
+        }
         if k == usize::from(self.modal.work) {
             self.modal.offset = std::array::from_fn(|i| work[i] + self.modal.g92[i]);
+            self.modal.rotation_deg = self.rotations.get(k).copied().unwrap_or(0.0);
         }
         Ok(())
     }

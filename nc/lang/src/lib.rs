@@ -121,6 +121,7 @@ mod params;
 mod parser;
 mod polar;
 mod predefined;
+mod rotation;
 mod rules;
 mod saved;
 mod source;

@@ -26,6 +26,7 @@ impl Parser<'_> {
         }
         if let Some((Code::CoordOffset(kind), pos)) = line.code_of_group(1) {
             self.comp_forbids("G92", pos)?;
+            self.rotation_forbids("G92", pos)?;
             return self.coord_offset(line, kind, pos);
         }
         if let Some((Code::SetTable, pos)) = line.code_of_group(1) {
@@ -60,6 +61,7 @@ impl Parser<'_> {
         match line.motion {
             Some((motion @ (Motion::G062 | Motion::G065), pos)) => {
                 self.comp_unsupported("a NURBS block", pos)?;
+                self.rotation_forbids("a NURBS block", pos)?;
                 self.comp_curve_allowed(motion, pos)?;
                 self.open_nurbs(line, motion, pos)
             }
@@ -87,6 +89,7 @@ impl Parser<'_> {
     ) -> Result<(), ParseError> {
         if let Motion::Cycle(c) = motion {
             self.comp_forbids("a canned cycle", pos)?;
+            self.rotation_forbids("a canned cycle", pos)?;
             return self.cycle(line, c, pos);
         }
         self.end_cycle();
@@ -98,6 +101,7 @@ impl Parser<'_> {
             Motion::G05 | Motion::G051 | Motion::G052 | Motion::G053
         ) {
             self.comp_forbids("a spline (G05, G05.1, G05.2)", pos)?;
+            self.rotation_forbids("a spline (G05, G05.1, G05.2)", pos)?;
             self.comp_curve_allowed(motion, pos)?;
         }
         match motion {
@@ -197,6 +201,33 @@ impl Parser<'_> {
             (None, None, false) => None,
             (None, m, _) => Some(self.here_or_reference(line, pos, m.unwrap_or('X'))?),
         };
+        if self.rotated() {
+            if let Some(w) = line.first_of("@^") {
+                return self
+                    .rotation_forbids("polar coordinates", w.pos)
+                    .map(|()| [0.0; 3]);
+            }
+            // In the program's (unturned) frame, then turned into the workpiece's.
+            let prev = here.map(|h| self.to_program(h)).unwrap_or([0.0; 3]);
+            let mut p = prev;
+            for (i, axis) in AXES.into_iter().enumerate() {
+                if let Some(w) = line.get(axis) {
+                    let v = w.value * self.modal.scale();
+                    p[i] = if self.modal.incremental {
+                        prev[i] + v
+                    } else {
+                        v
+                    };
+                }
+            }
+            let end = self.to_work(p);
+            for (i, axis) in AXES.into_iter().enumerate() {
+                if let Some(w) = line.get(axis) {
+                    check_domain(axis, end[i], w.pos)?;
+                }
+            }
+            return Ok(end);
+        }
         let mut end = [0.0; 3];
         for (i, axis) in AXES.into_iter().enumerate() {
             let prev = here.map(|h| h[i]).unwrap_or(0.0);

@@ -69,6 +69,8 @@ pub(super) struct Parser<'s> {
     pub comp: crate::comp::Comp,
     /// G54..G59 as the program has them (the setup's, changed by `G10 L2`/`L20`).
     pub work_offsets: [Option<[f64; 3]>; 6],
+    /// Their XY rotations (`G10 L2 R`), degrees.
+    pub rotations: [f64; 6],
     /// Tool lengths and diameters as the program has them (the setup's, changed by
     /// `G10 L1`), mm.
     pub tools: std::collections::BTreeMap<u32, f64>,
@@ -110,6 +112,7 @@ impl<'s> Parser<'s> {
             saved: crate::saved::SavedStates::default(),
             comp: crate::comp::Comp::default(),
             work_offsets: setup.work_offsets,
+            rotations: [0.0; 6],
             tools: setup.tools.clone(),
             diameters: setup.tool_diameters.clone(),
             comp_error: None,
@@ -326,6 +329,8 @@ impl<'s> Parser<'s> {
                         }
                     };
                     self.modal.offset = std::array::from_fn(|k| work[k] + self.modal.g92[k]);
+                    self.modal.rotation_deg =
+                        self.rotations.get(usize::from(i)).copied().unwrap_or(0.0);
                     self.modal.work = i;
                 }
                 Code::LengthComp(comp) => self.length_comp(line, comp, pos, motion)?,

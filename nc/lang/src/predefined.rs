@@ -29,6 +29,10 @@ impl Parser<'_> {
                     .map(|r| [r[0], r[1], r[2] - self.modal.tool_length])
             });
             let here = here.ok_or_else(unknown)?;
+            if self.rotated() {
+                let p = self.to_program(here);
+                return Ok(p.get(i).copied().unwrap_or(0.0) / self.modal.scale());
+            }
             return Ok((here[i] - self.modal.offset[i]) / self.modal.scale());
         }
         match self.orientation {
@@ -114,10 +118,11 @@ impl State for Parser<'_> {
             5221..=5390 if (n - 5221) % 20 < 10 => {
                 let k = ((n - 5221) / 20) as usize;
                 let i = ((n - 5221) % 20) as usize;
-                if k >= 6 {
-                    0.0
-                } else {
-                    self.offset(k, i)
+                match (k, i) {
+                    (6.., _) => 0.0,
+                    // #5230, #5250, ..: the rotation (G10 L2 R), degrees.
+                    (k, 9) => self.rotations.get(k).copied().unwrap_or(0.0),
+                    (k, i) => self.offset(k, i),
                 }
             }
             5400 => f64::from(self.modal.loaded.unwrap_or(0)),

@@ -55,8 +55,8 @@ fn each_refusal_is_at_its_word() {
     assert_eq!(fails("G10 P1 Z5"), (E::G10Kind, at(1, 1)));
     assert!(matches!(fails("G10 L2 P7 X1"), (E::G10Index { l: 2, .. }, p) if p == at(1, 8)));
     assert!(matches!(
-        fails("G10 L2 P1 X1 R30"),
-        (E::G10Rotary { letter: 'R', .. }, p) if p == at(1, 14)
+        fails("G10 L20 P1 X1 R30"),
+        (E::G10Rotary { letter: 'R', .. }, p) if p == at(1, 15)
     ));
     assert!(matches!(
         fails("G10 L2 P1 A90"),
@@ -116,4 +116,49 @@ fn g92_on_a_rotary_axis_makes_the_angle_in_effect_read_as_given() {
         a.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-9),
         "{a:?}"
     );
+}
+
+#[test]
+fn l2_r_turns_the_coordinate_system_about_its_origin() {
+    // G54 at X10, turned 90 deg: program X1 is machine Y+1 from the origin; G91 Y1 moves
+    // along the turned Y (machine -X); #5420/#5421 read the program's coordinates and #5230
+    // the rotation.
+    let e = ends(
+        "G10 L2 P1 X10 R90\nG54 G0 X1 Y0 Z0\nG91 G0 Y1\nG90\n#1=[#5420*100+#5421*10+#5230]\nG0 X[#1/100] Y0\nM2",
+    );
+    // #1 = 100 + 10 + 90: program X2, machine (10, 2).
+    let want = [[10.0, 1.0, 0.0], [9.0, 1.0, 0.0], [10.0, 2.0, 0.0]];
+    for (g, w) in e.iter().zip(want) {
+        assert!(g.iter().zip(w).all(|(a, b)| (a - b).abs() < 1e-9), "{e:?}");
+    }
+    // A G17 arc's centre offsets turn with it; G55 (not rotated) does not.
+    let e = ends("G10 L2 P1 R90\nG0 X0 Y0 Z0\nG2 X2 Y0 I1 J0 F100\nG55 G0 X1 Y0\nM2");
+    assert!(
+        (e[1][0] - 0.0).abs() < 1e-9 && (e[1][1] - 2.0).abs() < 1e-9,
+        "{e:?}"
+    );
+    assert!(
+        (e[2][0] - 1.0).abs() < 1e-9 && e[2][1].abs() < 1e-9,
+        "{e:?}"
+    );
+}
+
+#[test]
+fn what_is_not_turned_is_refused_in_a_rotated_system() {
+    let fails = |src: &str| {
+        let e = parse_with(src, &setup()).expect_err(src).errors[0];
+        (e.kind, e.pos)
+    };
+    let turned = "G10 L2 P1 R30\nG0 X0 Y0 Z0\n";
+    for (line, col) in [
+        ("G81 X1 Y1 Z-1 R1 F100", 1),
+        ("G18 G2 X1 Z1 I0.5 K0 F100", 5),
+        ("G92 X0", 1),
+        ("G0 @5 ^10", 4),
+        ("G5.1 X1 Y1 I1 J0 F100", 1),
+    ] {
+        let (kind, pos) = fails(&format!("{turned}{line}"));
+        assert!(matches!(kind, E::NotRotated { .. }), "{line}: {kind:?}");
+        assert_eq!(pos, at(3, col), "{line}");
+    }
 }
