@@ -93,6 +93,14 @@ pub fn describe_action(a: &Action) -> String {
                 } => format!(
                     "F{programmed_mm_min} mm/min is above the machine's max_feed_mm_min: feed moves run at {used_mm_min} mm/min"
                 ),
+                ActionKind::PathTolerance { p_mm, q_mm } => {
+                    let word = |l: &str, v: Option<f64>| v.map(|v| format!(" {l}{v} mm"));
+                    format!(
+                        "G64{}{}: LinuxCNC's permissions to leave the path; dnurbs follows it exactly (the on-line compressor, where the machine file turns it on, keeps the machine file's tolerance)",
+                        word("P", p_mm).unwrap_or_default(),
+                        word("Q", q_mm).unwrap_or_default()
+                    )
+                }
                 ActionKind::UserM { code, action } => match action {
                     UserAction::Ignore => {
                         format!("M{code} ignored, as the machine file's [mcodes] says")

@@ -343,6 +343,12 @@ pub enum ActionKind {
         programmed_mm_min: f64,
         used_mm_min: f64,
     },
+    /// `G64 P Q`: LinuxCNC's permissions to leave the path (blend within `P`, merge
+    /// collinear moves within `Q`, mm) that dnurbs does not take: it follows the path.
+    PathTolerance {
+        p_mm: Option<f64>,
+        q_mm: Option<f64>,
+    },
     /// A machine-defined M-code and what the machine file maps it to.
     UserM {
         code: u32,

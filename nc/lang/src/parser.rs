@@ -120,6 +120,9 @@ impl<'s> Parser<'s> {
         let startup = setup.startup.words();
         if !startup.is_empty() {
             parser.startup_error = parser.line(startup).err();
+            // The machine's own modes are not the program's words (a `G64 P` there is not
+            // reported with each program).
+            parser.actions.clear();
         }
         parser
     }
@@ -311,7 +314,17 @@ impl<'s> Parser<'s> {
                     self.feed = None;
                     self.feed_per_rev = None;
                 }
-                Code::Blend(b) => self.modal.blend = b,
+                Code::Blend(b) => {
+                    self.modal.blend = b;
+                    let scale = self.modal.scale();
+                    let (p_mm, q_mm) = (
+                        line.value('P').filter(|_| b).map(|v| v * scale),
+                        line.value('Q').filter(|_| b).map(|v| v * scale),
+                    );
+                    if p_mm.is_some() || q_mm.is_some() {
+                        self.act(pos, ActionKind::PathTolerance { p_mm, q_mm });
+                    }
+                }
                 Code::ArcCentreAbsolute(abs) => self.modal.arc_absolute = abs,
                 Code::Retract(to_r) => self.modal.cycle.retract_to_r = to_r,
                 Code::CannedOff if line.motion.is_none() => {

@@ -650,3 +650,18 @@ fn g5_2_blocks_are_linuxcncs_nurbs() {
     let e = parse("G0 X0 Y0 Z0\nF100\nG5.2 X1 Y1 P1\nX2 Y0 P1").unwrap_err();
     assert!(e.to_string().contains("not closed"), "{e}");
 }
+
+#[test]
+fn g64_p_q_are_reported_as_the_permissions_dnurbs_does_not_take() {
+    use nc_geom::program::ActionKind;
+    let p = crate::parse("G20 G64 P0.001 Q0.002\nG0 X0 Y0 Z0\nG61\nM2").unwrap();
+    let kinds: Vec<ActionKind> = p.actions.iter().map(|a| a.kind).collect();
+    assert_eq!(kinds.len(), 1, "{kinds:?}");
+    match kinds[0] {
+        ActionKind::PathTolerance {
+            p_mm: Some(pm),
+            q_mm: Some(qm),
+        } => assert!((pm - 0.0254).abs() < 1e-12 && (qm - 0.0508).abs() < 1e-12),
+        k => panic!("{k:?}"),
+    }
+}
