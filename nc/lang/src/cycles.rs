@@ -25,6 +25,10 @@ const PECK_CLEARANCE_IN: f64 = 0.010;
 /// cycle axis, `R L P Q`.
 const CYCLE_LETTERS: &str = "GMFSTXYZRLPQ@^";
 
+/// Most moves the canned cycle of one line may make (its `L` repeats times its pecks): a
+/// line's moves are built before the planner takes them, so they are bounded.
+pub const MAX_CYCLE_MOVES: usize = 100_000;
+
 impl Parser<'_> {
     /// A line of canned cycle `cycle` (its code, or the modal cycle with a hole position).
     pub(crate) fn cycle(
@@ -142,6 +146,7 @@ impl Parser<'_> {
             level
         };
         let back = PECK_CLEARANCE_IN * MM_PER_INCH / scale;
+        self.cycle_moves = 0;
         for k in 0..repeats {
             pa += da;
             pb += db;
@@ -235,6 +240,14 @@ impl Parser<'_> {
     ) -> Result<(), ParseError> {
         for (i, v) in end.iter().enumerate() {
             crate::moves::check_domain(['X', 'Y', 'Z'][i], *v, pos)?;
+        }
+        // One line's moves are built before the planner takes them: bounded.
+        self.cycle_moves += 1;
+        if self.cycle_moves > MAX_CYCLE_MOVES {
+            let kind = ParseErrorKind::CycleTooLong {
+                max: MAX_CYCLE_MOVES,
+            };
+            return Err(kind.at(pos));
         }
         let orientation = self.orientation;
         self.push_linear(

@@ -119,6 +119,8 @@ pub enum ParseErrorKind {
     CycleRBelowDepth { r: f64, depth: f64 },
     #[error("L{value}: a canned cycle's repeats are a whole number from 1")]
     BadRepeat { value: f64 },
+    #[error("the canned cycle on this line makes more than {max} moves (its L repeats times its pecks): write it over several lines")]
+    CycleTooLong { max: usize },
     #[error("Q{value}: the peck of G73/G83 must be above 0")]
     BadPeck { value: f64 },
     #[error("{letter}{value} is not a code: {letter} numbers are whole (M) or have one decimal (G), within 0.001")]

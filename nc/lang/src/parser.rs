@@ -54,6 +54,8 @@ pub(super) struct Parser<'s> {
     /// The start-up modes did not apply (a setup changed after [`crate::Startup::parse`]
     /// checked them): the first line reports it.
     startup_error: Option<ParseError>,
+    /// Moves the canned cycle of the current line has made.
+    pub cycle_moves: usize,
     /// `G95`: the programmed feed per revolution, mm.
     pub feed_per_rev: Option<f64>,
     /// The last feed reported as above the machine's highest (mm/min).
@@ -106,6 +108,7 @@ impl<'s> Parser<'s> {
             startup_error: None,
             clamped: None,
             feed_per_rev: None,
+            cycle_moves: 0,
             g52: None,
             last_spline_pq: None,
             level: 0,

@@ -665,3 +665,27 @@ fn g64_p_q_are_reported_as_the_permissions_dnurbs_does_not_take() {
         k => panic!("{k:?}"),
     }
 }
+
+#[test]
+fn a_canned_cycle_line_makes_a_bounded_number_of_moves() {
+    // Found by the fuzz target: L81115040 on a G81 line built 81 million holes' moves at
+    // once (2.3 GB); a peck of 1e-9 mm over a deep hole did the same with pecks.
+    for src in [
+        "G0 X0 Y0 Z1\nG91 G81 X1 R0.1 Z-0.5 F600 L81115040\nM2",
+        "G0 X0 Y0 Z1\nG83 X1 R0.1 Z-500 Q0.000001 F600\nM2",
+    ] {
+        let e = crate::parse(src).expect_err(src);
+        assert_eq!(
+            (e.kind, e.pos.line),
+            (
+                E::CycleTooLong {
+                    max: crate::cycles::MAX_CYCLE_MOVES
+                },
+                2
+            ),
+            "{src}"
+        );
+    }
+    // 10 000 holes on a line are fine.
+    assert!(crate::parse("G0 X0 Y0 Z1\nG91 G81 X1 R0.1 Z-0.5 F600 L10000\nM2").is_ok());
+}
