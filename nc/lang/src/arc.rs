@@ -112,6 +112,33 @@ pub struct ArcNet {
     pub sweep: f64,
 }
 
+impl ArcNet {
+    /// The `G02`/`G03` block of this net, every control point at the line's `pos`.
+    pub(crate) fn into_block(
+        self,
+        (pos, n): (nc_geom::program::SrcPos, Option<u32>),
+        feed_mm_min: f64,
+        tooling: nc_geom::program::MoveTooling,
+        turn_to: Option<(f64, f64)>,
+    ) -> nc_geom::program::NurbsBlock {
+        let count = self.ctrl.len();
+        nc_geom::program::NurbsBlock {
+            pos,
+            n,
+            kind: nc_geom::program::NurbsKind::G062,
+            degree: self.degree,
+            ctrl: self.ctrl,
+            tool_ctrl: Vec::new(),
+            ctrl_pos: vec![pos; count],
+            weights: self.weights,
+            knots: self.knots,
+            feed_mm_min,
+            tooling,
+            turn_to,
+        }
+    }
+}
+
 /// The net of the arc from `start` to `end` in `plane`, clockwise (`G02`) or not (`G03`),
 /// going round `turns` times (`P`, at least 1: the turns beyond the first are whole circles).
 pub fn arc(

@@ -7,7 +7,7 @@ use super::error::{Context, ParseError, ParseErrorKind};
 use super::line::Line;
 use super::parser::Parser;
 use crate::vocab::{Motion, Plane};
-use nc_geom::program::{Block, NurbsBlock, NurbsKind, Orientation, SrcPos};
+use nc_geom::program::{Block, Orientation, SrcPos};
 
 /// Most turns one arc may make (`P`); its control points are bounded further by
 /// [`nc_geom::program::MAX_BLOCK_CTRL`].
@@ -146,26 +146,13 @@ impl Parser<'_> {
             return self.comp_arc(line, pos, clockwise, (end, net.centre), feed_mm_min);
         }
         let tooling = self.tooling();
-        let count = net.ctrl.len();
         self.here = Some(end);
         if let Some((r1_deg, r2_deg)) = turn_to {
             self.orientation = Orientation::Angles { r1_deg, r2_deg };
             self.orientation_given = true;
         }
-        self.blocks.push(Block::Nurbs(NurbsBlock {
-            pos,
-            n: line.n,
-            kind: NurbsKind::G062,
-            degree: net.degree,
-            ctrl: net.ctrl,
-            tool_ctrl: Vec::new(),
-            ctrl_pos: vec![pos; count],
-            weights: net.weights,
-            knots: net.knots,
-            feed_mm_min,
-            tooling,
-            turn_to,
-        }));
+        let block = net.into_block((pos, line.n), feed_mm_min, tooling, turn_to);
+        self.blocks.push(Block::Nurbs(block));
         Ok(())
     }
 }

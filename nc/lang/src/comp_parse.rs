@@ -9,7 +9,7 @@ use super::error::{ParseError, ParseErrorKind};
 use super::line::Line;
 use super::parser::{tool_number, Parser};
 use crate::vocab::{Motion, Plane};
-use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, SrcPos};
+use nc_geom::program::{Block, LinearMove, SrcPos};
 
 impl CompError {
     fn kind(self) -> ParseErrorKind {
@@ -236,21 +236,13 @@ impl Parser<'_> {
                     let tol = arc::ArcTol::for_units(self.modal.inch);
                     match arc::arc(start, end, Plane::Xy, (!ccw, 1), offsets, tol) {
                         Ok(net) => {
-                            let count = net.ctrl.len();
-                            self.blocks.push(Block::Nurbs(NurbsBlock {
-                                pos: meta.pos,
-                                n: meta.n,
-                                kind: NurbsKind::G062,
-                                degree: net.degree,
-                                ctrl: net.ctrl,
-                                tool_ctrl: Vec::new(),
-                                ctrl_pos: vec![meta.pos; count],
-                                weights: net.weights,
-                                knots: net.knots,
-                                feed_mm_min: meta.feed_mm_min,
-                                tooling: meta.tooling,
-                                turn_to: None,
-                            }));
+                            let block = net.into_block(
+                                (meta.pos, meta.n),
+                                meta.feed_mm_min,
+                                meta.tooling,
+                                None,
+                            );
+                            self.blocks.push(Block::Nurbs(block));
                         }
                         Err(kind) => self.comp_error = Some(kind.at(meta.pos)),
                     }

@@ -81,11 +81,6 @@ impl Parser<'_> {
                 .flatten()
                 .unwrap_or([0.0; 3]);
             m.offset = std::array::from_fn(|k| work[k] + m.g92[k]);
-            m.rotation_deg = self
-                .rotations
-                .get(usize::from(saved.work))
-                .copied()
-                .unwrap_or(0.0);
             m.work = saved.work;
         }
         self.feed = saved.feed;

@@ -30,19 +30,24 @@ impl Parser<'_> {
         } else if !self.modal.inverse_time {
             let feed = f.value * self.modal.scale();
             self.feed = Some(feed);
-            if let Some(max) = self.setup.max_feed_mm_min.filter(|&m| feed > m) {
-                // Said once for each feed above the maximum (a post repeats its F).
-                if self.clamped != Some(feed) {
-                    self.clamped = Some(feed);
-                    let kind = ActionKind::FeedClamped {
-                        programmed_mm_min: feed,
-                        used_mm_min: max,
-                    };
-                    self.act(f.pos, kind);
-                }
-            }
+            self.report_clamp(feed, f.pos);
         }
         Ok(())
+    }
+
+    /// A feed above the machine's highest runs at it: said where it stands, once for each
+    /// such feed (a post repeats its F).
+    fn report_clamp(&mut self, feed: f64, pos: SrcPos) {
+        if let Some(max) = self.setup.max_feed_mm_min.filter(|&m| feed > m) {
+            if self.clamped != Some(feed) {
+                self.clamped = Some(feed);
+                let kind = ActionKind::FeedClamped {
+                    programmed_mm_min: feed,
+                    used_mm_min: max,
+                };
+                self.act(pos, kind);
+            }
+        }
     }
 
     /// Under `G95`: the feed, mm/min, from the feed per revolution and the spindle speed in
@@ -53,15 +58,8 @@ impl Parser<'_> {
         }
         let rpm = self.modal.rpm;
         self.feed = self.feed_per_rev.filter(|_| rpm > 0.0).map(|f| f * rpm);
-        if let (Some(feed), Some(max)) = (self.feed, self.setup.max_feed_mm_min) {
-            if feed > max && self.clamped != Some(feed) {
-                self.clamped = Some(feed);
-                let kind = ActionKind::FeedClamped {
-                    programmed_mm_min: feed,
-                    used_mm_min: max,
-                };
-                self.act(pos, kind);
-            }
+        if let Some(feed) = self.feed {
+            self.report_clamp(feed, pos);
         }
     }
 

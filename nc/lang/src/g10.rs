@@ -107,7 +107,6 @@ impl Parser<'_> {
         }
         if k == usize::from(self.modal.work) {
             self.modal.offset = std::array::from_fn(|i| work[i] + self.modal.g92[i]);
-            self.modal.rotation_deg = self.rotations.get(k).copied().unwrap_or(0.0);
         }
         Ok(())
     }

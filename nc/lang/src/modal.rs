@@ -116,8 +116,6 @@ pub(super) struct Modal {
     /// The `G92` offset of the rotary axes (degrees): the tilting axis (A or B) and C, added
     /// to the angles a program writes; and the one `G92.3` restores.
     pub g92_rot: [f64; 2],
-    /// The XY rotation of the work offset in effect (`G10 L2 R`), degrees.
-    pub rotation_deg: f64,
     pub g92_rot_saved: [f64; 2],
     pub comp: LengthComp,
     /// Tool length in effect (mm).
@@ -160,7 +158,6 @@ impl Default for Modal {
             g92: [0.0; 3],
             g92_saved: [0.0; 3],
             g92_rot: [0.0; 2],
-            rotation_deg: 0.0,
             g92_rot_saved: [0.0; 2],
             comp: LengthComp::Off,
             tool_length: 0.0,

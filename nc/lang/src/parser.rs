@@ -345,8 +345,6 @@ impl<'s> Parser<'s> {
                         }
                     };
                     self.modal.offset = std::array::from_fn(|k| work[k] + self.modal.g92[k]);
-                    self.modal.rotation_deg =
-                        self.rotations.get(usize::from(i)).copied().unwrap_or(0.0);
                     self.modal.work = i;
                 }
                 Code::LengthComp(comp) => self.length_comp(line, comp, pos, motion)?,

@@ -14,9 +14,17 @@ use super::parser::Parser;
 use nc_geom::program::SrcPos;
 
 impl Parser<'_> {
+    /// The XY rotation of the work offset in effect, degrees.
+    fn rotation_deg(&self) -> f64 {
+        self.rotations
+            .get(usize::from(self.modal.work))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
     /// Whether the work offset in effect is rotated.
     pub(super) fn rotated(&self) -> bool {
-        self.modal.rotation_deg != 0.0
+        self.rotation_deg() != 0.0
     }
 
     /// Refuses `what` in a rotated coordinate system.
@@ -26,7 +34,7 @@ impl Parser<'_> {
         pos: SrcPos,
     ) -> Result<(), ParseError> {
         if self.rotated() {
-            let deg = self.modal.rotation_deg;
+            let deg = self.rotation_deg();
             return Err(ParseErrorKind::NotRotated { what, deg }.at(pos));
         }
         Ok(())
@@ -34,7 +42,7 @@ impl Parser<'_> {
 
     /// A vector of the program's XY turned into the workpiece frame.
     pub(super) fn turn(&self, v: [f64; 2]) -> [f64; 2] {
-        let (s, c) = self.modal.rotation_deg.to_radians().sin_cos();
+        let (s, c) = self.rotation_deg().to_radians().sin_cos();
         [c * v[0] - s * v[1], s * v[0] + c * v[1]]
     }
 
@@ -54,7 +62,7 @@ impl Parser<'_> {
     pub(super) fn to_program(&self, w: [f64; 3]) -> [f64; 3] {
         let g = self.modal.g92;
         let work: [f64; 3] = std::array::from_fn(|i| self.modal.offset[i] - g[i]);
-        let (s, c) = self.modal.rotation_deg.to_radians().sin_cos();
+        let (s, c) = self.rotation_deg().to_radians().sin_cos();
         let (x, y) = (w[0] - work[0], w[1] - work[1]);
         [
             c * x + s * y - g[0],
