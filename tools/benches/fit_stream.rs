@@ -12,7 +12,7 @@
 mod common;
 
 use nc_fit::online::Compressing;
-use nc_fit::options::Options;
+use nc_fit::options::{Options, Policy};
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, SrcPos};
 use nc_lang::{Entries, Entry, LineSource, ParseError, Setup};
@@ -86,7 +86,11 @@ fn main() {
             text: String::new(),
         };
         let kin = MachineKinematics::Paper;
-        let mut c = Compressing::new(Entries::new(lines, &setup), &kin, Some(Options::default()));
+        let mut c = Compressing::new(
+            Entries::new(lines, &setup),
+            &kin,
+            Policy::on(Options::default()),
+        );
         let mut blocks = 0;
         for e in c.by_ref() {
             if let Entry::Block(_, Block::Nurbs(_)) = e.expect("the sweep parses") {

@@ -25,11 +25,10 @@ pub struct MachineSetup {
     pub axis_names: [&'static str; 5],
     /// Axis limits as in the machine file (mm or degrees), joint order.
     pub limits: [config::AxisLimits; 5],
-    /// On-line compression (`[interpolation] compress`): runs of G01 moves fitted into
-    /// G06.5 blocks before the program is built and planned; `None` when off.
-    pub compress: Option<nc_fit::options::Options>,
-    /// The compressor's settings from the machine file, for `--compress`.
-    compression: nc_fit::options::Options,
+    /// On-line compression (`[interpolation] compress`, `--compress`, `--no-compress`, and
+    /// the program's `G61`/`G64 P Q`): runs of G01 moves fitted into G06.5 blocks before
+    /// the program is built and planned.
+    pub compress: nc_fit::options::Policy,
 }
 
 pub fn method_of(m: config::Method) -> Method {
@@ -114,8 +113,10 @@ impl MachineSetup {
             method: method_of(ip.method),
             axis_names,
             limits,
-            compress: ip.compress.then_some(compression),
-            compression,
+            compress: nc_fit::options::Policy {
+                on: ip.compress,
+                ..nc_fit::options::Policy::on(compression)
+            },
         }
     }
 
@@ -128,10 +129,14 @@ impl MachineSetup {
         }
     }
 
-    /// `--compress` (`Some(true)`) or `--no-compress` (`Some(false)`) over the machine file.
+    /// `--compress` (`Some(true)`: on where the program says nothing) or `--no-compress`
+    /// (`Some(false)`: never, whatever the program permits) over the machine file.
     pub fn with_compress(mut self, over: Option<bool>) -> MachineSetup {
-        if let Some(on) = over {
-            self.compress = on.then_some(self.compression);
+        let opts = self.compress.opts;
+        match over {
+            Some(true) => self.compress = nc_fit::options::Policy::on(opts),
+            Some(false) => self.compress = nc_fit::options::Policy::off(opts),
+            None => {}
         }
         self
     }
@@ -145,12 +150,9 @@ impl MachineSetup {
         nc_geom::program::Program,
         Option<nc_fit::compress::Compressed>,
     ) {
-        match &self.compress {
-            Some(o) => {
-                let (p, c) = nc_fit::compress::compress(&program, &self.kin, o);
-                (p, Some(c))
-            }
-            None => (program, None),
+        if !self.compress.may_compress() {
+            return (program, None);
         }
+        nc_fit::compress::compress(&program, &self.kin, &self.compress)
     }
 }

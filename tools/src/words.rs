@@ -2,9 +2,46 @@
 //! lines `simulate` and `run` report. The machines dnurbs drives have no spindle or coolant
 //! drive yet, so these are reported, never silently dropped.
 
+use nc_fit::options::PROGRAM_TOL_MM;
 use nc_geom::program::{
-    Action, ActionKind, Coolant, Input, Program, Spindle, UserAction, WaitMode,
+    Action, ActionKind, Coolant, Input, Merge, PathMode, Program, Spindle, UserAction, WaitMode,
 };
+
+/// What a path-control mode does to the path: dnurbs blends no corner; the on-line
+/// compressor follows the naive-CAM tolerance ([`nc_fit::options::Policy`]).
+fn path_mode(mode: PathMode) -> String {
+    let (p_mm, q_mm) = match mode {
+        PathMode::Exact => {
+            return "G61/G61.1 exact path: the on-line compressor merges no move after it"
+                .to_owned()
+        }
+        PathMode::Blend { p_mm, q_mm } => (p_mm, q_mm),
+    };
+    let word = |l: &str, v: Option<f64>| v.map(|v| format!(" {l}{v} mm")).unwrap_or_default();
+    let code = format!("G64{}{}", word("P", p_mm), word("Q", q_mm));
+    let blend = if p_mm.is_some() {
+        "; corners are not blended, dnurbs follows them exactly"
+    } else {
+        ""
+    };
+    let (lo, hi) = (*PROGRAM_TOL_MM.start(), *PROGRAM_TOL_MM.end());
+    let merge = match mode.merge() {
+        Merge::Off => "the on-line compressor merges no move after it".to_owned(),
+        Merge::Machine => {
+            "the on-line compressor after it as the machine file or --compress sets it".to_owned()
+        }
+        Merge::Within(mm) if mm < lo => format!(
+            "below the compressor's closest tolerance ({lo} mm): the moves after it run as programmed"
+        ),
+        Merge::Within(mm) if mm > hi => format!(
+            "the on-line compressor merges runs of moves after it within {hi} mm, its largest tolerance (not with --no-compress)"
+        ),
+        Merge::Within(mm) => format!(
+            "the on-line compressor merges runs of moves after it within {mm} mm (not with --no-compress)"
+        ),
+    };
+    format!("{code}: {merge}{blend}")
+}
 
 /// One line per action: `line:col  word  what it does`.
 pub fn describe(program: &Program) -> Vec<String> {
@@ -93,14 +130,7 @@ pub fn describe_action(a: &Action) -> String {
                 } => format!(
                     "F{programmed_mm_min} mm/min is above the machine's max_feed_mm_min: feed moves run at {used_mm_min} mm/min"
                 ),
-                ActionKind::PathTolerance { p_mm, q_mm } => {
-                    let word = |l: &str, v: Option<f64>| v.map(|v| format!(" {l}{v} mm"));
-                    format!(
-                        "G64{}{}: LinuxCNC's permissions to leave the path; dnurbs follows it exactly (the on-line compressor, where the machine file turns it on, keeps the machine file's tolerance)",
-                        word("P", p_mm).unwrap_or_default(),
-                        word("Q", q_mm).unwrap_or_default()
-                    )
-                }
+                ActionKind::PathMode(mode) => path_mode(mode),
                 ActionKind::UserM { code, action } => match action {
                     UserAction::Ignore => {
                         format!("M{code} ignored, as the machine file's [mcodes] says")

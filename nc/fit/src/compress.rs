@@ -3,12 +3,14 @@
 //! blocks with the same fit as `dnurbs fit`, before the segment builder and the planner see
 //! it. The program's coordinates are already resolved here (work offsets, units, `G91`), so
 //! every run of feed moves qualifies that has no program word (spindle, coolant, stop,
-//! dwell) between its moves ([`super::find`] has the rest of the rules).
+//! dwell) between its moves ([`super::find`] has the rest of the rules). The program's
+//! path-control words (`G61`, `G64 P Q`) turn it on and off and set its tolerance where
+//! the [`Policy`] follows them.
 
 use super::find::{find_runs, moves_in};
-use super::Fitted;
-use crate::options::{Options, TOOL_MM};
-use nc_geom::program::{Block, LinearMove, NurbsBlock, NurbsKind, Program};
+use super::{fit, Fitted};
+use crate::options::{Options, Policy, TOOL_MM};
+use nc_geom::program::{ActionKind, Block, LinearMove, NurbsBlock, NurbsKind, Program};
 
 /// What the compressor did.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -28,12 +30,40 @@ pub struct Compressed {
     pub fit_deg: f64,
 }
 
-/// `program` with its runs of moves fitted into G06.5 blocks.
+/// How the compressor fits at each block of `program` (None: off there), and whether it is
+/// on anywhere: the path-control words before each block decide ([`Policy::at`]).
+fn fit_at(program: &Program, policy: &Policy) -> (Vec<Option<Options>>, bool) {
+    let mut now = policy.at(None);
+    let mut engaged = now.is_some();
+    let mut changes = program.actions.iter().filter_map(|a| match a.kind {
+        ActionKind::PathMode(m) => Some((a.before_block, m)),
+        _ => None,
+    });
+    let mut next = changes.next();
+    let mut at = Vec::with_capacity(program.blocks.len());
+    for k in 0..=program.blocks.len() {
+        while let Some((_, m)) = next.filter(|(b, _)| *b <= k) {
+            now = policy.at(Some(m));
+            engaged |= now.is_some();
+            next = changes.next();
+        }
+        at.push(now);
+    }
+    (at, engaged)
+}
+
+/// `program` with its runs of moves fitted into G06.5 blocks, and what the compressor did
+/// (None: it was never on).
 pub fn compress(
     program: &Program,
     kin: &nc_geom::kinematics::MachineKinematics,
-    opts: &Options,
-) -> (Program, Compressed) {
+    policy: &Policy,
+) -> (Program, Option<Compressed>) {
+    let (at, engaged) = fit_at(program, policy);
+    if !engaged {
+        return (program.clone(), None);
+    }
+    let opts = &policy.opts;
     let n = program.blocks.len();
     // A program word before block k ends any run there.
     let mut word_before = vec![false; n + 1];
@@ -42,14 +72,21 @@ pub fn compress(
             *w = true;
         }
     }
-    let runs = find_runs(
+    // A run starts where the compressor is on, and ends at the next word (a path-control
+    // word among them): its whole run is under the fit at its start.
+    let mut runs = find_runs(
         program,
         kin,
         opts,
-        |_| true,
+        |b| at[b].is_some(),
         |k| !word_before[k],
         |_, _| true,
     );
+    for run in &mut runs {
+        if let Some(o) = at[run.blocks.0].filter(|o| o.tol != opts.tol) {
+            run.fitted = fit(&run.points, o.tol, o.degree);
+        }
+    }
     let mut out = Compressed {
         moves_in: moves_in(program),
         blocks_in: n,
@@ -93,7 +130,7 @@ pub fn compress(
             end: program.end,
             tilt_word: program.tilt_word,
         },
-        out,
+        Some(out),
     )
 }
 

@@ -4,14 +4,15 @@
 //! [`super::find::find_runs`] finds, no program word between its moves), and so is the fit;
 //! a run that reaches [`MAX_RUN`] moves is fitted there and the next move starts a new one,
 //! so memory is bounded however long the program's runs. Up to that length the blocks are
-//! those [`super::compress::compress`] makes of the whole program (tested).
+//! those [`super::compress::compress`] makes of the whole program (tested). The program's
+//! path-control words turn it on and off and set its tolerance as they come ([`Policy`]).
 
 use super::compress::{fitted_block, Compressed};
 use super::find::{is_corner, keeps_vertical, may_follow, point, run_feed, same_run};
 use super::{fit, Point};
-use crate::options::Options;
+use crate::options::{Options, Policy};
 use nc_geom::kinematics::MachineKinematics;
-use nc_geom::program::{Block, LinearMove, SrcPos};
+use nc_geom::program::{ActionKind, Block, LinearMove, SrcPos};
 use nc_lang::{Entry, ParseError};
 use nc_plan::stream::ProgramSource;
 use std::collections::VecDeque;
@@ -25,8 +26,13 @@ pub const MAX_RUN: usize = 5_000;
 pub struct Compressing<'k, E> {
     inner: E,
     kin: &'k MachineKinematics,
-    /// None: compression is off, every entry passes as it is (counted).
+    /// When it is on, and how close.
+    policy: Policy,
+    /// How it fits now (the path-control mode in effect); None: off, every entry passes as
+    /// it is (counted).
     opts: Option<Options>,
+    /// It was on at some point.
+    engaged: bool,
     /// The last block read, when it is a linear move (a run's start point).
     prev: Option<LinearMove>,
     /// The run being gathered: the move it starts from, its moves, and its points (its
@@ -45,12 +51,15 @@ pub struct Compressing<'k, E> {
 }
 
 impl<'k, E: ProgramSource> Compressing<'k, E> {
-    /// `opts` None passes the entries through as they are.
-    pub fn new(inner: E, kin: &'k MachineKinematics, opts: Option<Options>) -> Self {
+    /// A policy that never compresses passes the entries through as they are.
+    pub fn new(inner: E, kin: &'k MachineKinematics, policy: Policy) -> Self {
+        let opts = policy.at(None);
         Compressing {
             inner,
             kin,
+            policy,
             opts,
+            engaged: opts.is_some(),
             prev: None,
             prev_of_run: None,
             run: Vec::new(),
@@ -63,10 +72,10 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
         }
     }
 
-    /// What the compressor did so far (all of it once the entries have ended); None when
-    /// it is off.
+    /// What the compressor did so far (all of it once the entries have ended); None while
+    /// it has never been on.
     pub fn compressed(&self) -> Option<Compressed> {
-        self.opts.as_ref().map(|_| self.done)
+        self.engaged.then_some(self.done)
     }
 
     /// The entries it reads (what they have noted on the way).
@@ -150,6 +159,12 @@ impl<'k, E: ProgramSource> Compressing<'k, E> {
         }
         let m = match block {
             Block::Linear(m) if self.opts.is_some() => m,
+            Block::Linear(m) => {
+                // Off here: it passes, and may start a run if the compressor comes on.
+                self.give(Block::Linear(m));
+                self.prev = Some(m);
+                return;
+            }
             other => {
                 self.close_run();
                 self.prev = None;
@@ -198,6 +213,10 @@ impl<E: ProgramSource> Iterator for Compressing<'_, E> {
                 Some(Ok(Entry::Action(mut a))) => {
                     // A program word ends the run; it stands before the next block given.
                     self.close_run();
+                    if let ActionKind::PathMode(mode) = a.kind {
+                        self.opts = self.policy.at(Some(mode));
+                        self.engaged |= self.opts.is_some();
+                    }
                     a.before_block = self.given;
                     self.out.push_back(Ok(Entry::Action(a)));
                 }

@@ -505,7 +505,8 @@ fn check(src: &str, counts: &mut Counts) -> Result<(), TestCaseError> {
     };
     let posted_s = plain.as_ref().ok().map(|f| f.duration);
     let plain_ok = accepted("posted", plain.map(|_| ()), src)?;
-    let (program, c) = compress(&posted, &kin, &opts);
+    let (program, c) = compress(&posted, &kin, &nc_fit::options::Policy::on(opts));
+    let c = c.expect("compression is on");
     counts.moves += c.moves_in as u64;
     counts.fitted_moves += c.moves_fitted as u64;
     counts.blocks += c.fitted_blocks as u64;

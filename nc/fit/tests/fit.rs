@@ -313,7 +313,9 @@ fn compressing_a_program_keeps_its_points_and_its_words() {
     let (cfg, bl) = nc_plan::fixtures::small_mill(0.002);
     let program = nc_lang::parse(&src).unwrap();
     let opts = Options::default();
-    let (small, c) = nc_fit::compress::compress(&program, &KIN, &opts);
+    let policy = nc_fit::options::Policy::on(opts);
+    let (small, c) = nc_fit::compress::compress(&program, &KIN, &policy);
+    let c = c.expect("compression is on");
     assert_eq!(c.fitted_blocks, 2, "{c:?}");
     assert_eq!(c.moves_fitted, 1200, "{c:?}");
     assert_eq!(small.blocks.len(), 4, "{c:?}");
@@ -363,7 +365,9 @@ fn a_compressed_row_end_is_passed_without_creeping() {
     for steps in [150, 223, 300, 417, 600] {
         let src = g01(&raster(4, steps), 3000.0);
         let program = nc_lang::parse(&src).unwrap();
-        let (small, c) = nc_fit::compress::compress(&program, &KIN, &Options::default());
+        let policy = nc_fit::options::Policy::on(Options::default());
+        let (small, c) = nc_fit::compress::compress(&program, &KIN, &policy);
+        let c = c.expect("compression is on");
         assert_eq!(c.fitted_blocks, 4, "{c:?}");
         let path = build(&small, &KIN, &bl).unwrap();
         let profile = nc_plan::plan::plan(&path, &KIN, &cfg).unwrap();

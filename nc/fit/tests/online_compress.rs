@@ -11,7 +11,7 @@ use nalgebra::Vector3;
 use nc_fit::compress::{compress, Compressed};
 use nc_fit::deviation::measure;
 use nc_fit::online::{Compressing, MAX_RUN};
-use nc_fit::options::Options;
+use nc_fit::options::{Options, Policy};
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Action, Block, Program};
 use nc_geom::segment::build;
@@ -23,8 +23,14 @@ const KIN: MachineKinematics = MachineKinematics::Paper;
 
 /// The blocks and actions the streaming compressor gives for `text`, and what it did.
 fn streamed(text: &str, opts: &Options) -> (Vec<Block>, Vec<Action>, Compressed) {
+    let (blocks, actions, done) = streamed_under(text, &Policy::on(*opts));
+    (blocks, actions, done.expect("compression is on"))
+}
+
+/// [`streamed`] under `policy`; None: it was never on.
+fn streamed_under(text: &str, policy: &Policy) -> (Vec<Block>, Vec<Action>, Option<Compressed>) {
     let setup = Setup::default();
-    let mut c = Compressing::new(Entries::new(StrLines::new(text), &setup), &KIN, Some(*opts));
+    let mut c = Compressing::new(Entries::new(StrLines::new(text), &setup), &KIN, *policy);
     let (mut blocks, mut actions) = (Vec::new(), Vec::new());
     for e in c.by_ref() {
         match e.expect("parses") {
@@ -42,13 +48,17 @@ fn streamed(text: &str, opts: &Options) -> (Vec<Block>, Vec<Action>, Compressed)
             }
         }
     }
-    (blocks, actions, c.compressed().expect("compression is on"))
+    (blocks, actions, c.compressed())
 }
 
 fn same_as_whole(name: &str, text: &str, opts: &Options) -> Compressed {
+    same_as_whole_under(name, text, &Policy::on(*opts)).expect("compression is on")
+}
+
+fn same_as_whole_under(name: &str, text: &str, policy: &Policy) -> Option<Compressed> {
     let program = nc_lang::parse(text).expect("parses");
-    let (whole, done) = compress(&program, &KIN, opts);
-    let (blocks, actions, got) = streamed(text, opts);
+    let (whole, done) = compress(&program, &KIN, policy);
+    let (blocks, actions, got) = streamed_under(text, policy);
     assert_eq!(blocks, whole.blocks, "{name}: blocks");
     assert_eq!(actions, whole.actions, "{name}: words");
     assert_eq!(got, done, "{name}: what the compressor did");
@@ -67,7 +77,7 @@ fn the_stream_compresses_as_the_whole_program_is_compressed() {
     }
     for seed in 1..4 {
         let name = format!("generated, seed {seed}");
-        fitted += same_as_whole(&name, &generated(seed, 3000), &opts).fitted_blocks;
+        fitted += same_as_whole(&name, &generated(seed, 3000, false), &opts).fitted_blocks;
     }
     assert!(fitted >= 20, "{fitted} blocks fitted");
 }
@@ -76,8 +86,9 @@ fn the_stream_compresses_as_the_whole_program_is_compressed() {
 /// are mostly gentle, some sharper than the corner angle; the tool axis swinging a little,
 /// sometimes jumping; and now and then a word, a dwell, a rapid, a feed change, or a switch
 /// between a feed per minute and inverse time (`G93`: F on every move, 1/minutes for its
-/// own length at the feed, to one decimal as a post writes it).
-fn generated(seed: u64, moves: usize) -> String {
+/// own length at the feed, to one decimal as a post writes it); with `path_words`, now and
+/// then a path-control word too (`G61`, `G61.1`, `G64`, `G64 P`, `G64 Q`, `Q0`).
+fn generated(seed: u64, moves: usize, path_words: bool) -> String {
     let mut rng = seed
         .wrapping_mul(6364136223846793005)
         .wrapping_add(1442695040888963407);
@@ -101,6 +112,17 @@ fn generated(seed: u64, moves: usize) -> String {
         } else if r < 0.025 {
             inverse = !inverse;
             s += if inverse { "G93\n" } else { "G94\n" };
+        } else if r < 0.035 && path_words {
+            let words = [
+                "G61",
+                "G61.1",
+                "G64",
+                "G64 P0.01",
+                "G64 P0.01 Q0.004",
+                "G64 Q0",
+            ];
+            let w = words[((next() * words.len() as f64) as usize).min(words.len() - 1)];
+            s += &format!("{w}\n");
         }
         let turn = if next() < 0.03 {
             0.5 + next()
@@ -137,7 +159,16 @@ proptest! {
     #[test]
     fn generated_programs_compress_alike_streamed_and_whole(seed in any::<u64>(), moves in 50usize..1500) {
         let opts = Options::default();
-        same_as_whole(&format!("seed {seed}, {moves} moves"), &generated(seed, moves), &opts);
+        same_as_whole(&format!("seed {seed}, {moves} moves"), &generated(seed, moves, false), &opts);
+    }
+
+    /// The program's path-control words turn the compressor on and off and set its
+    /// tolerance alike in both, whatever the machine's setting.
+    #[test]
+    fn path_words_compress_alike_streamed_and_whole(seed in any::<u64>(), moves in 50usize..1500, on: bool, follow: bool) {
+        let policy = Policy { opts: Options::default(), on, follow_program: follow };
+        let text = generated(seed, moves, true);
+        same_as_whole_under(&format!("seed {seed}, {moves} moves, {policy:?}"), &text, &policy);
     }
 }
 
@@ -253,4 +284,63 @@ fn a_run_in_inverse_time_becomes_a_block_at_its_length_over_its_time() {
     let text = inverse_time_program(40, 2.0, |_| 2.0e6);
     let done = same_as_whole("G93 beyond any feed", &text, &opts);
     assert_eq!((done.fitted_blocks, done.runs_kept), (0, 0), "{done:?}");
+}
+
+/// A curve posted as 0.1 mm moves whose points zigzag 3 um off it (a coarse post), three
+/// times: under `G61`, under `G64` (the machine's setting: off here) and under
+/// `G64 P0.05 Q0.02`. Only the last is merged, within the program's 0.02 mm rather than the
+/// machine's 0.001 mm, measured on the built paths.
+#[test]
+fn g64_q_turns_the_compressor_on_with_its_tolerance_and_g61_keeps_the_moves() {
+    let mut s = String::from("G90 G21 G94\nG00 X0 Y0 Z0 I0 J0 K1\nG01 F3000\n");
+    for section in 0..3 {
+        s += ["G61\n", "G64\n", "G64 P0.05 Q0.02\n"][section];
+        for k in 1..=400 {
+            let x = 40.0 * section as f64 + 0.1 * k as f64;
+            // 7 degrees between moves: below the corner angle.
+            let zig = if k % 2 == 0 { 0.003 } else { -0.003 };
+            let _ = writeln!(s, "X{x:.4} Y{:.4}", 3.0 * (x / 7.0).sin() + zig);
+        }
+    }
+    s += "M30\n";
+    let opts = Options::default();
+    let machine_off = Policy {
+        on: false,
+        ..Policy::on(opts)
+    };
+    let done =
+        same_as_whole_under("G61, G64, G64 Q", &s, &machine_off).expect("G64 Q turned it on");
+    let (blocks, _, _) = streamed_under(&s, &machine_off);
+    // The first 800 moves stay as they are (and the G00 and the G01 start).
+    let linear = blocks
+        .iter()
+        .take_while(|b| matches!(b, Block::Linear(_)))
+        .count();
+    assert!(linear >= 801, "{linear} moves before the first block");
+    assert_eq!(done.moves_fitted, 400, "{done:?}");
+    assert!(
+        done.fit_mm > 2.0 * opts.tol.mm && done.fit_mm <= 0.02,
+        "{done:?}"
+    );
+    // Measured on the built paths, not by the fit.
+    let input = nc_lang::parse(&s).unwrap();
+    let output = Program {
+        blocks,
+        ..input.clone()
+    };
+    let (_, bl) = nc_plan::fixtures::small_mill(0.002);
+    let (a, b) = (
+        build(&input, &KIN, &bl).unwrap(),
+        build(&output, &KIN, &bl).unwrap(),
+    );
+    let dev = measure(&a, &b, &KIN, 0.005, 0.02);
+    assert!(dev.point_mm <= 0.02 + 5e-7, "{dev:?}");
+    // `--no-compress`: never; the machine's setting on: the G64 section at its tolerance.
+    assert_eq!(
+        same_as_whole_under("no-compress", &s, &Policy::off(opts)),
+        None
+    );
+    let on = same_as_whole_under("machine on", &s, &Policy::on(opts)).unwrap();
+    assert_eq!(on.moves_fitted % 400, 0, "{on:?}");
+    assert!(on.moves_fitted >= 400 && on.fit_mm <= 0.02, "{on:?}");
 }

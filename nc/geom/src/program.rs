@@ -288,6 +288,55 @@ pub enum UserAction {
     Stop,
 }
 
+/// A path-control mode: LinuxCNC's permissions to leave the programmed path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PathMode {
+    /// `G61` exact path, `G61.1` exact stop: no permission.
+    Exact,
+    /// `G64`: blend corners within `p_mm`, merge runs of nearly collinear moves within
+    /// `q_mm` (LinuxCNC's naive-CAM tolerance; mm; None where the word is not given).
+    Blend {
+        p_mm: Option<f64>,
+        q_mm: Option<f64>,
+    },
+}
+
+impl Default for PathMode {
+    /// `G64` without `P` or `Q`: LinuxCNC's start-up mode.
+    fn default() -> Self {
+        PathMode::Blend {
+            p_mm: None,
+            q_mm: None,
+        }
+    }
+}
+
+/// How far runs of moves may be merged under a [`PathMode`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Merge {
+    /// Not at all: the moves run as programmed.
+    Off,
+    /// As the machine sets it (its default naive-CAM tolerance).
+    Machine,
+    /// Within this distance of the programmed points (mm).
+    Within(f64),
+}
+
+impl PathMode {
+    /// LinuxCNC's rule for the naive-CAM tolerance: `G64 Q`, else `G64 P`, else the
+    /// machine's default; none in `G61` and `G61.1`. A tolerance of 0 merges nothing.
+    pub fn merge(self) -> Merge {
+        match self {
+            PathMode::Exact => Merge::Off,
+            PathMode::Blend { p_mm, q_mm } => match q_mm.or(p_mm) {
+                None => Merge::Machine,
+                Some(t) if t > 0.0 => Merge::Within(t),
+                Some(_) => Merge::Off,
+            },
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ActionKind {
     /// `M03`/`M04`/`M05` with the speed in effect (rpm, `S`).
@@ -343,12 +392,9 @@ pub enum ActionKind {
         programmed_mm_min: f64,
         used_mm_min: f64,
     },
-    /// `G64 P Q`: LinuxCNC's permissions to leave the path (blend within `P`, merge
-    /// collinear moves within `Q`, mm) that dnurbs does not take: it follows the path.
-    PathTolerance {
-        p_mm: Option<f64>,
-        q_mm: Option<f64>,
-    },
+    /// `G61`, `G61.1` or `G64 P Q` (or an `M72` that restores one): the path-control mode
+    /// from here on. The on-line compressor follows it ([`PathMode::merge`]).
+    PathMode(PathMode),
     /// A machine-defined M-code and what the machine file maps it to.
     UserM {
         code: u32,

@@ -23,7 +23,7 @@ impl Parser<'_> {
             per_rev: m.per_rev,
             feed_per_rev: self.feed_per_rev,
             arc_absolute: m.arc_absolute,
-            blend: m.blend,
+            path: m.path,
             retract_to_r: m.cycle.retract_to_r,
             work: m.work,
             feed: self.feed,
@@ -61,7 +61,8 @@ impl Parser<'_> {
         Ok(())
     }
 
-    /// The modal state as `saved` has it; actions for the spindle and coolant it changes.
+    /// The modal state as `saved` has it; actions for the path-control mode, the spindle and
+    /// the coolant it changes.
     fn restore(&mut self, saved: &Saved, pos: SrcPos) {
         let m = &mut self.modal;
         m.plane = saved.plane;
@@ -70,7 +71,11 @@ impl Parser<'_> {
         m.inverse_time = saved.inverse_time;
         m.per_rev = saved.per_rev;
         m.arc_absolute = saved.arc_absolute;
-        m.blend = saved.blend;
+        if m.path != saved.path {
+            m.path = saved.path;
+            self.act(pos, ActionKind::PathMode(saved.path));
+        }
+        let m = &mut self.modal;
         m.cycle.retract_to_r = saved.retract_to_r;
         if m.work != saved.work {
             // The offset it was saved with is defined (it was selected then).

@@ -177,6 +177,8 @@ pub enum ParseErrorKind {
     // ---- modal state -------------------------------------------------------------------
     #[error("feed F{value} must be at least {MIN_FEED_MM_MIN} mm/min")]
     BadFeed { value: f64 },
+    #[error("G64 {letter}{value}: a path tolerance is a distance, 0 or more")]
+    NegativePathTolerance { letter: char, value: f64 },
     #[error(
         "{motion} needs a feed but none is in effect: program F<mm/min> on this or an earlier line"
     )]

@@ -119,6 +119,7 @@ mod nurbs_open;
 mod open_g52;
 mod params;
 mod parser;
+mod path;
 mod polar;
 mod predefined;
 mod rotation;

@@ -120,8 +120,9 @@ pub(super) struct Modal {
     pub comp: LengthComp,
     /// Tool length in effect (mm).
     pub tool_length: f64,
-    /// `G64` (true) or `G61`; dnurbs follows the programmed path exactly in both.
-    pub blend: bool,
+    /// `G61`/`G61.1` or `G64 P Q`: what the on-line compressor may merge (the action
+    /// [`ActionKind::PathMode`](nc_geom::program::ActionKind::PathMode) tells it).
+    pub path: nc_geom::program::PathMode,
     /// Mist and flood coolant on (`M07`, `M08` until `M09`).
     pub mist: bool,
     pub flood: bool,
@@ -161,7 +162,7 @@ impl Default for Modal {
             g92_rot_saved: [0.0; 2],
             comp: LengthComp::Off,
             tool_length: 0.0,
-            blend: true,
+            path: nc_geom::program::PathMode::default(),
             arc_absolute: false,
             mist: false,
             flood: false,

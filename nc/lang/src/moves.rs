@@ -124,8 +124,7 @@ impl Parser<'_> {
             s.push('H');
         }
         if matches!(line.code_of_group(10), Some((Code::Blend(true), _))) {
-            // G64 P (path tolerance) Q (naive-CAM tolerance): permissions to leave the
-            // path, which dnurbs does not need: it follows the programmed path.
+            // G64 P (path tolerance) Q (naive-CAM tolerance): read by `blend_words`.
             s.push_str("PQ");
         }
         if matches!(line.code_of_group(1), Some((Code::Dwell, _))) {

@@ -13,7 +13,7 @@ use super::nurbs::OpenNurbs;
 use crate::rules::{MAX_DWELL_S, MIN_VECTOR_LENGTH};
 use crate::vocab::Motion;
 use nc_geom::program::{
-    Action, ActionKind, Block, LengthMode, MoveTooling, Orientation, SrcPos, Wait,
+    Action, ActionKind, Block, LengthMode, MoveTooling, Orientation, PathMode, SrcPos, Wait,
 };
 
 /// The tool orientation until a program gives one: vertical.
@@ -123,9 +123,11 @@ impl<'s> Parser<'s> {
         let startup = setup.startup.words();
         if !startup.is_empty() {
             parser.startup_error = parser.line(startup).err();
-            // The machine's own modes are not the program's words (a `G64 P` there is not
-            // reported with each program).
-            parser.actions.clear();
+            // The machine's own modes are not the program's words, but for a path-control
+            // mode other than LinuxCNC's default: the compressor follows it from the start.
+            parser
+                .actions
+                .retain(|a| matches!(a.kind, ActionKind::PathMode(m) if m != PathMode::default()));
         }
         parser
     }
@@ -318,15 +320,13 @@ impl<'s> Parser<'s> {
                     self.feed_per_rev = None;
                 }
                 Code::Blend(b) => {
-                    self.modal.blend = b;
-                    let scale = self.modal.scale();
-                    let (p_mm, q_mm) = (
-                        line.value('P').filter(|_| b).map(|v| v * scale),
-                        line.value('Q').filter(|_| b).map(|v| v * scale),
-                    );
-                    if p_mm.is_some() || q_mm.is_some() {
-                        self.act(pos, ActionKind::PathTolerance { p_mm, q_mm });
-                    }
+                    let path = if b {
+                        self.blend_words(line)?
+                    } else {
+                        PathMode::Exact
+                    };
+                    self.modal.path = path;
+                    self.act(pos, ActionKind::PathMode(path));
                 }
                 Code::ArcCentreAbsolute(abs) => self.modal.arc_absolute = abs,
                 Code::Retract(to_r) => self.modal.cycle.retract_to_r = to_r,

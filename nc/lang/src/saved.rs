@@ -14,7 +14,7 @@ pub(crate) struct Saved {
     /// `G95`'s feed per revolution, mm.
     pub feed_per_rev: Option<f64>,
     pub arc_absolute: bool,
-    pub blend: bool,
+    pub path: nc_geom::program::PathMode,
     pub retract_to_r: bool,
     pub work: u8,
     pub feed: Option<f64>,

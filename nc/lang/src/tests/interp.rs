@@ -652,18 +652,60 @@ fn g5_2_blocks_are_linuxcncs_nurbs() {
 }
 
 #[test]
-fn g64_p_q_are_reported_as_the_permissions_dnurbs_does_not_take() {
-    use nc_geom::program::ActionKind;
-    let p = crate::parse("G20 G64 P0.001 Q0.002\nG0 X0 Y0 Z0\nG61\nM2").unwrap();
-    let kinds: Vec<ActionKind> = p.actions.iter().map(|a| a.kind).collect();
-    assert_eq!(kinds.len(), 1, "{kinds:?}");
-    match kinds[0] {
-        ActionKind::PathTolerance {
-            p_mm: Some(pm),
-            q_mm: Some(qm),
-        } => assert!((pm - 0.0254).abs() < 1e-12 && (qm - 0.0508).abs() < 1e-12),
-        k => panic!("{k:?}"),
+fn every_path_control_word_is_an_action_in_mm_with_linuxcnc_merge_rule() {
+    use nc_geom::program::{ActionKind, Merge, PathMode};
+    let src = "G20 G64 P0.001 Q0.002\nG0 X0 Y0 Z0\nG61\nG1 X1 F10\nG64 P0.004\nG61.1\n\
+               G64\nG64 P0.01 Q0\nM2";
+    let p = crate::parse(src).unwrap();
+    let modes: Vec<(PathMode, usize, u32)> = p
+        .actions
+        .iter()
+        .filter_map(|a| match a.kind {
+            ActionKind::PathMode(m) => Some((m, a.before_block, a.pos.line)),
+            _ => None,
+        })
+        .collect();
+    let near = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() < 1e-12);
+    assert_eq!(modes.len(), 6, "{modes:?}");
+    match modes[0].0 {
+        PathMode::Blend { p_mm, q_mm } => assert!(near(p_mm, 0.0254) && near(q_mm, 0.0508)),
+        m => panic!("{m:?}"),
     }
+    assert!(matches!(modes[0].0.merge(), Merge::Within(q) if (q - 0.0508).abs() < 1e-12));
+    // Where each stands: before the move after it.
+    assert_eq!(
+        modes.iter().map(|m| (m.1, m.2)).collect::<Vec<_>>(),
+        [(0, 1), (1, 3), (2, 5), (2, 6), (2, 7), (2, 8)]
+    );
+    // Q absent: P is the naive-CAM tolerance too (LinuxCNC's rule).
+    assert!(matches!(modes[2].0.merge(), Merge::Within(q) if (q - 0.1016).abs() < 1e-12));
+    assert_eq!(modes[1].0.merge(), Merge::Off);
+    assert_eq!(modes[3].0.merge(), Merge::Off);
+    assert_eq!(modes[4].0.merge(), Merge::Machine);
+    // Q0 merges nothing.
+    assert_eq!(modes[5].0.merge(), Merge::Off);
+    let e = crate::parse("G0 X0 Y0 Z0\nG64 P0.01 Q-1\nM2").unwrap_err();
+    assert_eq!((e.pos.line, e.pos.col), (2, 11), "{e}");
+    assert!(e.to_string().contains("a distance, 0 or more"), "{e}");
+}
+
+#[test]
+fn an_m72_restore_brings_back_the_path_mode_as_an_action() {
+    use nc_geom::program::{ActionKind, PathMode};
+    let src = "G0 X0 Y0 Z0 F100\nG64 P0.02\nM70\nG61\nG1 X1\nM72\nG1 X2\nM2";
+    let p = crate::parse(src).unwrap();
+    let modes: Vec<(PathMode, usize)> = p
+        .actions
+        .iter()
+        .filter_map(|a| match a.kind {
+            ActionKind::PathMode(m) => Some((m, a.before_block)),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(modes.len(), 3, "{modes:?}");
+    assert_eq!(modes[1], (PathMode::Exact, 1));
+    assert_eq!(modes[2].1, 2);
+    assert_eq!(modes[2].0, modes[0].0);
 }
 
 #[test]

@@ -38,6 +38,27 @@ fn startup_modes_are_in_effect_from_the_first_line() {
 }
 
 #[test]
+fn a_startup_path_mode_reaches_the_compressor_and_no_other_startup_word_is_reported() {
+    use nc_geom::program::{ActionKind, PathMode};
+    let kinds = |startup: &str| -> Vec<ActionKind> {
+        let p = parse_with("G0 X1 Y2 Z3\nM2", &with(startup)).unwrap();
+        p.actions.iter().map(|a| a.kind).collect()
+    };
+    // LinuxCNC's default mode says nothing the compressor does not assume.
+    assert_eq!(kinds("G17 G21 G64 G90"), []);
+    assert_eq!(kinds("G61"), [ActionKind::PathMode(PathMode::Exact)]);
+    match kinds("G20 G64 P0.001")[..] {
+        [ActionKind::PathMode(PathMode::Blend {
+            p_mm: Some(p),
+            q_mm: None,
+        })] => {
+            assert!((p - 0.0254).abs() < 1e-12)
+        }
+        ref k => panic!("{k:?}"),
+    }
+}
+
+#[test]
 fn startup_modes_refuse_what_is_not_a_mode_with_its_column() {
     let (col, message) = refused("G20 G0");
     assert_eq!(col, 5);
