@@ -154,6 +154,51 @@ fn simulate_compresses_on_request_and_says_so() {
     let _ = std::fs::remove_file(&src);
 }
 
+/// The program's `G64 Q` turns the compressor on where the machine file leaves it off, and
+/// says so with its line; `G61` before the moves keeps them; `--no-compress` overrides the
+/// program.
+#[test]
+fn simulate_follows_the_programs_g64_q_and_says_so() {
+    let src = temp("fit-helix-g64q.nc");
+    let with = |word: &str| helix(400).replace("G90 G21 G94\n", &format!("G90 G21 G94\n{word}\n"));
+    let json = |out: &std::process::Output| -> serde_json::Value {
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    std::fs::write(&src, with("G64 P0.01 Q0.005")).unwrap();
+    let q = json(&on_paper_machine("simulate", &src, &["--json"]));
+    assert_eq!(q["compressed"]["moves_fitted"], 400, "{}", q["compressed"]);
+    let text = on_paper_machine("simulate", &src, &[]);
+    let text = String::from_utf8_lossy(&text.stdout).to_string();
+    assert!(
+        text.contains("4:1  G64 P0.01 mm Q0.005 mm: the on-line compressor merges runs of moves after it within 0.005 mm"),
+        "{text}"
+    );
+    let off = json(&on_paper_machine(
+        "simulate",
+        &src,
+        &["--json", "--no-compress"],
+    ));
+    assert!(off.get("compressed").is_none(), "{}", off["compressed"]);
+    std::fs::write(&src, with("G61")).unwrap();
+    let exact = json(&on_paper_machine(
+        "simulate",
+        &src,
+        &["--json", "--compress"],
+    ));
+    assert_eq!(
+        exact["compressed"]["moves_fitted"], 0,
+        "{}",
+        exact["compressed"]
+    );
+    let _ = std::fs::remove_file(&src);
+}
+
 /// A post's program (NX's swarf pass: machine angles on every move, a `G28 Z` with the
 /// table still tilted after it) is fitted, the move that ends the run stays as written so
 /// the angles are modal after the block, and what is written runs in `simulate` on the

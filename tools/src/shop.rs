@@ -29,10 +29,12 @@ pub struct ShopArgs {
     pub optional_stop: bool,
     /// Fit runs of G01 moves into G06.5 blocks before planning (as `dnurbs fit` does, with
     /// the machine file's `compress_tol_mm`, `compress_tol_deg` and `compress_corner_deg`),
-    /// whatever the machine file's `[interpolation] compress` says.
+    /// whatever the machine file's `[interpolation] compress` says. The program's `G61`
+    /// still turns it off and `G64 Q` sets its tolerance for the moves after them.
     #[arg(long, conflicts_with = "no_compress")]
     pub compress: bool,
-    /// Plan the G01 moves as they are, whatever the machine file's `compress` says.
+    /// Plan the G01 moves as they are, whatever the machine file's `compress` and the
+    /// program's `G64 Q` say.
     #[arg(long)]
     pub no_compress: bool,
 }
