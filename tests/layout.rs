@@ -10,6 +10,8 @@
 //!   edges must not close a circle. Test-only code (`#[cfg(test)]`, `cfg(any(test, ...))`)
 //!   is left out: tests may reach anywhere.
 //! * **One module layout:** `x.rs` beside `x/`, never `x/mod.rs`.
+//! * **No orphan source file:** every `.rs` file under a crate's `src/` is a module of it
+//!   (test modules included), so none is left out of the build without a word.
 //! * **Files a few hundred lines long:** no source file has more than [`MAX_CODE_LINES`]
 //!   lines of non-test code (not blank, not only a comment).
 //! * **The real-time crates' graph:** the crates the real-time thread runs code of
@@ -494,6 +496,71 @@ fn the_circle_check_finds_a_planted_circle() {
     assert_eq!(c.len(), 1, "{c:?}");
     assert!(c[0].iter().any(|l| l.starts_with("x -> y")), "{c:?}");
     assert!(c[0].iter().any(|l| l.starts_with("y -> x")), "{c:?}");
+}
+
+/// Every file `mod` declarations reach from `file` (test-only ones too), with `dir` the
+/// folder its child modules' files are in.
+fn reachable(file: &Path, dir: &Path, items: &[syn::Item], out: &mut BTreeSet<PathBuf>) {
+    out.insert(file.to_path_buf());
+    for item in items {
+        let syn::Item::Mod(m) = item else { continue };
+        let name = m.ident.to_string();
+        match &m.content {
+            Some((_, inner)) => reachable(file, &dir.join(&name), inner, out),
+            None => {
+                let flat = dir.join(format!("{name}.rs"));
+                let (f, sub) = if flat.exists() {
+                    (flat, dir.join(&name))
+                } else {
+                    (dir.join(&name).join("mod.rs"), dir.join(&name))
+                };
+                let src = std::fs::read_to_string(&f)
+                    .unwrap_or_else(|e| panic!("{}: mod {name}: {e}", file.display()));
+                let ast = syn::parse_file(&src).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+                reachable(&f, &sub, &ast.items, out);
+            }
+        }
+    }
+}
+
+/// The `.rs` files under `dir`.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let path = e.expect("a directory entry").path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+#[test]
+fn every_source_file_is_a_module_of_its_crate() {
+    let mut reached = BTreeSet::new();
+    let mut dirs = BTreeSet::new();
+    for (_, entry) in crates() {
+        let src = std::fs::read_to_string(&entry).expect("the crate's entry");
+        let ast = syn::parse_file(&src).expect("the crate's entry parses");
+        let dir = entry.parent().expect("src/").to_path_buf();
+        reachable(&entry, &dir, &ast.items, &mut reached);
+        dirs.insert(dir);
+    }
+    let mut all = Vec::new();
+    for d in &dirs {
+        rust_files(d, &mut all);
+    }
+    let orphans: Vec<String> = all
+        .iter()
+        .filter(|f| !reached.contains(*f))
+        .map(|f| f.display().to_string())
+        .collect();
+    assert!(all.len() > 100, "found only {} files", all.len());
+    assert!(
+        orphans.is_empty(),
+        "source files no crate declares as a module (never built, never tested):\n{}",
+        orphans.join("\n")
+    );
 }
 
 #[test]

@@ -170,6 +170,23 @@ impl<'q> Follower<'q> {
         self.gates.awaiting_spindle
     }
 
+    /// The program's digital inputs as read this period (bit n: `M66 P<n>`), or `None`
+    /// without an I/O module (an `M66` then passes at once). Every period, before
+    /// [`Self::advance`].
+    pub fn inputs(&mut self, bits: Option<u64>) {
+        self.gates.inputs = bits;
+    }
+
+    /// The line of the `M66` the path waits at, while it waits.
+    pub fn awaiting_input(&self) -> Option<u32> {
+        self.gates.awaiting_input
+    }
+
+    /// `M66` waits that ended at their timeout, and the line of the last.
+    pub fn input_timeouts(&self) -> (u64, Option<u32>) {
+        (self.gates.input_timeouts, self.gates.last_timeout)
+    }
+
     /// Spindle and coolant as commanded now: those of the segment being machined, or of
     /// the one waiting for the spindle.
     pub fn aux(&self) -> Aux {
@@ -389,7 +406,15 @@ impl<'q> Follower<'q> {
             tau = held;
             self.tracker.rest();
         }
-        (tau, aux)
+        let dt = self.hold.period;
+        let (held, input_aux) = self
+            .gates
+            .input(self.local.iter(), tau, self.tau, self.paused, dt);
+        if let Some(held) = held {
+            tau = held;
+            self.tracker.rest();
+        }
+        (tau, aux.or(input_aux))
     }
 
     /// The path position at plan time `tau`, in the chunk that holds it (retiring those

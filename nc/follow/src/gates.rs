@@ -1,11 +1,14 @@
 //! Where the path waits: at an operator stop (`M00`, `M01`, `M06`: the plan is at rest
 //! where the chunk that carries it starts; the path holds there, paused, until resumed)
 //! and before a move that needs the spindle at speed (held there until the drive reports
-//! that speed; the move's spindle command goes out at once). Only the next chunk boundary
-//! can hold one, so the gates look at the first two chunks at hand.
+//! that speed; the move's spindle command goes out at once), and before a move after `M66`
+//! (held there until each digital input it waits for rises, falls, is high or is low, or
+//! its timeout has passed; the move's outputs go out at once, so an `M64` before the
+//! `M66` is in effect while it waits). Only the next chunk boundary can hold one, so the
+//! gates look at the first two chunks at hand.
 
 use crate::chunk::Chunk;
-use nc_geom::program::Aux;
+use nc_geom::program::{Aux, MAX_INPUT_WAITS};
 
 /// The gates' state.
 #[derive(Clone, Copy, Debug, Default)]
@@ -23,6 +26,21 @@ pub(crate) struct Gates {
     spindle_from: usize,
     /// Source line of the move that waits for the spindle, while it waits.
     pub(crate) awaiting_spindle: Option<u32>,
+    /// The program's digital inputs as last read (bit n: `M66 P<n>`); None without an
+    /// I/O module: an input wait then passes at once (simulated inputs).
+    pub(crate) inputs: Option<u64>,
+    /// Chunks from this index on may still hold input waits not yet passed; of the first
+    /// such chunk, waits from `input_k` on.
+    input_from: usize,
+    input_k: usize,
+    /// The wait under way: seconds waited, and whether the level before its edge was seen.
+    waited_s: f64,
+    seen: bool,
+    /// Line of the `M66` waited for, while it waits.
+    pub(crate) awaiting_input: Option<u32>,
+    /// Waits that ended at their timeout, and the last one's line.
+    pub(crate) input_timeouts: u64,
+    pub(crate) last_timeout: Option<u32>,
 }
 
 impl Gates {
@@ -78,5 +96,63 @@ impl Gates {
             self.awaiting_spindle = Some(g.src.line);
         }
         (Some(c.t_start.max(tau_now)), aux)
+    }
+
+    /// A move ahead that waits for inputs, reached by plan time `tau`: the plan time to hold
+    /// at while one of its waits is not over, and the move's outputs (and spindle and
+    /// coolant) to command from now on. `dt`: the period, s. Paused (at an operator stop
+    /// before the same move, or by the operator), nothing is switched and nothing waited
+    /// for until the run resumes.
+    pub(crate) fn input<'c>(
+        &mut self,
+        ahead: impl Iterator<Item = &'c Box<Chunk>>,
+        tau: f64,
+        tau_now: f64,
+        paused: bool,
+        dt: f64,
+    ) -> (Option<f64>, Option<Aux>) {
+        self.awaiting_input = None;
+        let mut ahead = ahead.take(2);
+        let found = ahead.find(|c| {
+            c.index >= self.input_from && c.first().is_some_and(|g| g.inputs[0].is_some())
+        });
+        let Some((c, g)) = found.and_then(|c| Some((c, c.first()?))) else {
+            return (None, None);
+        };
+        if tau < c.t_start {
+            return (None, None);
+        }
+        let held = Some(c.t_start.max(tau_now));
+        if paused {
+            return (held, None);
+        }
+        // At most MAX_INPUT_WAITS waits pass in one period (no loop without a bound).
+        for _ in 0..=MAX_INPUT_WAITS {
+            let Some(w) = g.inputs.get(self.input_k).copied().flatten() else {
+                self.input_from = c.index + 1;
+                self.input_k = 0;
+                return (None, Some(g.aux));
+            };
+            let high = |bits: u64| bits.checked_shr(u32::from(w.input)).unwrap_or(0) & 1 == 1;
+            let over = match self.inputs {
+                None => true,
+                Some(bits) if w.met(high(bits), &mut self.seen) => true,
+                Some(_) if self.waited_s + 0.5 * dt >= w.timeout_s => {
+                    self.input_timeouts += 1;
+                    self.last_timeout = Some(w.pos.line);
+                    true
+                }
+                Some(_) => false,
+            };
+            if !over {
+                self.waited_s += dt;
+                self.awaiting_input = Some(w.pos.line);
+                return (held, Some(g.aux));
+            }
+            self.input_k += 1;
+            self.waited_s = 0.0;
+            self.seen = false;
+        }
+        (held, Some(g.aux))
     }
 }

@@ -179,13 +179,50 @@ pub struct Wait {
     pub spindle: bool,
 }
 
+/// Most `M66` waits between two moves (`Segment::inputs`).
+pub const MAX_INPUT_WAITS: usize = 4;
+
+/// One `M66 P<n> L1..L4 Q<s>`: the path waits at rest until digital input `input` rises,
+/// falls, is high or is low, at most `timeout_s`; then it goes on (LinuxCNC's `#5399`
+/// would say -1 after a timeout; dnurbs refuses a program that reads it).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InputWait {
+    pub input: u8,
+    pub mode: WaitMode,
+    pub timeout_s: f64,
+    /// Where the `M66` stands.
+    pub pos: SrcPos,
+}
+
+impl InputWait {
+    /// Whether the wait is over with the input `high` now, `seen` telling whether the
+    /// level before the edge has been seen since the wait began (updated here).
+    pub fn met(&self, high: bool, seen: &mut bool) -> bool {
+        match self.mode {
+            WaitMode::Immediate => true,
+            WaitMode::High => high,
+            WaitMode::Low => !high,
+            WaitMode::Rise => {
+                let met = *seen && high;
+                *seen |= !high;
+                met
+            }
+            WaitMode::Fall => {
+                let met = *seen && !high;
+                *seen |= high;
+                met
+            }
+        }
+    }
+}
+
 impl Wait {
     pub fn is_some(&self) -> bool {
         self.dwell_s > 0.0 || self.operator.is_some() || self.spindle
     }
 }
 
-/// The spindle and coolant commanded while a segment runs.
+/// The spindle, coolant and digital outputs commanded while a segment runs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Aux {
     /// rpm, signed: positive after `M03` (clockwise), negative after `M04`, 0 stopped.
@@ -194,6 +231,9 @@ pub struct Aux {
     pub mist: bool,
     /// `M08` until `M09`.
     pub flood: bool,
+    /// The program's digital outputs (`M62`..`M65 P<n>`: bit n), on from the move after
+    /// the word.
+    pub outputs: u64,
 }
 
 impl Aux {
@@ -217,6 +257,14 @@ impl Aux {
             ActionKind::Coolant(Coolant::Off) => {
                 self.mist = false;
                 self.flood = false;
+            }
+            ActionKind::DigitalOutput { index, on, .. } => {
+                let bit = 1u64.checked_shl(u32::from(index)).unwrap_or(0);
+                if on {
+                    self.outputs |= bit;
+                } else {
+                    self.outputs &= !bit;
+                }
             }
             _ => {}
         }

@@ -14,7 +14,7 @@
 use crate::arclen::ArcTable;
 use crate::kinematics::{Joints, Kinematics, MachineKinematics, RotaryLimits};
 use crate::nurbs::DoubleNurbs;
-use crate::program::{Aux, Program, SrcPos, Wait};
+use crate::program::{Aux, InputWait, Program, SrcPos, Wait, MAX_INPUT_WAITS};
 use nalgebra::Vector3;
 
 mod builder;
@@ -124,6 +124,9 @@ pub struct Segment {
     pub stop: bool,
     /// What happens at rest before the segment starts (`G04`, `M00`, `M01`, `M06`).
     pub wait: Wait,
+    /// `M66` waits for digital inputs before the segment, in their order (the builder sets
+    /// them from the program's actions, on the first segment after them).
+    pub inputs: [Option<InputWait>; MAX_INPUT_WAITS],
     /// Tool length on the machine's Z axis at the start and end, mm; it changes linearly
     /// along a straight move (`G43 Z.. H..`) and stays constant along a curve.
     pub z: (f64, f64),
@@ -135,6 +138,12 @@ pub struct Segment {
 
 impl Segment {
     /// Pose at path position `s` in [0, length] (clamped). Allocation-free.
+    /// The path stops at rest before the segment and waits there (dwell, operator,
+    /// spindle, inputs).
+    pub fn waits(&self) -> bool {
+        self.wait.is_some() || self.inputs[0].is_some()
+    }
+
     pub fn pose(&self, s: f64) -> Pose {
         let s = s.clamp(0.0, self.length);
         let f = if self.length > 0.0 {
@@ -231,6 +240,8 @@ pub enum BuildErrorKind {
     RotaryWithoutRtcp { tilt_deg: f64, c_deg: f64 },
     #[error("the tool length changes from {from} to {to} mm at a curve: change it on a straight move before")]
     LengthChangeOnCurve { from: f64, to: f64 },
+    #[error("more than {MAX_INPUT_WAITS} M66 waits between two moves: put a move between them")]
+    TooManyInputWaits,
 }
 
 /// A [`BuildErrorKind`] at the position of the block that broke it.

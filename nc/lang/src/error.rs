@@ -242,6 +242,8 @@ pub enum ParseErrorKind {
     BadWaitMode { value: f64 },
     #[error("M66 Q{value}: the timeout is 0..=3600 s")]
     BadWaitTimeout { value: f64 },
+    #[error("M66 L{mode} waits at most Q seconds: give Q more than 0 (LinuxCNC refuses a zero timeout with a wait mode other than L0)")]
+    ZeroWaitTimeout { mode: u8 },
     #[error("M66 L{mode} with E (an analog input) waits for a digital input's edge or level: give P, or L0")]
     AnalogWait { mode: u8 },
     #[error("M{code} switched tool-centre-point control off ([mcodes] of the machine file): the machine's axes are then the program's, which they are only with the rotary axes at 0 (here {r1}, {r2} deg)")]

@@ -119,6 +119,10 @@ impl Parser<'_> {
                     }
                     None => 0.0,
                 };
+                if timeout_s == 0.0 && mode != WaitMode::Immediate {
+                    let l = line.value('L').unwrap_or(0.0) as u8; // 1..=4 here
+                    return Err(ParseErrorKind::ZeroWaitTimeout { mode: l }.at(pos));
+                }
                 ActionKind::WaitInput {
                     input,
                     mode,

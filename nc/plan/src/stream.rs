@@ -10,6 +10,8 @@ use nc_geom::segment::Path;
 
 mod cutter;
 mod source;
+#[cfg(test)]
+mod tests;
 
 pub use cutter::Cutter;
 pub use source::{Machine, ProgramEntries, ProgramSource, Source, Stages, StreamError};

@@ -1,5 +1,5 @@
 //! A move that waits (a `G04` dwell before it, an `M00` for the operator, the spindle
-//! coming to speed after `M03`) starts from rest: the plan arrives there at speed zero,
+//! coming to speed after `M03`, an input after `M66`) starts from rest: the plan arrives there at speed zero,
 //! rests, and leaves from zero. It once arrived and left at the planner's slowest feed
 //! (1 um/s): harmless where the axes move a micrometre per millimetre of path, but where a
 //! move turns C fast next to the vertical (hundreds of degrees per millimetre), leaving at
@@ -28,6 +28,7 @@ enum Wait {
     Dwell,
     Operator,
     Spindle,
+    Input,
 }
 
 /// A pass of `moves` moves of `step` mm along X and Y, A stepping by `da` and C by `dc`
@@ -45,6 +46,7 @@ fn program(
                 Wait::Dwell => "G04 P0.05\n",
                 Wait::Operator => "M00\n",
                 Wait::Spindle => "M03 S8000\n",
+                Wait::Input => "M64 P1\nM66 P0 L3 Q2\n",
             };
         }
         let t = k as f64 * step;
@@ -65,7 +67,7 @@ fn program(
 fn at_rest_where_moves_wait(path: &Path, profile: &FeedProfile) -> Result<(), TestCaseError> {
     let eps = 1e-9 * profile.length.max(1.0);
     for (seg, &at) in path.segments.iter().zip(&profile.seg_start).skip(1) {
-        if !seg.wait.is_some() {
+        if !seg.waits() {
             continue;
         }
         let mut found = false;
@@ -100,7 +102,15 @@ fn the_plan_rests_wherever_a_move_waits_and_holds_every_limit() {
     };
     let kin = MachineKinematics::Paper;
     let (cfg, bl) = nc_plan::fixtures::adversarial_mill(PERIOD);
-    let wait = prop_oneof![Just(Wait::Dwell), Just(Wait::Operator), Just(Wait::Spindle)];
+    let wait = prop_oneof![
+        Just(Wait::Dwell),
+        Just(Wait::Operator),
+        Just(Wait::Spindle),
+        Just(Wait::Input)
+    ];
+    let mut setup = nc_lang::Setup::default();
+    setup.io.digital_inputs = 1;
+    setup.io.digital_outputs = 2;
     let strategy = (
         (-3.0..3.0f64, -180.0..180.0f64, -0.2..0.2f64, -60.0..60.0f64),
         (4usize..40, 0.01..0.3f64),
@@ -110,7 +120,8 @@ fn the_plan_rests_wherever_a_move_waits_and_holds_every_limit() {
     let result =
         seeded_runner(config, env("WAIT_SEED", 0)).run(&strategy, |(angles, pass, waits)| {
             let src = program(angles, pass, &waits);
-            let program = nc_lang::parse(&src).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let program = nc_lang::parse_with(&src, &setup)
+                .map_err(|e| TestCaseError::fail(format!("{e:?}")))?;
             let path =
                 build(&program, &kin, &bl).map_err(|e| TestCaseError::fail(e.to_string()))?;
             let smooth = smooth_junctions(&path, &kin, &cfg);
@@ -142,4 +153,34 @@ fn the_plan_rests_wherever_a_move_waits_and_holds_every_limit() {
         "only {} plans of {cases} cases",
         planned.get()
     );
+}
+
+/// The builder puts each `M66` wait on the first segment after it, in order, with the
+/// outputs in effect; a fifth wait between two moves is refused at its line.
+#[test]
+fn input_waits_and_outputs_reach_the_segment_after_them() {
+    use nc_geom::program::WaitMode;
+    let mut setup = nc_lang::Setup::default();
+    setup.io.digital_inputs = 4;
+    setup.io.digital_outputs = 4;
+    let (_, bl) = nc_plan::fixtures::adversarial_mill(PERIOD);
+    let kin = MachineKinematics::Paper;
+    let src =
+        "G01 X0 Y0 Z0 A0 C0 F3000\nX1\nM62 P3\nM66 P1 L1 Q2\nM66 P2 L4 Q0.5\nX2\nM63 P3\nX3\nM2";
+    let path = build(&nc_lang::parse_with(src, &setup).unwrap(), &kin, &bl).unwrap();
+    let waits: Vec<_> = path.segments[1].inputs.iter().flatten().collect();
+    assert_eq!(waits.len(), 2, "{:?}", path.segments[1].inputs);
+    assert_eq!(
+        (waits[0].input, waits[0].mode, waits[0].pos.line),
+        (1, WaitMode::Rise, 4)
+    );
+    assert_eq!((waits[1].input, waits[1].timeout_s), (2, 0.5));
+    assert!(path.segments[1].stop && path.segments[1].waits());
+    let outputs: Vec<u64> = path.segments.iter().map(|s| s.aux.outputs).collect();
+    assert_eq!(outputs, [0, 1 << 3, 0]);
+    let five = "G01 X0 Y0 Z0 A0 C0 F3000\nM66 P0 L3 Q1\nM66 P0 L3 Q1\nM66 P0 L3 Q1\n\
+                M66 P0 L3 Q1\nM66 P0 L3 Q1\nX1\nM2";
+    let e = build(&nc_lang::parse_with(five, &setup).unwrap(), &kin, &bl).unwrap_err();
+    assert_eq!(e.pos.line, 6, "{e}");
+    assert!(e.to_string().contains("more than 4 M66 waits"), "{e}");
 }

@@ -7,7 +7,10 @@ use super::straight::{linear, linear_tool};
 use super::vertical::{c_leaving_vertical, follow, turn_c};
 use super::{BuildError, BuildErrorKind, BuildLimits, Pose, Segment};
 use crate::kinematics::{Joints, MachineKinematics, Tilt};
-use crate::program::{Action, Aux, Block, LengthMode, SrcPos, Wait};
+use crate::program::{
+    Action, ActionKind, Aux, Block, Input, InputWait, LengthMode, SrcPos, Wait, WaitMode,
+    MAX_INPUT_WAITS,
+};
 use nalgebra::Vector3;
 
 /// The segments of a program's blocks, given in order with the actions between them.
@@ -28,6 +31,10 @@ pub struct Builder<'k> {
     /// after the spindle is started or changes speed waits for it to be at speed.
     aux: Aux,
     spindle_wait: bool,
+    /// `M66` waits before the next block, for its first segment.
+    inputs: [Option<InputWait>; MAX_INPUT_WAITS],
+    /// An `M66` beyond [`crate::program::MAX_INPUT_WAITS`] before the next move: refused there.
+    too_many_waits: Option<SrcPos>,
 }
 
 impl<'k> Builder<'k> {
@@ -47,6 +54,8 @@ impl<'k> Builder<'k> {
             wait: Wait::default(),
             aux: Aux::default(),
             spindle_wait: false,
+            inputs: [None; MAX_INPUT_WAITS],
+            too_many_waits: None,
         }
     }
 
@@ -65,10 +74,31 @@ impl<'k> Builder<'k> {
         }
     }
 
-    /// An action (spindle, coolant, stop, dwell) before the next block.
+    /// An action (spindle, coolant, outputs, an input wait) before the next block.
     pub fn action(&mut self, a: &Action) {
         let aux = &mut self.aux;
         self.spindle_wait = aux.apply(&a.kind) || (self.spindle_wait && aux.spindle_rpm != 0.0);
+        if let ActionKind::WaitInput {
+            input: Input::Digital(input),
+            mode,
+            timeout_s,
+        } = a.kind
+        {
+            if mode != WaitMode::Immediate {
+                let wait = InputWait {
+                    input,
+                    mode,
+                    timeout_s,
+                    pos: a.pos,
+                };
+                match self.inputs.iter_mut().find(|w| w.is_none()) {
+                    Some(slot) => *slot = Some(wait),
+                    None => {
+                        self.too_many_waits.get_or_insert(a.pos);
+                    }
+                }
+            }
+        }
     }
 
     /// The start pose, where it was programmed and its joints: final once a segment is
@@ -94,6 +124,9 @@ impl<'k> Builder<'k> {
         out: &mut Vec<Segment>,
     ) -> Result<(), BuildError> {
         let err = |pos, kind| BuildError { pos, kind };
+        if let Some(pos) = self.too_many_waits.take() {
+            return Err(err(pos, BuildErrorKind::TooManyInputWaits));
+        }
         let (kin, limits) = (self.kin, self.limits);
         let lim = &limits.rotary;
         if self.start.is_none() {
@@ -139,7 +172,8 @@ impl<'k> Builder<'k> {
         for mut seg in segs {
             if core::mem::take(&mut first) {
                 seg.wait = core::mem::take(&mut self.wait);
-                seg.stop |= seg.wait.is_some();
+                seg.inputs = core::mem::take(&mut self.inputs);
+                seg.stop |= seg.waits();
             }
             seg.aux = self.aux;
             if self.spindle_wait && !seg.rapid {
@@ -159,6 +193,7 @@ impl<'k> Builder<'k> {
                     self.joints[4] = c;
                     // The turn waits where the segment would have: not a second time.
                     seg.wait = Wait::default();
+                    seg.inputs = [None; MAX_INPUT_WAITS];
                 }
             }
             // The joints at the end are those the interpolator arrives with: follow the

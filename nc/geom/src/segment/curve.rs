@@ -8,7 +8,7 @@ use super::{
 use crate::arclen::ArcTable;
 use crate::kinematics::{Joints, MachineKinematics};
 use crate::nurbs::DoubleNurbs;
-use crate::program::{Aux, NurbsBlock, NurbsKind, Wait};
+use crate::program::{Aux, NurbsBlock, NurbsKind, Wait, MAX_INPUT_WAITS};
 
 pub(super) fn nurbs(
     block: u32,
@@ -63,6 +63,7 @@ pub(super) fn nurbs(
                             rotary_only: true,
                             stop: false,
                             wait: Wait::default(),
+                            inputs: [None; MAX_INPUT_WAITS],
                             z: (pose.z, pose.z),
                             aux: Aux::default(),
                             geometry: Geometry::Line { from: c.p, to: c.p },
@@ -86,6 +87,7 @@ pub(super) fn nurbs(
             rotary_only: false,
             stop: piece.corner,
             wait: Wait::default(),
+            inputs: [None; MAX_INPUT_WAITS],
             z: (pose.z, pose.z),
             aux: Aux::default(),
             geometry: Geometry::Nurbs {

@@ -5,7 +5,7 @@ use super::{
     BuildError, BuildErrorKind, BuildLimits, Geometry, Pose, Segment, Tool, Tooling, NULL_MOVE,
 };
 use crate::kinematics::{Joints, MachineKinematics};
-use crate::program::{Aux, LinearMove, Orientation, Wait};
+use crate::program::{Aux, LinearMove, Orientation, Wait, MAX_INPUT_WAITS};
 use nalgebra::Vector3;
 
 pub(super) fn linear_tool(m: &LinearMove) -> Tool {
@@ -86,6 +86,7 @@ pub(super) fn linear(
         rotary_only,
         stop: false,
         wait: Wait::default(),
+        inputs: [None; MAX_INPUT_WAITS],
         z: (pose.z, m.tooling.tool_length),
         aux: Aux::default(),
         geometry: Geometry::Line { from, to },

@@ -49,6 +49,7 @@ pub(super) fn turn_c(seg: &Segment, joints: &Joints, c: f64, limits: &BuildLimit
         rotary_only: true,
         stop: seg.stop,
         wait: seg.wait,
+        inputs: seg.inputs,
         z: (seg.z.0, seg.z.0),
         aux: seg.aux,
         geometry: Geometry::Line { from: p, to: p },

@@ -443,7 +443,7 @@ impl Sampler {
                     } else {
                         last.after = st.after;
                     }
-                    last.vlim = if seg.wait.is_some() {
+                    last.vlim = if seg.waits() {
                         // A dwell, the operator's resume or the spindle: the path rests here.
                         // Arriving and leaving at the floor speed stepped each axis's velocity
                         // by its rate times that speed: C's by 0.47 deg/s where a move turned

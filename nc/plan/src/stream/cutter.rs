@@ -174,7 +174,7 @@ impl Sink for Cutter {
     fn segment(&mut self, seg: Segment) {
         let s = self.total;
         if let Some(&a) = self.open.starts.first() {
-            let waits = seg.wait.operator.is_some() || seg.wait.spindle;
+            let waits = seg.wait.operator.is_some() || seg.wait.spindle || seg.inputs[0].is_some();
             let long = s - a >= self.min_len;
             if waits || long || self.open.segments.len() >= MAX_CHUNK_SEGMENTS {
                 self.close();

@@ -5,7 +5,9 @@ use super::*;
 use crate::interp::tests::{machine, paper_program};
 use crate::interp::{Interpolator, Method};
 use crate::plan::plan;
+use nc_follow::{Follower, Queues, StreamCounters};
 use nc_geom::segment::build;
+use nc_geom::setpoint::Setpoint;
 
 fn planned(src: Option<&str>) -> (Path, FeedProfile, HoldConfig) {
     let (kin, cfg, bl) = machine();
@@ -18,8 +20,8 @@ fn planned(src: Option<&str>) -> (Path, FeedProfile, HoldConfig) {
     (path, profile, cfg.hold())
 }
 
-const TWO: &str = include_str!("../../../tests/data/two-blocks-g2.nc");
-const G01: &str = include_str!("../../../tests/data/g01-5axis.nc");
+const TWO: &str = include_str!("../../../../tests/data/two-blocks-g2.nc");
+const G01: &str = include_str!("../../../../tests/data/g01-5axis.nc");
 
 /// Run with the planner pushing one chunk every `every` periods (0: all at once) into a
 /// queue `depth` deep.
@@ -295,4 +297,90 @@ fn the_spindle_starts_only_after_the_tool_change_and_the_move_waits_for_its_spee
     assert!(last.done);
     assert_eq!((for_operator, for_spindle), (100, 200));
     assert_eq!(last.p.x, 20.0);
+}
+
+/// `M64` then two `M66` before one move, on inputs wired back from the outputs (one period
+/// late, as a valve's switch): the path waits at rest with the output already on until its
+/// input is high, then for a rise that never comes until the 0.5 s timeout, then goes on,
+/// and `M65` switches the output off from the move after it.
+#[test]
+fn the_path_waits_for_its_inputs_with_the_outputs_on_and_goes_on_at_a_timeout() {
+    let src = "G00 X0 Y0 Z50\nG01 X5 F600\nM64 P2\nM66 P2 L3 Q5\nM66 P1 L1 Q0.5\n\
+               G01 X20 F600\nM65 P2\nG01 X25\nM2";
+    let mut setup = nc_lang::Setup::default();
+    setup.io.digital_outputs = 4;
+    setup.io.digital_inputs = 4;
+    let (kin, cfg, bl) = machine();
+    let program = nc_lang::parse_with(src, &setup).unwrap();
+    let path = build(&program, &kin, &bl).unwrap();
+    let profile = plan(&path, &kin, &cfg).unwrap();
+    let hold = cfg.hold();
+    let (start, all) = chunks(path, &profile, &hold, 16);
+    let mut q = Queues::new();
+    let (mut feeder, inlet) = q.split(16);
+    let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+    feeder.feed(&mut all.into_iter());
+    let mut last = f.step();
+    let mut waited = [0u64; 2];
+    for i in 0..20_000u64 {
+        // The inputs as the module reports them: the outputs of the last period.
+        f.inputs(Some(last.aux.outputs));
+        let before = f.awaiting_input();
+        let sp = f.step();
+        if let Some(line) = before.filter(|_| f.awaiting_input().is_some()) {
+            assert_eq!(sp.p, last.p, "moved while waiting at {i}");
+            assert_eq!(sp.aux.outputs, 1 << 2, "the M64 before the wait is on");
+            waited[usize::from(line == 5)] += 1;
+        }
+        if sp.p.x > 20.0 + 1e-9 {
+            assert_eq!(sp.aux.outputs, 0, "M65 is in effect after X20");
+        }
+        last = sp;
+        if sp.done {
+            break;
+        }
+    }
+    feeder.feed(&mut std::iter::empty());
+    assert!(last.done);
+    assert_eq!(last.p.x, 25.0);
+    // P2 is high one period after the output went on; the rise on P1 never comes.
+    assert!(waited[0] <= 1, "{waited:?}");
+    let timeout_periods = (0.5 / hold.period).round() as u64;
+    assert!(
+        waited[1].abs_diff(timeout_periods) <= 1,
+        "{waited:?} against {timeout_periods}"
+    );
+    assert_eq!(f.input_timeouts(), (1, Some(5)));
+}
+
+/// Without an I/O module (a simulated machine) an `M66` passes at once.
+#[test]
+fn without_inputs_an_input_wait_passes_at_once() {
+    let src = "G00 X0 Y0 Z50\nG01 X5 F600\nM66 P0 L3 Q5\nG01 X20\nM2";
+    let mut setup = nc_lang::Setup::default();
+    setup.io.digital_inputs = 1;
+    let (kin, cfg, bl) = machine();
+    let program = nc_lang::parse_with(src, &setup).unwrap();
+    let path = build(&program, &kin, &bl).unwrap();
+    assert!(path.segments.iter().any(|s| s.inputs[0].is_some()));
+    let profile = plan(&path, &kin, &cfg).unwrap();
+    let hold = cfg.hold();
+    let (start, all) = chunks(path, &profile, &hold, 16);
+    let mut q = Queues::new();
+    let (mut feeder, inlet) = q.split(16);
+    let mut f = Follower::new(inlet, start, kin, cfg.rotary, hold);
+    feeder.feed(&mut all.into_iter());
+    let mut done = false;
+    for _ in 0..20_000u64 {
+        f.inputs(None);
+        let sp = f.step();
+        assert_eq!(f.awaiting_input(), None);
+        if sp.done {
+            done = true;
+            break;
+        }
+    }
+    feeder.feed(&mut std::iter::empty());
+    assert!(done);
+    assert_eq!(f.input_timeouts(), (0, None));
 }
