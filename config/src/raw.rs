@@ -45,6 +45,12 @@ pub(crate) struct RawFile {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawIo {
+    /// On a machine with a bus: the I/O module (the coolant's, if it has one).
+    pub bus: Option<String>,
+    pub node: Option<i64>,
+    /// Module output / input 1..=8 of program output / input 0.
+    pub first_output: Option<i64>,
+    pub first_input: Option<i64>,
     pub digital_outputs: Option<i64>,
     pub digital_inputs: Option<i64>,
     pub analog_outputs: Option<i64>,

@@ -12,6 +12,7 @@ use machine::bus;
 use machine::Machine;
 
 mod hardware;
+mod io;
 mod motion;
 mod program;
 mod spindle;
@@ -49,12 +50,23 @@ pub(crate) fn machine(
         )?),
         None => None,
     };
+    let (io, bus_io) = io::io(
+        &check,
+        raw.io,
+        &buses,
+        &drives,
+        spindle.as_ref(),
+        coolant.as_ref(),
+    )?;
     let nodes: Vec<bus::Nodes> = (0..buses.len())
         .map(|i| bus::Nodes {
             drives: (drives.iter().filter(|d| d.bus == i).count()
                 + usize::from(spindle.as_ref().is_some_and(|s| s.on_bus(i).is_some())))
                 as u32,
-            io: u32::from(coolant.as_ref().is_some_and(|c| c.on_bus(i).is_some())),
+            io: u32::from(
+                coolant.as_ref().is_some_and(|c| c.on_bus(i).is_some())
+                    || bus_io.is_some_and(|b| b.on_bus(i)),
+            ),
         })
         .collect();
     let bus_overload = check.bus_load(&buses, &nodes, period_s);
@@ -99,12 +111,13 @@ pub(crate) fn machine(
     };
     let mut program =
         program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
-    program.io = program::io(&check, raw.io, !buses.is_empty())?;
+    program.io = io;
     program.mcodes = program::mcodes(&check, raw.mcodes.unwrap_or_default())?;
     Ok(Machine {
         program,
         spindle,
         coolant,
+        bus_io,
         work_offsets,
         reference,
         g30,

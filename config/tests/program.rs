@@ -140,15 +140,86 @@ fn io_counts_and_machine_m_codes() {
         let (_, shown) = fail(&format!("{MINIMAL}\n{text}"));
         assert_mentions(&shown, parts);
     }
-    // A machine with a bus: [io] is refused rather than M62..M68 run without outputs.
-    let with_bus = format!(
-        "{MINIMAL}\n[[bus]]\nname = \"can0\"\ninterface = \"vcan0\"\n{}\n[io]\ndigital_outputs = 1\n",
-        ["x", "y", "z", "a", "c"]
-            .iter()
-            .enumerate()
-            .map(|(i, ax)| format!("\n[axes.{ax}.drive]\nbus = \"can0\"\nnode = {}\ncounts_per_unit = 1000.0\n", i + 1))
-            .collect::<String>()
+    // A simulated machine's I/O has no module bits.
+    let (_, shown) = fail(&format!(
+        "{MINIMAL}\n[io]\ndigital_outputs = 1\nfirst_output = 3\n"
+    ));
+    assert_mentions(&shown, &["io.first_output", "machine with a bus"]);
+}
+
+/// A machine with a bus and `[io]`: its digital outputs and inputs are consecutive bits of
+/// its I/O module, the coolant's when it has one; analog channels and overlaps are refused.
+#[test]
+fn io_on_a_bus_is_bits_of_the_one_io_module() {
+    let with_bus = |extra: &str| {
+        format!(
+            "{MINIMAL}\n[[bus]]\nname = \"can0\"\ninterface = \"vcan0\"\n{}\n{extra}",
+            ["x", "y", "z", "a", "c"]
+                .iter()
+                .enumerate()
+                .map(|(i, ax)| format!(
+                    "\n[axes.{ax}.drive]\nbus = \"can0\"\nnode = {}\ncounts_per_unit = 1000.0\n",
+                    i + 1
+                ))
+                .collect::<String>()
+        )
+    };
+    let m = common::parse(&with_bus(
+        "[io]\nbus = \"can0\"\nnode = 9\ndigital_outputs = 3\nfirst_output = 4\ndigital_inputs = 2\n",
+    ))
+    .unwrap();
+    let io = m.bus_io.expect("on the bus");
+    assert_eq!(
+        (
+            io.at.node,
+            io.first_output,
+            io.outputs,
+            io.first_input,
+            io.inputs
+        ),
+        (9, 4, 3, 1, 2)
     );
-    let (_, shown) = fail(&with_bus);
-    assert_mentions(&shown, &["io", "simulated machine", "M62..M68"]);
+    assert_eq!(
+        (m.program.io.digital_outputs, m.program.io.digital_inputs),
+        (3, 2)
+    );
+    assert_eq!(m.io_module(0), Some(9));
+    // With coolant: the same module, bus and node may be omitted.
+    let coolant = "[coolant]\nbus = \"can0\"\nnode = 7\nmist_output = 1\nflood_output = 2\n";
+    let m = common::parse(&with_bus(&format!(
+        "{coolant}\n[io]\ndigital_outputs = 4\nfirst_output = 3\ndigital_inputs = 4\nfirst_input = 3\n"
+    )))
+    .unwrap();
+    assert_eq!(m.bus_io.map(|b| (b.at.node, b.first_output)), Some((7, 3)));
+    assert_eq!(m.io_module(0), Some(7));
+    for (extra, parts) in [
+        ("[io]\ndigital_outputs = 1\n", &["io.bus", "bus and node"][..]),
+        (
+            "[io]\nbus = \"can0\"\nnode = 9\nanalog_outputs = 1\n",
+            &["io.analog_outputs", "M67"][..],
+        ),
+        (
+            "[io]\nbus = \"can0\"\nnode = 9\ndigital_outputs = 4\nfirst_output = 6\n",
+            &["io.first_output", "6", "within the module's 8"][..],
+        ),
+        (
+            "[io]\nbus = \"can0\"\nnode = 9\ndigital_inputs = 9\n",
+            &["io.first_input", "within the module's 8"][..],
+        ),
+        (
+            "[io]\nbus = \"can0\"\nnode = 2\ndigital_outputs = 1\n",
+            &["io.node", "unique on bus"][..],
+        ),
+        (
+            &format!("{coolant}\n[io]\ndigital_outputs = 2\n"),
+            &["io.first_output", "mist_output"][..],
+        ),
+        (
+            &format!("{coolant}\n[io]\nbus = \"can0\"\nnode = 8\ndigital_outputs = 1\nfirst_output = 3\n"),
+            &["io.node", "the coolant's I/O module"][..],
+        ),
+    ] {
+        let (_, shown) = fail(&with_bus(extra));
+        assert_mentions(&shown, parts);
+    }
 }

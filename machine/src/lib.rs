@@ -11,9 +11,11 @@ use std::fmt;
 use std::str::FromStr;
 
 pub mod bus;
+pub mod io;
 pub mod program;
 pub mod spindle;
 
+pub use io::BusIo;
 pub use program::{IoCounts, McodeAction, ProgramSetup, Tool};
 pub use spindle::{BusNode, Coolant, Spindle};
 
@@ -47,11 +49,21 @@ pub struct Machine {
     pub spindle: Option<crate::spindle::Spindle>,
     /// `[coolant]`: the coolant valves' I/O module, if the machine has one on its bus.
     pub coolant: Option<crate::spindle::Coolant>,
+    /// `[io]` on a machine with a bus: the program's digital I/O on its I/O module (the
+    /// coolant's, if it has one); the counts are in `program.io`.
+    pub bus_io: Option<BusIo>,
     /// `[program]`: start-up modes, tool table, subroutine path, loop limit.
     pub program: ProgramSetup,
 }
 
 impl Machine {
+    /// The node of the machine's I/O module on bus `bus` (the coolant's, or `[io]`'s: one
+    /// module when it has both), if it has one there.
+    pub fn io_module(&self, bus: usize) -> Option<u8> {
+        let coolant = self.coolant.as_ref().and_then(|c| c.on_bus(bus));
+        coolant.or(self.bus_io.filter(|b| b.on_bus(bus)).map(|b| b.at.node))
+    }
+
     /// Every bus within its `max_load` at the machine's period; else the message naming the
     /// bus, its load and by how much it is over.
     pub fn check_bus_load(&self) -> Result<(), &str> {

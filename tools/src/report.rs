@@ -50,6 +50,10 @@ pub struct Report {
     pub feed_holds: u64,
     /// Periods where the path ran out before a hold had stopped the tool (should be 0).
     pub hard_stops: u64,
+    /// `M66` waits that ended at their timeout (the path then went on, as LinuxCNC's does),
+    /// and the line of the last.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input_timeouts: Option<InputTimeouts>,
     pub drives: Vec<DriveEnd>,
     #[serde(with = "crate::rt_serde::SummaryDef")]
     pub latency: rt_loop::stats::Summary,
@@ -65,6 +69,14 @@ pub struct Report {
     /// How the planner streamed the program.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stream: Option<StreamNotes>,
+}
+
+/// `M66` waits that ended at their timeout.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct InputTimeouts {
+    pub count: u64,
+    /// The line of the last `M66` that timed out.
+    pub last_line: Option<u32>,
 }
 
 /// Axis names in joint order.
@@ -90,6 +102,15 @@ impl Report {
             "overruns: {} (longest run {})   feed holds (planner underruns): {}   hard stops: {}\n",
             self.overruns, self.max_consecutive_overruns, self.feed_holds, self.hard_stops
         ));
+        if let Some(t) = &self.input_timeouts {
+            let line = t
+                .last_line
+                .map_or(String::new(), |l| format!(", the last at line {l}"));
+            s.push_str(&format!(
+                "M66 waits ended at their timeout: {}{line} (the path went on after each)\n",
+                t.count
+            ));
+        }
         for d in &self.drives {
             let end = d
                 .program_end_counts

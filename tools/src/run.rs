@@ -80,6 +80,8 @@ pub struct RunResult {
     pub end_counts: Vec<Option<i32>>,
     pub underruns: u64,
     pub hard_stops: u64,
+    /// `M66` waits that ended at their timeout, and the line of the last.
+    pub input_timeouts: (u64, Option<u32>),
     /// Spindle, coolant, tool, stop and dwell words of the program (`crate::words`).
     pub program_words: Vec<String>,
     /// What on-line compression did, when it was on.
@@ -109,6 +111,10 @@ impl RunResult {
             max_consecutive_overruns: self.stats.max_consecutive_overruns,
             feed_holds: self.underruns,
             hard_stops: self.hard_stops,
+            input_timeouts: (self.input_timeouts.0 > 0).then_some(crate::report::InputTimeouts {
+                count: self.input_timeouts.0,
+                last_line: self.input_timeouts.1,
+            }),
             drives: self
                 .drives
                 .iter()
@@ -156,7 +162,7 @@ fn check_drives(m: &Machine) -> Result<(), InputError> {
 pub const AT_SPEED_WINDOW_MS: u16 = 100;
 
 /// The nodes of bus `bus` in the master's order: the axes' drives (X Y Z tilt C), then the
-/// spindle drive, then the coolant I/O module.
+/// spindle drive, then the I/O module (the coolant valves', the program's `[io]`).
 pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
     let mut v: Vec<NodeSetup> = machine
         .drives
@@ -175,7 +181,7 @@ pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
             v.push(NodeSetup::Velocity(n, setup));
         }
     }
-    if let Some(node) = machine.coolant.as_ref().and_then(|c| c.on_bus(bus)) {
+    if let Some(node) = machine.io_module(bus) {
         v.extend(NodeId::new(node).map(NodeSetup::Io));
     }
     v
@@ -361,6 +367,7 @@ impl Finished {
             end_counts,
             underruns: c.underruns,
             hard_stops: c.hard_stops,
+            input_timeouts: pipeline.follower.input_timeouts(),
             program_words: self.learned.words(),
             compressed: self.learned.compressed(),
             refusal: self.learned.refusal().map(|r| r.1),

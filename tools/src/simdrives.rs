@@ -58,7 +58,7 @@ pub fn node_value<T: std::str::FromStr>(s: &str) -> Result<(u8, T), String> {
 }
 
 /// The simulated nodes of bus `bus`: the axes' drives (at their `offset`), the spindle
-/// drive, the coolant I/O module.
+/// drive, the I/O module (its inputs wired back from its outputs).
 pub fn sim_nodes(
     m: &config::Machine,
     bus: usize,
@@ -84,7 +84,7 @@ pub fn sim_nodes(
             nodes.push(c);
         }
     }
-    if let Some(node) = m.coolant.as_ref().and_then(|c| c.on_bus(bus)) {
+    if let Some(node) = m.io_module(bus) {
         if let Some(n) = NodeId::new(node) {
             let mut c = SimNodeConfig::io(n);
             c.faults = faults.for_node(node);

@@ -96,7 +96,7 @@ pub fn describe_action(a: &Action) -> String {
                     } else {
                         "at once"
                     };
-                    format!("{code} P{index} digital output {index} {state} {when} (simulated: the machine file's [io])")
+                    format!("{code} P{index} digital output {index} {state} {when} (the machine file's [io]: a bit of its I/O module on a bus, else simulated)")
                 }
                 ActionKind::AnalogOutput {
                     index,
@@ -122,7 +122,12 @@ pub fn describe_action(a: &Action) -> String {
                         WaitMode::High => "wait until high",
                         WaitMode::Low => "wait until low",
                     };
-                    format!("M66 {which}: {how}, at most {timeout_s} s (simulated: the input answers at once)")
+                    let wait = if mode == WaitMode::Immediate {
+                        "(what it reads is refused: dnurbs plans ahead)"
+                    } else {
+                        "(the path waits at rest: on a bus the I/O module's input answers, on a simulated machine at once; at the timeout the path goes on)"
+                    };
+                    format!("M66 {which}: {how}, at most {timeout_s} s {wait}")
                 }
                 ActionKind::FeedClamped {
                     programmed_mm_min,

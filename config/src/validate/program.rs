@@ -4,8 +4,8 @@
 
 use crate::check::Check;
 use crate::error::ConfigError;
-use crate::raw::{RawIo, RawProgram};
-use machine::{IoCounts, McodeAction, ProgramSetup};
+use crate::raw::RawProgram;
+use machine::{McodeAction, ProgramSetup};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -76,47 +76,6 @@ pub(crate) fn program(
         program.max_loop_lines = n as u64;
     }
     Ok(program)
-}
-
-/// Most inputs or outputs of one kind.
-const MAX_IO: i64 = 64;
-
-/// `[io]`: simulated only (a machine with a bus has none yet: its I/O module's inputs and
-/// outputs beyond the coolant valves are not driven).
-pub(crate) fn io(
-    check: &Check<'_, '_>,
-    raw: Option<RawIo>,
-    has_bus: bool,
-) -> Result<IoCounts, ConfigError> {
-    let Some(raw) = raw else {
-        return Ok(IoCounts::default());
-    };
-    if has_bus {
-        return Err(check.invalid(
-            &["io"],
-            None,
-            "is for a simulated machine (no [[bus]]): dnurbs does not drive M62..M68 on a bus yet, \
-             so a program using them is refused there rather than run without them"
-                .into(),
-        ));
-    }
-    let count = |key: &str, v: Option<i64>| -> Result<u8, ConfigError> {
-        match v {
-            None => Ok(0),
-            Some(n) if (0..=MAX_IO).contains(&n) => Ok(n as u8),
-            Some(n) => Err(check.invalid(
-                &["io", key],
-                Some(n.to_string()),
-                format!("must be in 0..={MAX_IO}"),
-            )),
-        }
-    };
-    Ok(IoCounts {
-        digital_outputs: count("digital_outputs", raw.digital_outputs)?,
-        digital_inputs: count("digital_inputs", raw.digital_inputs)?,
-        analog_outputs: count("analog_outputs", raw.analog_outputs)?,
-        analog_inputs: count("analog_inputs", raw.analog_inputs)?,
-    })
 }
 
 /// `[mcodes]`: `M<n> = "<action>"` for M-codes the language does not define itself.

@@ -9,7 +9,7 @@ use machine::{BusNode, Coolant, Spindle};
 
 /// Where `[section]` is: on its bus at a free node, or nowhere on a simulated machine (no
 /// `[[bus]]`; then it must not name one).
-fn place(
+pub(super) fn place(
     check: &Check<'_, '_>,
     section: &str,
     (bus, node): (Option<&str>, Option<i64>),

@@ -18,8 +18,10 @@ pub struct BusDrives<L: CanLink> {
     pub drives: HVec<Drive, MAX_NODES>,
     /// The spindle drive and its index in the master's node order (after the axes).
     pub spindle: Option<(usize, machine::Spindle)>,
-    /// The coolant I/O module and its index in the master's node order (last).
+    /// The coolant valves on the I/O module, and its index in the master's node order (last).
     pub coolant: Option<(usize, machine::Coolant)>,
+    /// The program's digital I/O on the same module, and its index.
+    pub io: Option<(usize, machine::BusIo)>,
     pub(super) targets: [i32; MAX_NODES],
 }
 
@@ -39,6 +41,7 @@ impl<L: CanLink> BusDrives<L> {
             drives: v,
             spindle: None,
             coolant: None,
+            io: None,
             targets,
         })
     }
@@ -49,11 +52,29 @@ impl<L: CanLink> BusDrives<L> {
         self
     }
 
-    /// The coolant I/O module is the master's node after the drives (and the spindle).
+    /// The I/O module is the master's node after the drives (and the spindle).
+    fn module_index(&self) -> usize {
+        self.drives.len() + usize::from(self.spindle.is_some())
+    }
+
+    /// The coolant valves are outputs of the I/O module.
     pub fn with_coolant(mut self, coolant: machine::Coolant) -> Self {
-        let i = self.drives.len() + usize::from(self.spindle.is_some());
-        self.coolant = Some((i, coolant));
+        self.coolant = Some((self.module_index(), coolant));
         self
+    }
+
+    /// The program's digital outputs and inputs are bits of the I/O module (the coolant's,
+    /// when it has one: one module).
+    pub fn with_io(mut self, io: machine::BusIo) -> Self {
+        self.io = Some((self.module_index(), io));
+        self
+    }
+
+    /// The program's digital inputs as the I/O module reported them (bit n = `M66 P<n>`).
+    pub fn program_inputs(&self) -> Option<u64> {
+        let (i, io) = self.io.as_ref()?;
+        let st = self.master.status().get(*i)?;
+        Some(io.program_inputs(st.actual as u8))
     }
 
     /// Spindle speed and coolant outputs as targets.
@@ -63,9 +84,19 @@ impl<L: CanLink> BusDrives<L> {
                 *t = s.velocity(aux.spindle_rpm);
             }
         }
-        if let Some((i, c)) = &self.coolant {
-            if let Some(t) = self.targets.get_mut(*i) {
-                *t = i32::from(c.outputs(aux.mist, aux.flood));
+        let coolant = self
+            .coolant
+            .as_ref()
+            .map(|(i, c)| (*i, c.outputs(aux.mist, aux.flood)));
+        let io = self
+            .io
+            .as_ref()
+            .map(|(i, b)| (*i, b.output_byte(aux.outputs)));
+        // One module: its byte is the coolant's bits and the program's.
+        if let Some(i) = coolant.or(io).map(|(i, _)| i) {
+            let byte = coolant.map_or(0, |c| c.1) | io.map_or(0, |b| b.1);
+            if let Some(t) = self.targets.get_mut(i) {
+                *t = i32::from(byte);
             }
         }
     }

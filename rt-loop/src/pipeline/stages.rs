@@ -56,6 +56,8 @@ impl<L: CanLink> Pipeline<'_, L> {
     fn interpolate(&mut self) -> Prepared {
         let at_speed = self.spindle_at_speed();
         self.follower.spindle_at_speed(at_speed);
+        let inputs = self.buses.iter().find_map(|b| b.program_inputs());
+        self.follower.inputs(inputs);
         self.follower.advance();
         let t0 = os::now();
         let sp = self.follower.evaluate();
@@ -63,7 +65,7 @@ impl<L: CanLink> Pipeline<'_, L> {
         let overflow = self.set_targets(&axes).err();
         let compute_ns = os::now().saturating_sub(t0);
         let at_rest = sp.done || self.follower.is_stopped();
-        // At the end, or stopped: spindle and coolant off.
+        // At the end, or stopped: spindle, coolant and the program's outputs off.
         self.command_aux(if at_rest { Aux::default() } else { sp.aux });
         Prepared {
             compute_ns,

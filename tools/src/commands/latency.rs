@@ -64,6 +64,7 @@ pub fn latency(
         max_consecutive_overruns: stats.max_consecutive_overruns,
         feed_holds: 0,
         hard_stops: 0,
+        input_timeouts: None,
         drives: Vec::new(),
         latency: stats.summary(),
     };

@@ -53,5 +53,8 @@ pub(super) fn set_up<L: CanLink, C: Clock>(
     if let Some(c) = machine.coolant.as_ref().filter(|c| c.on_bus(bi).is_some()) {
         bus = bus.with_coolant(c.clone());
     }
+    if let Some(io) = machine.bus_io.filter(|b| b.on_bus(bi)) {
+        bus = bus.with_io(io);
+    }
     Ok(bus)
 }

@@ -136,8 +136,14 @@ fn io_beyond_the_machine_or_shared_words_are_refused_with_the_column() {
         E::Interp(I::InputUnknown)
     ));
     // LinuxCNC: "Zero timeout with wait type != immediate return".
-    for src in ["G0 X0 Y0 Z0\nM66 P0 L3\nM2", "G0 X0 Y0 Z0\nM66 P0 L2 Q0\nM2"] {
-        assert!(matches!(fails(src), (E::ZeroWaitTimeout { .. }, 2, 1)), "{src}");
+    for src in [
+        "G0 X0 Y0 Z0\nM66 P0 L3\nM2",
+        "G0 X0 Y0 Z0\nM66 P0 L2 Q0\nM2",
+    ] {
+        assert!(
+            matches!(fails(src), (E::ZeroWaitTimeout { .. }, 2, 1)),
+            "{src}"
+        );
     }
     // E belongs to M66..M68 only.
     assert!(matches!(
