@@ -130,7 +130,7 @@ use std::path::Path;
 pub use error::{ConfigError, LineCol, Location};
 // The types a machine file is read into, defined below the file's parsing (crate `machine`).
 pub use machine::{
-    bus, Axes, AxisLimits, BusNode, Compress, Coolant, Interpolation, IoCounts, Kinematics,
+    bus, Axes, AxisLimits, BusNode, Compress, Coolant, Interpolation, IoCounts, Kinematics, Level,
     Machine, McodeAction, Method, Realtime, RotaryName, Spindle, Tool, UnknownMethod,
 };
 

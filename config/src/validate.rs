@@ -112,7 +112,7 @@ pub(crate) fn machine(
     let mut program =
         program::program(&check, raw.program.unwrap_or_default(), &work_offsets, read)?;
     program.io = io;
-    program.mcodes = program::mcodes(&check, raw.mcodes.unwrap_or_default())?;
+    program.mcodes = program::mcodes(&check, raw.mcodes.unwrap_or_default(), io)?;
     Ok(Machine {
         program,
         spindle,

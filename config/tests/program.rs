@@ -106,12 +106,28 @@ fn the_loop_limit_is_in_range_and_unknown_keys_are_refused() {
 #[test]
 fn io_counts_and_machine_m_codes() {
     let m = common::parse(&format!(
-        "{MINIMAL}\n[io]\ndigital_outputs = 4\nanalog_inputs = 2\n\n[mcodes]\nM428 = \"tcp-on\"\nM100 = \"ignore\"\n"
+        "{MINIMAL}\n[io]\ndigital_outputs = 4\ndigital_inputs = 1\nanalog_inputs = 2\n\n[mcodes]\nM428 = \"tcp-on\"\nM100 = \"ignore\"\n\
+         M110 = \"output 3 on\"\nM111 = \"wait 0 rise 2.5\"\n"
     ))
     .unwrap();
+    assert_eq!(
+        m.program.mcodes[&110],
+        config::McodeAction::Output {
+            output: 3,
+            on: true
+        }
+    );
+    assert_eq!(
+        m.program.mcodes[&111],
+        config::McodeAction::Wait {
+            input: 0,
+            level: config::Level::Rise,
+            timeout_s: 2.5
+        }
+    );
     assert_eq!(m.program.io.digital_outputs, 4);
     assert_eq!(m.program.io.analog_inputs, 2);
-    assert_eq!(m.program.io.digital_inputs, 0);
+    assert_eq!(m.program.io.digital_inputs, 1);
     assert_eq!(m.program.mcodes[&428], config::McodeAction::TcpOn);
     assert_eq!(m.program.mcodes[&100], config::McodeAction::Ignore);
     for (text, parts) in [
@@ -130,7 +146,27 @@ fn io_counts_and_machine_m_codes() {
         ),
         (
             "[mcodes]\nM101 = \"dance\"\n",
-            &["mcodes.M101", "\"dance\"", "ignore, tcp-on, tcp-off, stop"][..],
+            &[
+                "mcodes.M101",
+                "\"dance\"",
+                "ignore, tcp-on, tcp-off, stop, output <n> on|off",
+            ][..],
+        ),
+        (
+            "[io]\ndigital_outputs = 2\n[mcodes]\nM101 = \"output 2 on\"\n",
+            &[
+                "mcodes.M101",
+                "digital_outputs 2",
+                "[io] digital_outputs is 2",
+            ][..],
+        ),
+        (
+            "[mcodes]\nM101 = \"wait 0 high 1\"\n",
+            &["mcodes.M101", "digital_inputs is 0"][..],
+        ),
+        (
+            "[io]\ndigital_inputs = 1\n[mcodes]\nM101 = \"wait 0 high 0\"\n",
+            &["mcodes.M101", "0 < seconds <= 3600"][..],
         ),
         (
             "[mcodes]\nM101 = \"stop\"\nm101 = \"ignore\"\n",

@@ -16,7 +16,7 @@ pub mod program;
 pub mod spindle;
 
 pub use io::BusIo;
-pub use program::{IoCounts, McodeAction, ProgramSetup, Tool};
+pub use program::{IoCounts, Level, McodeAction, ProgramSetup, Tool};
 pub use spindle::{BusNode, Coolant, Spindle};
 
 /// A validated machine configuration.

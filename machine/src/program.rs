@@ -40,7 +40,7 @@ pub struct IoCounts {
 }
 
 /// What a machine-defined M-code does (`[mcodes] M428 = "tcp-on"`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum McodeAction {
     /// `"ignore"`: nothing, reported with a note.
     Ignore,
@@ -50,18 +50,65 @@ pub enum McodeAction {
     TcpOff,
     /// `"stop"`: a program stop, as `M00`.
     Stop,
+    /// `"output <n> on"` / `"output <n> off"`: the program's digital output `n` (as `M62` /
+    /// `M63 P<n>`).
+    Output { output: u8, on: bool },
+    /// `"wait <n> high|low|rise|fall <seconds>"`: wait for digital input `n`, at most that
+    /// long (as `M66 P<n> L3|L4|L1|L2 Q<seconds>`).
+    Wait {
+        input: u8,
+        level: Level,
+        timeout_s: f64,
+    },
+}
+
+/// What a machine-defined wait waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    High,
+    Low,
+    Rise,
+    Fall,
 }
 
 impl McodeAction {
-    /// The names a machine file gives, in the order of the variants.
-    pub const NAMES: [&'static str; 4] = ["ignore", "tcp-on", "tcp-off", "stop"];
+    /// The forms a machine file gives, in the order of the variants.
+    pub const NAMES: [&'static str; 6] = [
+        "ignore",
+        "tcp-on",
+        "tcp-off",
+        "stop",
+        "output <n> on|off",
+        "wait <n> high|low|rise|fall <seconds>",
+    ];
 
+    /// The action a machine file names (the numbers unchecked against `[io]` here).
     pub fn from_name(name: &str) -> Option<McodeAction> {
-        match name {
-            "ignore" => Some(McodeAction::Ignore),
-            "tcp-on" => Some(McodeAction::TcpOn),
-            "tcp-off" => Some(McodeAction::TcpOff),
-            "stop" => Some(McodeAction::Stop),
+        let words: Vec<&str> = name.split_whitespace().collect();
+        match words[..] {
+            ["ignore"] => Some(McodeAction::Ignore),
+            ["tcp-on"] => Some(McodeAction::TcpOn),
+            ["tcp-off"] => Some(McodeAction::TcpOff),
+            ["stop"] => Some(McodeAction::Stop),
+            ["output", n, on] => Some(McodeAction::Output {
+                output: n.parse().ok()?,
+                on: match on {
+                    "on" => true,
+                    "off" => false,
+                    _ => return None,
+                },
+            }),
+            ["wait", n, level, seconds] => Some(McodeAction::Wait {
+                input: n.parse().ok()?,
+                level: match level {
+                    "high" => Level::High,
+                    "low" => Level::Low,
+                    "rise" => Level::Rise,
+                    "fall" => Level::Fall,
+                    _ => return None,
+                },
+                timeout_s: seconds.parse().ok().filter(|t: &f64| t.is_finite())?,
+            }),
             _ => None,
         }
     }

@@ -122,6 +122,23 @@ pub fn parse_setup(
                     config::McodeAction::TcpOn => UserAction::TcpOn,
                     config::McodeAction::TcpOff => UserAction::TcpOff,
                     config::McodeAction::Stop => UserAction::Stop,
+                    config::McodeAction::Output { output, on } => {
+                        UserAction::Output { index: output, on }
+                    }
+                    config::McodeAction::Wait {
+                        input,
+                        level,
+                        timeout_s,
+                    } => UserAction::Wait {
+                        input,
+                        mode: match level {
+                            config::Level::High => nc_geom::program::WaitMode::High,
+                            config::Level::Low => nc_geom::program::WaitMode::Low,
+                            config::Level::Rise => nc_geom::program::WaitMode::Rise,
+                            config::Level::Fall => nc_geom::program::WaitMode::Fall,
+                        },
+                        timeout_s,
+                    },
                 };
                 (n, action)
             })

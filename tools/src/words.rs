@@ -149,6 +149,20 @@ pub fn describe_action(a: &Action) -> String {
                     UserAction::Stop => format!(
                         "M{code} program stop (the machine file's [mcodes]): the path stops for the operator"
                     ),
+                    UserAction::Output { index, on } => format!(
+                        "M{code} digital output {index} {} (the machine file's [mcodes]: as M6{} P{index})",
+                        if on { "on" } else { "off" },
+                        if on { 2 } else { 3 }
+                    ),
+                    UserAction::Wait { input, mode, timeout_s } => format!(
+                        "M{code} waits for digital input {input} (the machine file's [mcodes]: as M66 P{input} L{} Q{timeout_s})",
+                        match mode {
+                            WaitMode::Rise => 1,
+                            WaitMode::Fall => 2,
+                            WaitMode::High => 3,
+                            _ => 4,
+                        }
+                    ),
                 },
             };
             format!("{}  {what}", a.pos)

@@ -5,7 +5,7 @@
 use crate::check::Check;
 use crate::error::ConfigError;
 use crate::raw::RawProgram;
-use machine::{McodeAction, ProgramSetup};
+use machine::{IoCounts, McodeAction, ProgramSetup};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -82,6 +82,7 @@ pub(crate) fn program(
 pub(crate) fn mcodes(
     check: &Check<'_, '_>,
     raw: BTreeMap<String, String>,
+    io: IoCounts,
 ) -> Result<BTreeMap<u32, McodeAction>, ConfigError> {
     let mut out = BTreeMap::new();
     for (key, value) in raw {
@@ -117,6 +118,27 @@ pub(crate) fn mcodes(
                 format!("must be one of {}", McodeAction::NAMES.join(", ")),
             ));
         };
+        let (n_io, count, what) = match action {
+            McodeAction::Output { output, .. } => (output, io.digital_outputs, "digital_outputs"),
+            McodeAction::Wait { input, .. } => (input, io.digital_inputs, "digital_inputs"),
+            _ => (0, 1, ""),
+        };
+        if n_io >= count {
+            return Err(check.invalid(
+                &["mcodes", &key],
+                Some(format!("{value:?}")),
+                format!("names {what} {n_io}, but [io] {what} is {count} (0..{count})"),
+            ));
+        }
+        if let McodeAction::Wait { timeout_s, .. } = action {
+            if !(timeout_s > 0.0 && timeout_s <= 3600.0) {
+                return Err(check.invalid(
+                    &["mcodes", &key],
+                    Some(format!("{value:?}")),
+                    "waits at most 0 < seconds <= 3600 (as M66 Q)".into(),
+                ));
+            }
+        }
         out.insert(n, action);
     }
     Ok(out)

@@ -321,7 +321,7 @@ pub enum Input {
 }
 
 /// What the machine file maps a machine-defined M-code to (`[mcodes]`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum UserAction {
     /// Nothing moves or switches: reported with a note.
     Ignore,
@@ -334,6 +334,15 @@ pub enum UserAction {
     TcpOff,
     /// A program stop: the path stops for the operator, as at `M00`.
     Stop,
+    /// The program's digital output `index` on or off, as `M62`/`M63` (an action of its own
+    /// follows the code's).
+    Output { index: u8, on: bool },
+    /// A wait for digital input `input`, as `M66 P L1..L4 Q` (an action of its own follows).
+    Wait {
+        input: u8,
+        mode: WaitMode,
+        timeout_s: f64,
+    },
 }
 
 /// A path-control mode: LinuxCNC's permissions to leave the programmed path.

@@ -152,12 +152,60 @@ impl Parser<'_> {
                 self.modal.tcp_on = false;
             }
             UserAction::Ignore | UserAction::Stop => {}
+            UserAction::Output { .. } | UserAction::Wait { .. } => {}
         }
         self.act(pos, ActionKind::UserM { code, action });
+        // An output or a wait is then the action its M62/M63/M66 would be.
+        match action {
+            UserAction::Output { index, on } => {
+                self.user_io(code, pos, index, self.setup.io.digital_outputs)?;
+                self.act(
+                    pos,
+                    ActionKind::DigitalOutput {
+                        index,
+                        on,
+                        synced: true,
+                    },
+                );
+            }
+            UserAction::Wait {
+                input,
+                mode,
+                timeout_s,
+            } => {
+                self.user_io(code, pos, input, self.setup.io.digital_inputs)?;
+                let input = Input::Digital(input);
+                self.act(
+                    pos,
+                    ActionKind::WaitInput {
+                        input,
+                        mode,
+                        timeout_s,
+                    },
+                );
+            }
+            _ => {}
+        }
         if action == UserAction::Stop && self.wait.operator.is_none() {
             self.wait.operator = Some(pos);
         }
         Ok(())
+    }
+
+    /// A machine-defined M-code's output or input `n` is one of the machine's `count` (the
+    /// machine file checks it; a setup built otherwise is checked here).
+    fn user_io(&self, code: u32, pos: SrcPos, n: u8, count: u8) -> Result<(), ParseError> {
+        if n < count {
+            return Ok(());
+        }
+        let kind = ParseErrorKind::NoSuchIo {
+            code: f64::from(code),
+            letter: 'P',
+            value: f64::from(n),
+            count,
+            what: "digital_outputs or digital_inputs",
+        };
+        Err(kind.at(pos))
     }
 
     /// After a move with tool-centre-point control off: the rotary axes must be at 0.

@@ -192,6 +192,50 @@ fn machine_defined_m_codes_do_what_the_machine_file_says() {
 }
 
 #[test]
+fn a_machine_defined_output_or_wait_is_the_action_its_m62_or_m66_would_be() {
+    let mut s = setup();
+    s.user_mcodes
+        .insert(110, UserAction::Output { index: 3, on: true });
+    let wait = UserAction::Wait {
+        input: 1,
+        mode: WaitMode::Fall,
+        timeout_s: 2.0,
+    };
+    s.user_mcodes.insert(111, wait);
+    s.user_mcodes
+        .insert(112, UserAction::Output { index: 9, on: true });
+    let p = parse_with("G0 X0 Y0 Z0\nM110\nM111\nG1 X1 F100\nM2", &s).unwrap();
+    let kinds: Vec<A> = p.actions.iter().map(|a| a.kind).collect();
+    assert_eq!(
+        kinds,
+        [
+            A::UserM {
+                code: 110,
+                action: UserAction::Output { index: 3, on: true }
+            },
+            A::DigitalOutput {
+                index: 3,
+                on: true,
+                synced: true
+            },
+            A::UserM {
+                code: 111,
+                action: wait
+            },
+            A::WaitInput {
+                input: Input::Digital(1),
+                mode: WaitMode::Fall,
+                timeout_s: 2.0
+            },
+        ]
+    );
+    // Beyond the machine's outputs: refused where it stands.
+    let e = parse_with("G0 X0 Y0 Z0\nM112\nM2", &s).expect_err("P9 of 4");
+    assert!(matches!(e.errors[0].kind, E::NoSuchIo { count: 4, .. }));
+    assert_eq!(e.errors[0].pos, at(2, 1));
+}
+
+#[test]
 fn tcp_on_makes_g43_place_the_tool_tip_and_g53_turns_the_table() {
     use nc_geom::program::{LengthMode, Orientation};
     let mut s = setup();
