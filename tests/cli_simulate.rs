@@ -81,10 +81,17 @@ fn methods_rank_taylor1_taylor2_arclength() {
 #[test]
 fn a_taylor_excess_is_listed_where_it_happens() {
     let m = config::load(&machine("xyzac-trt-mill.toml")).unwrap();
-    let (s, rows) = simulate(
+    let (out, s, rows) = common::simulate_output(
         "classics/dual-spline.nc",
         "xyzac-trt-mill.toml",
         &["--method", "taylor1"],
+    );
+    // Never a success (issue 56): exit 2, and stderr says why and what run sends.
+    assert_eq!(out.status.code(), Some(2), "{s}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("the taylor1 setpoints exceed an axis limit") && err.contains("arclength"),
+        "{err}"
     );
     let listed = s["limits_exceeded"].as_array().expect("limits_exceeded");
     assert!(
@@ -156,7 +163,7 @@ fn a_taylor_excess_is_listed_where_it_happens() {
         "--method",
         "taylor1",
     ]);
-    assert!(out.status.success());
+    assert_eq!(out.status.code(), Some(2));
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(
         text.contains("limits             EXCEEDED by these taylor1 setpoints: ")

@@ -83,7 +83,7 @@ fn xyzac_trt_machine_loads_with_expected_values() {
     assert_eq!(m.axes.z, limits(-400.0, 400.0, 250.0, 2500.0, 50000.0));
     assert_eq!(m.axes.tilt, limits(-110.0, 110.0, 90.0, 900.0, 20000.0));
     assert_eq!(m.axes.c, limits(-3600.0, 3600.0, 180.0, 1800.0, 40000.0));
-    assert_eq!(m.interpolation.method, Method::Taylor2);
+    assert_eq!(m.interpolation.method, Method::Arclength);
     assert_eq!(m.interpolation.chord_tolerance_mm, 0.002);
     assert_eq!(m.interpolation.max_feed_mm_min, 12000.0);
     // rapid_feed_mm_min is omitted in the file: it follows max_feed_mm_min.

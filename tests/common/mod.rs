@@ -87,13 +87,29 @@ pub fn read_trace(path: &std::path::Path) -> Vec<Row> {
         .collect()
 }
 
-/// Run `simulate` with `--json` and a trace; returns the summary and the rows.
+/// Run `simulate` with `--json` and a trace, which must exit 0; returns the summary and
+/// the rows.
 pub fn simulate(
     program: &str,
     machine_file: &str,
     extra: &[&str],
 ) -> (serde_json::Value, Vec<Row>) {
-    let trace = temp("trace.csv");
+    let (out, summary, rows) = simulate_output(program, machine_file, extra);
+    assert!(
+        out.status.success(),
+        "dnurbs simulate {program} {machine_file} {extra:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (summary, rows)
+}
+
+/// [`simulate`], whatever its exit: the process's output, the summary and the rows.
+pub fn simulate_output(
+    program: &str,
+    machine_file: &str,
+    extra: &[&str],
+) -> (std::process::Output, serde_json::Value, Vec<Row>) {
+    let trace = temp(&format!("trace-{}.csv", std::process::id()));
     let prog = data(program);
     let mach = machine(machine_file);
     let mut args = vec![
@@ -107,15 +123,15 @@ pub fn simulate(
     ];
     args.extend_from_slice(extra);
     let out = dnurbs(&args);
-    assert!(
-        out.status.success(),
-        "dnurbs {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON summary");
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "dnurbs {args:?}: no JSON summary ({e}): {}",
+            String::from_utf8_lossy(&out.stderr)
+        )
+    });
     let rows = read_trace(&trace);
     let _ = std::fs::remove_file(&trace);
-    (summary, rows)
+    (out, summary, rows)
 }
 
 /// Cox-de Boor recursion (paper eq. 4), closed on the right at the end of the knot range.

@@ -29,7 +29,7 @@ pub const TABLE: &str = "Exit codes (every subcommand):
   2  bad input: NC program, machine file or command-line value (nothing moved; or an
      error in the program met ahead of the moving tool, by the planner or, for a program
      too long to check whole before it starts, the pre-pass: stopped along the path,
-     drives disabled)
+     drives disabled); `simulate` with a Taylor method whose setpoints go over a limit
   3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
      too many consecutive overruns); the drives were stopped and disabled
   4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,
@@ -46,6 +46,9 @@ pub enum Outcome {
     StoppedByOperator,
     /// An error in the program met ahead of the tool while it moved: stopped along the path.
     StoppedByProgram,
+    /// `simulate` with a Taylor method (the machine file's `method`, `--method`) made
+    /// setpoints over an axis limit: that method does not hold this program's limits.
+    OverLimits,
 }
 
 impl Outcome {
@@ -55,7 +58,7 @@ impl Outcome {
             Outcome::CompletedWithOverruns => COMPLETED_OVERRUNS,
             Outcome::StoppedByFault => STOPPED_FAULT,
             Outcome::StoppedByOperator => STOPPED_OPERATOR,
-            Outcome::StoppedByProgram => BAD_INPUT,
+            Outcome::StoppedByProgram | Outcome::OverLimits => BAD_INPUT,
         }
     }
 
@@ -67,6 +70,7 @@ impl Outcome {
             Outcome::StoppedByFault => "stopped by a fault",
             Outcome::StoppedByOperator => "stopped by the operator",
             Outcome::StoppedByProgram => "stopped by the program",
+            Outcome::OverLimits => "setpoints over a limit",
         }
     }
 }

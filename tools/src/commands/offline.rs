@@ -117,7 +117,21 @@ pub fn simulate(
     } else {
         print!("{}", summary.text());
     }
-    Ok(Outcome::Completed)
+    if summary.limits_exceeded.is_empty() {
+        return Ok(Outcome::Completed);
+    }
+    // Never reported as a success: the plan is checked on the arclength setpoints.
+    if method == Method::ArcLength {
+        anyhow::bail!(
+            "{name}: the arclength setpoints exceed an axis limit the plan was checked against: a planner fault, please report it"
+        );
+    }
+    eprintln!(
+        "dnurbs simulate: {name}: the {} setpoints exceed an axis limit ({}): the Taylor methods are comparisons and hold no limit; `run` sends the arclength setpoints (--method arclength, or the machine file's method = \"arclength\")",
+        method.name(),
+        summary.limits_brief()
+    );
+    Ok(Outcome::OverLimits)
 }
 
 pub fn compare(programs: &[PathBuf], machine: &Path, shop: &ShopArgs) -> anyhow::Result<Outcome> {
