@@ -93,6 +93,12 @@ pub fn run(
     shop: &crate::shop::ShopArgs,
 ) -> anyhow::Result<Outcome> {
     let m = crate::load_machine(machine)?;
+    if m.interpolation.method != config::Method::Arclength {
+        eprintln!(
+            "dnurbs run: note: the machine file's method = \"{}\" is for simulate's comparisons; run sends the arclength setpoints, the ones the plan is checked on",
+            m.interpolation.method.name()
+        );
+    }
     // Read a line at a time as it runs (the planner thread opens it; a FIFO is read once):
     // a program that is not there is exit 2 before anything else.
     std::fs::metadata(program).map_err(|error| InputError::ReadProgram {
