@@ -191,6 +191,11 @@ pub(crate) struct RawDrive {
     pub sign: Option<i64>,
     /// Counts at axis position 0; default 0.
     pub offset: Option<i64>,
+    /// The drive's own guard: following error (mm or deg) and its time (ms), option codes.
+    pub following_error: Option<f64>,
+    pub following_error_timeout_ms: Option<i64>,
+    pub quick_stop_option: Option<i64>,
+    pub fault_reaction_option: Option<i64>,
 }
 
 /// `[machine]`

@@ -11,6 +11,7 @@ use crate::source::Source;
 use machine::bus;
 use machine::Machine;
 
+mod guard;
 mod hardware;
 mod io;
 mod motion;

@@ -310,6 +310,58 @@ fn drives_load_and_convert_counts() {
     );
 }
 
+/// Each drive's own guard: by default a following error of the distance its axis covers
+/// at its velocity limit in 20 ms, 10 ms, the quick-stop ramp on a quick stop and on a
+/// fault; each key checked with its range.
+#[test]
+fn a_drive_guards_its_following_error_and_stop_reactions() {
+    let m = common::parse(&with_drives("2.0", "1000000")).unwrap();
+    let x = &m.drives[0];
+    let want = m.axes.x.velocity * 0.02;
+    assert_eq!(x.guard.following_error, Some(want));
+    assert_eq!(
+        (
+            x.guard.following_error_timeout_ms,
+            x.guard.quick_stop_option,
+            x.guard.fault_reaction_option
+        ),
+        (10, 2, 2)
+    );
+    let text = set(
+        &with_drives("2.0", "1000000"),
+        "axes.x.drive",
+        "following_error",
+        "0.5",
+    );
+    let text = set(&text, "axes.x.drive", "following_error_timeout_ms", "25");
+    let text = set(&text, "axes.x.drive", "quick_stop_option", "6");
+    let m = common::parse(&text).unwrap();
+    let g = m.drives[0].guard;
+    assert_eq!(
+        (
+            g.following_error,
+            g.following_error_timeout_ms,
+            g.quick_stop_option
+        ),
+        (Some(0.5), 25, 6)
+    );
+    for (key, value, rule) in [
+        ("following_error", "0", "at least one count"),
+        ("following_error", "0.0001", "at least one count"),
+        ("following_error_timeout_ms", "70000", "0..=65535 ms"),
+        ("quick_stop_option", "9", "CiA-402 option code 0..=8"),
+        ("fault_reaction_option", "-1", "CiA-402 option code 0..=8"),
+    ] {
+        let (_, shown) = fail(&set(
+            &with_drives("2.0", "1000000"),
+            "axes.x.drive",
+            key,
+            value,
+        ));
+        assert_mentions(&shown, &[&format!("axes.x.drive.{key} = {value}"), rule]);
+    }
+}
+
 #[test]
 fn bus_load_over_the_maximum_says_by_how_much() {
     // 5 drives at 1 ms on 1 Mbit/s: 1205 bits = 120.5 % against the default 70 %. The file

@@ -9,6 +9,6 @@ pub mod setup;
 
 pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
 pub use setup::{
-    configure, configure_nodes, Clock, NodeSetup, SetupError, SetupErrorKind, SetupOptions,
-    VelocitySetup, WallClock,
+    configure, configure_nodes, Clock, NodeSetup, Protections, SetupError, SetupErrorKind,
+    SetupOptions, VelocitySetup, WallClock, FOLLOWING_OFF,
 };

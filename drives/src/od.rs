@@ -33,6 +33,14 @@ pub const MODES_OF_OPERATION_DISPLAY: u16 = 0x6061;
 pub const POSITION_ACTUAL: u16 = 0x6064;
 /// Following error window (u32).
 pub const FOLLOWING_ERROR_WINDOW: u16 = 0x6065;
+/// Following error time out (u16, ms).
+pub const FOLLOWING_ERROR_TIMEOUT: u16 = 0x6066;
+/// Quick stop option code (i16).
+pub const QUICK_STOP_OPTION: u16 = 0x605A;
+/// Fault reaction option code (i16).
+pub const FAULT_REACTION_OPTION: u16 = 0x605E;
+/// Software position limit: sub 1 min, sub 2 max (i32, counts).
+pub const SOFTWARE_POSITION_LIMIT: u16 = 0x607D;
 /// Target position (i32).
 pub const TARGET_POSITION: u16 = 0x607A;
 /// Velocity actual value (i32, velocity units).

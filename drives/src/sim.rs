@@ -263,6 +263,9 @@ pub struct Faults {
     /// From this SYNC count on, drop every frame this node would send (a broken cable or a
     /// dead transceiver): the master must notice missing feedback and heartbeats.
     pub silent_from_sync: Option<u64>,
+    /// Writes of this object (index, sub) are acknowledged and not kept: a drive that keeps
+    /// its own value, which only reading it back finds.
+    pub keeps_object: Option<(u16, u8)>,
 }
 
 /// One node at one SYNC in operational: the target that took effect and what the node
@@ -400,6 +403,12 @@ impl SimBus {
     /// same); `None` for a node that is not simulated and for a drive.
     pub fn io_outputs(&self, node: NodeId) -> Option<u8> {
         self.node(node).and_then(SimNode::io_outputs)
+    }
+
+    /// Object `index:sub` of a node's dictionary (raw bits); `None` for a node that is not
+    /// simulated or an object it does not have.
+    pub fn object(&self, node: NodeId, index: u16, sub: u8) -> Option<u32> {
+        self.node(node).and_then(|n| n.object(index, sub))
     }
 
     /// What a node ignored or lost.

@@ -61,7 +61,7 @@ fn start(fault_at: Option<u64>) -> Rig {
     ];
     let mut sim = Lockstep::new(drive_end, sims, PERIOD);
     let setups = [
-        NodeSetup::Position(id(AXIS)),
+        NodeSetup::Position(id(AXIS), drives::master::Protections::default()),
         NodeSetup::Velocity(id(SPINDLE), VELOCITY),
         NodeSetup::Io(id(IO)),
     ];

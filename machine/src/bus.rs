@@ -77,6 +77,45 @@ pub struct Drive {
     pub sign: i8,
     /// Counts at axis position 0.
     pub offset: i32,
+    /// What the drive guards by itself, written in set-up.
+    pub guard: Guard,
+}
+
+/// What an axis drive is told to guard by itself (`[axes.*.drive]`), so that it stops even
+/// if the controller dies: following error, stop reactions; its software position limits
+/// are the axis's travel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guard {
+    /// Following error the drive tolerates, axis units (mm or degrees); None: off.
+    pub following_error: Option<f64>,
+    /// How long the error may stay over it, ms (0x6066).
+    pub following_error_timeout_ms: u16,
+    /// Quick-stop option code 0x605A and fault-reaction option code 0x605E (CiA-402).
+    pub quick_stop_option: i16,
+    pub fault_reaction_option: i16,
+}
+
+impl Guard {
+    /// Default time the following error may stay over its window, ms.
+    pub const TIMEOUT_MS: u16 = 10;
+    /// Default following error: the distance at the axis's velocity limit in this time, s.
+    pub const FOLLOWING_TIME_S: f64 = 0.02;
+    /// Default option codes: the quick-stop ramp, then switch on disabled (0x605A = 2); the
+    /// quick-stop ramp on a fault (0x605E = 2).
+    pub const QUICK_STOP_OPTION: i16 = 2;
+    pub const FAULT_REACTION_OPTION: i16 = 2;
+}
+
+impl Default for Guard {
+    /// Following control off, the default option codes.
+    fn default() -> Self {
+        Guard {
+            following_error: None,
+            following_error_timeout_ms: Guard::TIMEOUT_MS,
+            quick_stop_option: Guard::QUICK_STOP_OPTION,
+            fault_reaction_option: Guard::FAULT_REACTION_OPTION,
+        }
+    }
 }
 
 impl Drive {
@@ -118,6 +157,7 @@ mod tests {
             counts_per_unit: 10_000.0,
             sign: -1,
             offset: 500,
+            guard: Guard::default(),
         };
         assert_eq!(d.counts(1.5), Some(-14_500));
         assert!((d.position(-14_500) - 1.5).abs() < 1e-12);

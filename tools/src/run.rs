@@ -168,7 +168,13 @@ pub fn node_setups(machine: &Machine, bus: usize) -> Vec<NodeSetup> {
         .drives
         .iter()
         .filter(|d| d.bus == bus)
-        .filter_map(|d| NodeId::new(d.node).map(NodeSetup::Position))
+        .filter_map(|d| {
+            let limits = machine.axes.all().get(d.axis).map(|(_, l)| (*l).clone());
+            Some(NodeSetup::Position(
+                NodeId::new(d.node)?,
+                buses::protections(d, limits),
+            ))
+        })
         .collect();
     if let Some(s) = machine.spindle.as_ref() {
         if let Some(n) = s.on_bus(bus).and_then(NodeId::new) {

@@ -37,6 +37,7 @@ impl FaultArgs {
                 .find(|(n, _)| *n == node)
                 .map(|x| x.1),
             silent_from_sync: find(&self.silent_from),
+            keeps_object: None,
         }
     }
 }

@@ -233,6 +233,7 @@ impl Check<'_, '_> {
                 counts_per_unit,
                 sign: sign as i8,
                 offset,
+                guard: super::guard::guard(self, &path, d, limits, counts_per_unit)?,
             };
             if !limits.is_unlimited()
                 && (drive.counts(limits.min).is_none() || drive.counts(limits.max).is_none())

@@ -122,11 +122,15 @@ pub struct VelocitySetup {
     pub window_ms: u16,
 }
 
+mod protect;
+
+pub use protect::{Protections, FOLLOWING_OFF};
+
 /// One node to configure, with what it is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NodeSetup {
-    /// An axis drive, cyclic synchronous position.
-    Position(NodeId),
+    /// An axis drive, cyclic synchronous position, and what it guards by itself.
+    Position(NodeId, Protections),
     /// The spindle drive, profile velocity.
     Velocity(NodeId, VelocitySetup),
     /// A CiA-401 digital I/O module.
@@ -136,13 +140,13 @@ pub enum NodeSetup {
 impl NodeSetup {
     pub fn node(&self) -> NodeId {
         match *self {
-            NodeSetup::Position(n) | NodeSetup::Velocity(n, _) | NodeSetup::Io(n) => n,
+            NodeSetup::Position(n, _) | NodeSetup::Velocity(n, _) | NodeSetup::Io(n) => n,
         }
     }
 
     pub fn kind(&self) -> NodeKind {
         match self {
-            NodeSetup::Position(_) => NodeKind::Position,
+            NodeSetup::Position(..) => NodeKind::Position,
             NodeSetup::Velocity(..) => NodeKind::Velocity,
             NodeSetup::Io(_) => NodeKind::Io,
         }
@@ -344,13 +348,14 @@ impl<L: CanLink, C: Clock> Session<'_, L, C> {
     fn node(&mut self, setup: &NodeSetup, period: (u8, i8)) -> Result<i32, SetupError> {
         let node = setup.node();
         let (rpdo, tpdo): (&[u32], &[u32]) = match setup {
-            NodeSetup::Position(_) => (&RPDO1_CSP_MAPPING, &TPDO1_CSP_MAPPING),
+            NodeSetup::Position(..) => (&RPDO1_CSP_MAPPING, &TPDO1_CSP_MAPPING),
             NodeSetup::Velocity(..) => (&RPDO1_PV_MAPPING, &TPDO1_PV_MAPPING),
             NodeSetup::Io(_) => (&RPDO1_IO_MAPPING, &TPDO1_IO_MAPPING),
         };
         match setup {
-            NodeSetup::Position(_) => {
+            NodeSetup::Position(_, protections) => {
                 self.mode(node, od::MODE_CSP)?;
+                self.protections(node, protections)?;
                 self.write(
                     node,
                     od::INTERPOLATION_TIME_PERIOD,
@@ -393,7 +398,7 @@ impl<L: CanLink, C: Clock> Session<'_, L, C> {
             SdoValue::U16(self.opts.heartbeat_ms),
         )?;
         match setup {
-            NodeSetup::Position(_) => self.read_i32(node, od::POSITION_ACTUAL, 0),
+            NodeSetup::Position(..) => self.read_i32(node, od::POSITION_ACTUAL, 0),
             NodeSetup::Velocity(..) => self.read_i32(node, od::VELOCITY_ACTUAL, 0),
             NodeSetup::Io(_) => Ok(self.read_i32(node, od::DIGITAL_INPUTS, 1)? & 0xFF),
         }
@@ -411,7 +416,10 @@ pub fn configure<L: CanLink>(
     clock: &mut impl Clock,
     observe: &mut dyn FnMut(&CanFrame),
 ) -> Result<Vec<i32>, SetupError> {
-    let setups: Vec<NodeSetup> = nodes.iter().map(|&n| NodeSetup::Position(n)).collect();
+    let setups: Vec<NodeSetup> = nodes
+        .iter()
+        .map(|&n| NodeSetup::Position(n, Protections::default()))
+        .collect();
     configure_nodes(link, &setups, opts, clock, observe)
 }
 

@@ -20,8 +20,10 @@ pub struct Drive {
     model: DriveModel,
     motor: Motor,
     lag_s: f64,
-    /// CSP: `|0x607A - 0x6064| > 0x6065` at the last SYNC.
+    /// CSP: `|demand - 0x6064| > 0x6065` for longer than 0x6066 ms.
     following_error: bool,
+    /// CSP: SYNCs in a row with the error over the window.
+    over_window: u64,
     /// PV: SYNCs since the velocity entered the window (0 at the first), `None` outside.
     in_window: Option<u64>,
     /// PV: it has stayed there for 0x606E ms.
@@ -37,6 +39,7 @@ impl Drive {
             motor: Motor::new(f64::from(initial_position)),
             lag_s,
             following_error: false,
+            over_window: 0,
             in_window: None,
             target_reached: false,
         }
@@ -61,6 +64,7 @@ impl Drive {
         self.model = DriveModel::new();
         self.motor.stop();
         self.following_error = false;
+        self.over_window = 0;
         self.in_window = None;
         self.target_reached = false;
         dict.set(od::TARGET_POSITION, 0, self.position() as u32);
@@ -96,7 +100,17 @@ impl Drive {
         let state = self.model.state();
         let enabled = state == State::OperationEnabled;
         let mode = mode(dict);
+        // The software position limits 0x607D bound the demand.
+        let (lo, hi) = (
+            dict.get(od::SOFTWARE_POSITION_LIMIT, 1) as i32,
+            dict.get(od::SOFTWARE_POSITION_LIMIT, 2) as i32,
+        );
         let target = dict.get(od::TARGET_POSITION, 0) as i32;
+        let target = if lo <= hi {
+            target.clamp(lo, hi)
+        } else {
+            target
+        };
         let csp = enabled && mode == od::MODE_CSP;
         let demand = if mode == od::MODE_PV {
             Demand::Velocity(pv_ramp(state, dict))
@@ -107,9 +121,20 @@ impl Drive {
         };
         self.motor.set_demand(demand);
 
+        // Following control: off at a window of 0 or 2^32 - 1; reported once the error has
+        // stayed over the window for 0x6066 ms (from the SYNC it was first seen at; within a
+        // microsecond, as the velocity window).
         let window = dict.get(od::FOLLOWING_ERROR_WINDOW, 0);
+        let timeout_ms = f64::from(dict.get(od::FOLLOWING_ERROR_TIMEOUT, 0));
         let error = (i64::from(target) - i64::from(self.position())).unsigned_abs();
-        self.following_error = csp && window != 0 && error > u64::from(window);
+        let over = csp && window != 0 && window != u32::MAX && error > u64::from(window);
+        self.over_window = if over {
+            self.over_window.saturating_add(1)
+        } else {
+            0
+        };
+        self.following_error =
+            over && (self.over_window - 1) as f64 * period_s * 1000.0 + 1e-3 >= timeout_ms;
 
         let velocity_target = i64::from(dict.get(od::TARGET_VELOCITY, 0) as i32);
         let error = (velocity_target - i64::from(self.motor.velocity_units())).unsigned_abs();

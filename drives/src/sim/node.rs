@@ -97,6 +97,13 @@ impl SimNode {
     }
 
     /// An I/O module's outputs in effect; `None` for a drive.
+    pub fn object(&self, index: u16, sub: u8) -> Option<u32> {
+        self.dict
+            .upload(index, sub)
+            .ok()
+            .map(|_| self.dict.get(index, sub))
+    }
+
     pub fn io_outputs(&self) -> Option<u8> {
         match self.app {
             App::Io(_) => Some(Io::outputs(&self.dict)),
@@ -255,6 +262,9 @@ impl SimNode {
         now_s: f64,
         out: &mut dyn FnMut(CanFrame),
     ) -> Result<(), AbortCode> {
+        if self.faults.keeps_object == Some((index, sub)) {
+            return Ok(());
+        }
         self.dict.download(index, sub, data)?;
         self.written(index, out);
         match index {

@@ -22,6 +22,7 @@ pub enum Kind {
     U8,
     I8,
     U16,
+    I16,
     U32,
     I32,
 }
@@ -30,7 +31,7 @@ impl Kind {
     pub const fn bytes(self) -> u8 {
         match self {
             Kind::U8 | Kind::I8 => 1,
-            Kind::U16 => 2,
+            Kind::U16 | Kind::I16 => 2,
             Kind::U32 | Kind::I32 => 4,
         }
     }
@@ -136,7 +137,7 @@ impl Table {
 }
 
 use Access::{Ro, Rw};
-use Kind::{I32, I8, U16, U32, U8};
+use Kind::{I16, I32, I8, U16, U32, U8};
 use PdoKind::{Rpdo, Tpdo};
 
 /// Entries of the communication area.
@@ -185,14 +186,20 @@ static DRIVE: Table = Table {
     application: &[
         entry(od::CONTROLWORD, 0, U16, Rw, 0).map(Rpdo),
         entry(od::STATUSWORD, 0, U16, Ro, 0).map(Tpdo),
+        entry(od::QUICK_STOP_OPTION, 0, I16, Rw, 2),
+        entry(od::FAULT_REACTION_OPTION, 0, I16, Rw, 2),
         entry(od::MODES_OF_OPERATION, 0, I8, Rw, 0),
         entry(od::MODES_OF_OPERATION_DISPLAY, 0, I8, Ro, 0),
         entry(od::POSITION_ACTUAL, 0, I32, Ro, 0).map(Tpdo),
         entry(od::FOLLOWING_ERROR_WINDOW, 0, U32, Rw, 0),
+        entry(od::FOLLOWING_ERROR_TIMEOUT, 0, U16, Rw, 0),
         entry(od::VELOCITY_ACTUAL, 0, I32, Ro, 0).map(Tpdo),
         entry(od::VELOCITY_WINDOW, 0, U16, Rw, 10),
         entry(od::VELOCITY_WINDOW_TIME, 0, U16, Rw, 0),
         entry(od::TARGET_POSITION, 0, I32, Rw, 0).map(Rpdo),
+        entry(od::SOFTWARE_POSITION_LIMIT, 0, U8, Ro, 2),
+        entry(od::SOFTWARE_POSITION_LIMIT, 1, I32, Rw, i32::MIN as u32),
+        entry(od::SOFTWARE_POSITION_LIMIT, 2, I32, Rw, i32::MAX as u32),
         entry(od::PROFILE_ACCELERATION, 0, U32, Rw, 10_000),
         entry(od::PROFILE_DECELERATION, 0, U32, Rw, 10_000),
         entry(od::QUICK_STOP_DECELERATION, 0, U32, Rw, 20_000),

@@ -224,6 +224,11 @@ impl Master {
     pub fn drive_state(&self, id: u8) -> State {
         self.bus.node_state(node(id)).unwrap().1
     }
+
+    /// A drive's actual position, counts.
+    pub fn drive_state_position(&self, id: u8) -> i32 {
+        self.bus.node_state(node(id)).unwrap().2
+    }
 }
 
 /// Decodes the heartbeats among `frames` as `(node, state)`.

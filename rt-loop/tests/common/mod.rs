@@ -139,6 +139,7 @@ fn axis_drives(counts_per_unit: [f64; 5]) -> Vec<Drive> {
             counts_per_unit: counts_per_unit[axis],
             sign: 1,
             offset: 0,
+            guard: machine::bus::Guard::default(),
         })
         .collect()
 }

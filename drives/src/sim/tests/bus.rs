@@ -169,6 +169,36 @@ fn statusword_bits_12_and_13_in_csp() {
     assert_eq!(m.read_u32(n, od::STATUSWORD, 0), 0x0233);
 }
 
+/// The following error counts only once it has stayed over the window longer than 0x6066
+/// (1 ms periods here); 2^32 - 1 switches it off; 0x607D bounds the demand.
+#[test]
+fn following_error_time_and_software_position_limits() {
+    let mut m = Master::with_nodes(&[1]);
+    m.operational(&[1]);
+    let n = node(1);
+    m.sdo_write(n, od::FOLLOWING_ERROR_WINDOW, 0, SdoValue::U32(30))
+        .unwrap();
+    m.sdo_write(n, od::FOLLOWING_ERROR_TIMEOUT, 0, SdoValue::U16(3))
+        .unwrap();
+    m.enable(1);
+    let bit13 = |m: &mut Master, target| m.cycle(&[(1, 0x0F, target)])[0].1.statusword & 0x2000;
+    // 40 counts a period: over the window every period, reported from the fourth (> 3 ms).
+    let seen: Vec<u16> = (1..=6).map(|k| bit13(&mut m, 40 * k)).collect();
+    assert_eq!(seen, [0, 0, 0, 0x2000, 0x2000, 0x2000]);
+    assert_eq!(bit13(&mut m, 240), 0, "caught up");
+    m.sdo_write(n, od::FOLLOWING_ERROR_WINDOW, 0, SdoValue::U32(u32::MAX))
+        .unwrap();
+    let off: Vec<u16> = (7..=12).map(|k| bit13(&mut m, 40 * k)).collect();
+    assert!(off.iter().all(|&b| b == 0), "off: {off:?}");
+    // Limits: the drive stops at 500 whatever the target.
+    m.sdo_write(n, od::SOFTWARE_POSITION_LIMIT, 2, SdoValue::I32(500))
+        .unwrap();
+    for _ in 0..5 {
+        m.cycle(&[(1, 0x0F, 900)]);
+    }
+    assert_eq!(m.drive_state_position(1), 500);
+}
+
 #[test]
 fn target_followed_needs_csp_mode() {
     let mut m = Master::with_nodes(&[1]);
