@@ -1,7 +1,9 @@
 //! Drive configuration, outside the real-time thread, for every node of one bus:
 //!
 //! 1. NMT reset communication, then wait for each node's boot-up message;
-//! 2. SDO: modes of operation 0x6060 = 8 (CSP), read back from 0x6061;
+//! 2. SDO: modes of operation 0x6060 = 8 (CSP), read back from 0x6061; then what the drive
+//!    guards by itself ([`Protections`]: 0x6065, 0x6066, 0x605A, 0x605E, 0x607D), each
+//!    read back;
 //! 3. SDO: interpolation time period 0x60C2 = the machine period (value * 10^exponent s);
 //! 4. PDO mapping exactly as CiA-301 prescribes (docs/canopen.md): RPDO1 = controlword
 //!    0x6040 + target 0x607A, TPDO1 = statusword 0x6041 + actual 0x6064, both disabled while
