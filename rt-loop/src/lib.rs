@@ -25,3 +25,4 @@ pub mod pipeline;
 pub mod report;
 pub mod stats;
 pub mod thread;
+pub mod trace;

@@ -37,12 +37,14 @@
 //! Files: this one ([`Pipeline`], its state and its period), `stages.rs` (what each stage
 //! does in a period), `bus.rs` (the drives of a bus: targets in counts, spindle and coolant,
 //! the drives' states), `approach.rs` (the move to the start), `drive_loop.rs` (the
-//! real-time loop around [`Pipeline::cycle`], with its lead).
+//! real-time loop around [`Pipeline::cycle`], with its lead), `traced.rs` (each period's
+//! targets into the trace's queue, `crate::trace`).
 
 mod approach;
 mod bus;
 mod drive_loop;
 mod stages;
+mod traced;
 
 pub use crate::control::Progress;
 use crate::control::{Command, Consumer};
@@ -69,6 +71,20 @@ pub enum Stage {
     Stopping,
     Disabling,
     Finished,
+}
+
+impl Stage {
+    /// Its index in [`crate::control::STAGES`].
+    pub fn index(self) -> u8 {
+        match self {
+            Stage::Enabling => 0,
+            Stage::Approach => 1,
+            Stage::Running => 2,
+            Stage::Stopping => 3,
+            Stage::Disabling => 4,
+            Stage::Finished => 5,
+        }
+    }
 }
 
 /// Why a run stopped before the program's end.
@@ -218,6 +234,9 @@ pub struct Pipeline<'q, L: CanLink> {
     aux: Aux,
     /// Most periods at rest at the end for the drives (and the spindle) to settle.
     settle_limit: u64,
+    /// Where each period's targets go, if they are traced; rows the queue had no room for.
+    trace: Option<crate::trace::Producer<'q, crate::trace::TraceRow>>,
+    trace_dropped: u64,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
@@ -307,6 +326,8 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             cycles: 0,
             max_overruns: u64::MAX,
             commands: None,
+            trace: None,
+            trace_dropped: 0,
         })
     }
 
@@ -338,14 +359,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
     ///
     /// Real-time thread.
     pub fn publish(&self, progress: &Progress) {
-        let stage = match self.stage() {
-            Stage::Enabling => 0,
-            Stage::Approach => 1,
-            Stage::Running => 2,
-            Stage::Stopping => 3,
-            Stage::Disabling => 4,
-            Stage::Finished => 5,
-        };
+        let stage = usize::from(self.stage().index());
         let sp = self.follower.last();
         let axes = match &self.phase {
             Phase::Enabling(Some(ap)) | Phase::Approach(ap) => ap.now(),
@@ -449,6 +463,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 fault = fault.or(Some(f));
             }
         }
+        self.trace_period();
         if let Some(f) = fault {
             if self.reason.is_none() {
                 self.set_reason(StopReason::Fault(f));

@@ -1,7 +1,8 @@
 //! The whole pipeline touches neither the heap nor a new page: the streamed interpolator,
 //! unit conversion and the CiA-402 master over the in-process link, against simulated
 //! drives, while a planner streams segments through a 4-deep queue and an operator pauses,
-//! resumes and overrides the feed through the control queue. A counting global allocator
+//! resumes and overrides the feed through the control queue, and every period's targets go
+//! into the trace's queue (`run --trace`; on the virtual clock). A counting global allocator
 //! counts the allocations and frees of the loop's thread, and getrusage(RUSAGE_THREAD) its
 //! minor page faults.
 //!
@@ -190,11 +191,16 @@ fn prove_on_a_virtual_clock<L: CanLink, D: CanLink>(link: L, drive_end: D) {
         common::five_drives(),
         common::LENIENT,
     );
+    let mut ring = Box::new(rt_loop::trace::TraceRing::new());
     let mut queues = Queues::new();
     let (mut pipeline, mut feeder) = pipeline(bus, &mut queues, start, &mut source);
     let mut commands = Commands::new();
     let (mut command_tx, command_rx) = commands.split();
     pipeline.set_commands(command_rx);
+    // `run --trace`: every period's targets into the trace's queue, drained by the world.
+    let (trace_tx, mut trace_rx) = ring.split();
+    pipeline.set_trace(trace_tx).expect("five drives fit a row");
+    let mut traced = 0u64;
     let mut operator = Operator {
         ms: 0,
         next: 0,
@@ -216,6 +222,9 @@ fn prove_on_a_virtual_clock<L: CanLink, D: CanLink>(link: L, drive_end: D) {
             let f0 = os::minor_faults();
             sim.advance_to(Duration::from_nanos(t));
             feeder.feed(&mut source);
+            while trace_rx.dequeue().is_some() {
+                traced += 1;
+            }
             // A millisecond of the operator's clock every 1 / PERIOD periods.
             periods += 1;
             if periods % 7 == 0 {
@@ -251,6 +260,8 @@ fn prove_on_a_virtual_clock<L: CanLink, D: CanLink>(link: L, drive_end: D) {
         "the pause was never seen in the published status"
     );
     check_the_run(&pipeline, cycles, 100_000, events, faults, true);
+    assert_eq!(pipeline.trace_dropped(), 0);
+    assert!(traced + 1 >= cycles, "{traced} rows traced over {cycles} periods");
     let records = sim.take_records();
     assert!(
         records.len() as u64 > 5 * 100_000,

@@ -371,6 +371,7 @@ pub fn run_options(name: &str, control: Option<PathBuf>) -> dnurbs_tools::run::R
         progress: false,
         control,
         shop: Default::default(),
+        trace: None,
     }
 }
 

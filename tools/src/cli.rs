@@ -76,6 +76,11 @@ pub enum Command {
         /// simulated drives, read a line at a time as it runs (as `dnurbs run` does).
         #[arg(long, value_name = "FILE")]
         program: Option<PathBuf>,
+        /// Write every target as sent to the drives, one row a period (cycle, t, stage,
+        /// the axes' positions, each node's target), to this CSV file; written outside the
+        /// real-time thread.
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
     },
     /// Run a program on the machine's CiA-402 drives over SocketCAN.
     ///
@@ -109,6 +114,11 @@ pub enum Command {
         /// [control] socket). See `dnurbs ctl`.
         #[arg(long, value_name = "SOCKET")]
         control: Option<PathBuf>,
+        /// Write every target as sent to the drives, one row a period (cycle, t, stage,
+        /// the axes' positions, each node's target), to this CSV file; written outside the
+        /// real-time thread.
+        #[arg(long, value_name = "FILE")]
+        trace: Option<PathBuf>,
         #[command(flatten)]
         shop: crate::shop::ShopArgs,
     },

@@ -69,6 +69,9 @@ pub struct Report {
     /// How the planner streamed the program.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stream: Option<StreamNotes>,
+    /// What `--trace` wrote.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trace: Option<crate::run::trace::TraceNotes>,
 }
 
 /// `M66` waits that ended at their timeout.
@@ -138,6 +141,21 @@ impl Report {
         }
         if let Some(r) = &self.refusal {
             s.push_str(&format!("refused: {r}\n"));
+        }
+        if let Some(t) = &self.trace {
+            let dropped = if t.dropped == 0 {
+                String::new()
+            } else {
+                format!(
+                    "; {} periods NOT traced (the writer fell behind the real-time thread)",
+                    t.dropped
+                )
+            };
+            s.push_str(&format!(
+                "trace: {} periods' targets in {}{dropped}\n",
+                t.rows,
+                t.file.display()
+            ));
         }
         let what = if self.machine.is_empty() {
             self.program.clone()

@@ -21,6 +21,7 @@
 mod buses;
 mod realtime;
 pub mod simulated;
+pub mod trace;
 
 use crate::feed::{Input, Learned, Pace, Ready};
 use crate::report::{DriveEnd, Report, StreamNotes, AXES};
@@ -60,6 +61,8 @@ pub struct RunOptions {
     pub control: Option<PathBuf>,
     /// Tool table and switches for the parser.
     pub shop: crate::shop::ShopOptions,
+    /// Write every target as sent to the drives into this file (`--trace`).
+    pub trace: Option<PathBuf>,
 }
 
 /// What a run did.
@@ -90,6 +93,8 @@ pub struct RunResult {
     pub refusal: Option<String>,
     /// How the planner streamed the program.
     pub stream: Option<StreamNotes>,
+    /// What `--trace` wrote.
+    pub trace: Option<trace::TraceNotes>,
 }
 
 impl RunResult {
@@ -132,6 +137,7 @@ impl RunResult {
             compressed: self.compressed,
             refusal: self.refusal.clone(),
             stream: self.stream,
+            trace: self.trace.clone(),
         }
     }
 }
@@ -382,6 +388,7 @@ impl Finished {
                 checked_whole: self.ready.checked_whole,
                 lines: self.learned.lines.get().copied(),
             }),
+            trace: None,
         }
     }
 }

@@ -65,6 +65,7 @@ pub fn latency(
         feed_holds: 0,
         hard_stops: 0,
         input_timeouts: None,
+        trace: None,
         drives: Vec::new(),
         latency: stats.summary(),
     };

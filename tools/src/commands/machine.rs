@@ -25,14 +25,21 @@ fn finish(
     Ok(crate::report::outcome(r.reason.as_ref(), r.stats.overruns))
 }
 
+/// The files a run writes: its report directory, its trace.
+pub struct Written {
+    pub report: Option<PathBuf>,
+    pub trace: Option<PathBuf>,
+}
+
 pub fn demo(
-    report: Option<PathBuf>,
+    written: Written,
     link: DemoLink,
     rt: rt_loop::thread::RtSettings,
     lead_ns: u64,
     control: Option<PathBuf>,
     program: Option<PathBuf>,
 ) -> anyhow::Result<Outcome> {
+    let Written { report, trace } = written;
     keep_off_rt_cpu(rt)?;
     report_dir(&report)?;
     let name = program
@@ -54,6 +61,7 @@ pub fn demo(
         progress: true,
         control,
         shop: Default::default(),
+        trace,
     };
     let bus = match link {
         DemoLink::Memory => "an in-memory CAN link",
@@ -86,12 +94,13 @@ pub fn demo(
 pub fn run(
     program: &Path,
     machine: &Path,
-    report: Option<PathBuf>,
+    written: Written,
     approach: bool,
     no_rt: bool,
     control: Option<PathBuf>,
     shop: &crate::shop::ShopArgs,
 ) -> anyhow::Result<Outcome> {
+    let Written { report, trace } = written;
     let m = crate::load_machine(machine)?;
     if m.interpolation.method != config::Method::Arclength {
         eprintln!(
@@ -134,6 +143,7 @@ pub fn run(
         progress: true,
         control: control.or_else(|| m.control_socket.clone()),
         shop: shop.load()?,
+        trace,
     };
     keep_off_rt_cpu(opts.rt)?;
     eprintln!(

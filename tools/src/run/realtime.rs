@@ -2,6 +2,7 @@
 //! thread running the loop, and this thread reporting (the `.hlog`, the progress line) while
 //! the control socket's thread serves the operator.
 
+use super::trace::TraceWriter;
 use super::{buses, check, stage, RunOptions, RunResult};
 use crate::exit::StoppedBeforeMotion;
 use crate::feed::{Input, Pace};
@@ -16,6 +17,7 @@ use rt_loop::os;
 use rt_loop::pipeline::{drive_loop, Pipeline, Progress};
 use rt_loop::stats::Stats;
 use rt_loop::thread::RtMode;
+use rt_loop::trace::{Consumer, TraceRing, TraceRow};
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -32,6 +34,18 @@ pub(super) fn run<L: CanLink + Send>(
     let period_ns = (machine.period_s * 1e9).round() as u64;
     let mut commands = Commands::new();
     let (command_tx, command_rx) = commands.split();
+    let mut writer = match &opts.trace {
+        Some(file) => Some(TraceWriter::create(file, machine)?),
+        None => None,
+    };
+    let mut ring = writer.as_ref().map(|_| Box::new(TraceRing::new()));
+    let (trace_tx, trace_rx) = match ring.as_mut() {
+        Some(r) => {
+            let (p, c) = r.split();
+            (Some(p), Some(c))
+        }
+        None => (None, None),
+    };
     let server = match &opts.control {
         Some(path) => {
             let tilt = if machine.axes.tilt_name == config::RotaryName::B {
@@ -102,11 +116,26 @@ pub(super) fn run<L: CanLink + Send>(
     stop_before_motion()?;
     let (mut pipeline, finish) = staged.pipeline(machine, opts, buses)?;
     pipeline.set_commands(command_rx);
+    if let Some(p) = trace_tx {
+        pipeline.set_trace(p).map_err(too_many_nodes)?;
+    }
     let control = server.as_ref().map(|s| (s, command_tx));
-    let (stats, realtime) = run_threads(&mut pipeline, period_ns, stop, opts, log, control)?;
-    let r = finish.result(&pipeline, stats, realtime);
+    let trace = writer.as_mut().zip(trace_rx);
+    let (stats, realtime) = run_threads(&mut pipeline, period_ns, stop, opts, log, control, trace)?;
+    let mut r = finish.result(&pipeline, stats, realtime);
+    if let Some(w) = writer {
+        r.trace = Some(w.finish(pipeline.trace_dropped())?);
+    }
     finished.store(true, Ordering::Release);
     Ok(r)
+}
+
+/// `set_trace`'s refusal: more nodes than a trace row holds.
+pub(super) fn too_many_nodes(nodes: usize) -> anyhow::Error {
+    anyhow::anyhow!(
+        "--trace holds at most {} nodes a period; this machine has {nodes}",
+        rt_loop::trace::TRACE_NODES
+    )
 }
 
 /// The real-time thread runs the loop; this one reports until it ends. Returns the totals
@@ -118,6 +147,7 @@ fn run_threads<L: CanLink + Send>(
     opts: &RunOptions,
     mut log: Option<rt_loop::report::HlogFile>,
     control: Option<(&crate::control::Server, Producer<'_, Command>)>,
+    mut trace: Option<(&mut TraceWriter, Consumer<'_, TraceRow>)>,
 ) -> anyhow::Result<(Stats, RtMode)> {
     let (mut iq, first) = IntervalQueues::new();
     let (full_p, mut full_c) = iq.full.split();
@@ -175,6 +205,9 @@ fn run_threads<L: CanLink + Send>(
                 report(&iv, &mut totals)?;
                 iv.stats.clear();
                 let _ = free_p.enqueue(iv);
+            }
+            if let Some((w, rows)) = trace.as_mut() {
+                w.drain(rows)?;
             }
             if finished {
                 break;

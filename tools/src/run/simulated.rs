@@ -9,6 +9,7 @@
 //! for period) and takes as long as its computation: what the tests of whole runs use,
 //! whatever the machine's load.
 
+use super::trace::TraceWriter;
 use super::{buses, check, stage, RunOptions, RunResult};
 use crate::feed::{Input, Pace};
 use config::Machine;
@@ -22,6 +23,7 @@ use rt_loop::latency::INTERVAL_NS;
 use rt_loop::pipeline::{drive_loop, Progress};
 use rt_loop::stats::Stats;
 use rt_loop::thread::RtMode;
+use rt_loop::trace::TraceRing;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
@@ -46,6 +48,11 @@ pub fn run_simulated<L: CanLink + Send>(
     );
     let period_ns = (machine.period_s * 1e9).round() as u64;
     let stop = AtomicBool::new(false);
+    let mut writer = match &opts.trace {
+        Some(file) => Some(TraceWriter::create(file, machine)?),
+        None => None,
+    };
+    let mut ring = writer.as_ref().map(|_| Box::new(TraceRing::new()));
     let (go_tx, go) = std::sync::mpsc::sync_channel(1);
     let (done, done_rx) = std::sync::mpsc::sync_channel(1);
     let staged = stage(
@@ -77,6 +84,15 @@ pub fn run_simulated<L: CanLink + Send>(
     let mut commands = Commands::new();
     let (mut command_tx, command_rx) = commands.split();
     pipeline.set_commands(command_rx);
+    let mut trace_rx = None;
+    if let Some(r) = ring.as_mut() {
+        let (p, c) = r.split();
+        pipeline
+            .set_trace(p)
+            .map_err(super::realtime::too_many_nodes)?;
+        trace_rx = Some(c);
+    }
+    let mut trace_error = None;
     let (mut iq, first) = IntervalQueues::new();
     let (full_p, mut full_c) = iq.full.split();
     let (mut free_p, free_c) = iq.free.split();
@@ -96,6 +112,11 @@ pub fn run_simulated<L: CanLink + Send>(
                 totals.add(&iv.stats);
                 iv.stats.clear();
                 let _ = free_p.enqueue(iv);
+            }
+            if let (Some(w), Some(rows)) = (writer.as_mut(), trace_rx.as_mut()) {
+                if let Err(e) = w.drain(rows) {
+                    trace_error.get_or_insert(e);
+                }
             }
         };
         let mut clock = VirtualClock::new(t0, world);
@@ -120,7 +141,14 @@ pub fn run_simulated<L: CanLink + Send>(
         without_because: Some("simulated time: the loop ran on a virtual clock".into()),
         ..RtMode::default()
     };
-    let result = finish.result(&pipeline, totals, realtime);
+    let mut result = finish.result(&pipeline, totals, realtime);
+    if let Some(e) = trace_error {
+        return Err(e);
+    }
+    if let (Some(mut w), Some(rows)) = (writer, trace_rx.as_mut()) {
+        w.drain(rows)?;
+        result.trace = Some(w.finish(pipeline.trace_dropped())?);
+    }
     let records = drives.iter_mut().flat_map(|d| d.take_records()).collect();
     Ok((result, records))
 }
