@@ -1,8 +1,9 @@
 //! `dnurbs run` on a real SocketCAN interface (vcan0 in the PREEMPT_RT guest, see
 //! tests/vcan/run) against a `dnurbs sim-drives` process: the paper example and a
 //! multi-block program run to their end; every target the simulated drives recorded lies
-//! on the interpolated path of `dnurbs simulate --trace` (same machine, same period), and
-//! the drives end at the program's end within 1 count.
+//! on the interpolated path of `dnurbs simulate --trace` (same machine, same period), the
+//! targets `run --trace` says it sent are, node by node and period by period, those
+//! `sim-drives --record` took, and the drives end at the program's end within 1 count.
 
 mod common;
 
@@ -50,6 +51,7 @@ fn run_on_vcan(program: &str) {
     let record = out.join(format!("run-{stem}-drives.csv"));
     let trace = out.join(format!("run-{stem}-trace.csv"));
     let report = out.join(format!("run-{stem}-report"));
+    let sent = out.join(format!("run-{stem}-sent.csv"));
     let machine_file = data("vcan-machine.toml");
     let machine = config::load(&machine_file).expect("vcan machine file");
     let bin = env!("CARGO_BIN_EXE_dnurbs");
@@ -72,6 +74,8 @@ fn run_on_vcan(program: &str) {
         .arg("--approach")
         .arg("--report")
         .arg(&report)
+        .arg("--trace")
+        .arg(&sent)
         .output()
         .expect("dnurbs run");
     // sim-drives flushes its record every 100 ms; let it write the last targets.
@@ -118,6 +122,7 @@ fn run_on_vcan(program: &str) {
         let d = by_node[&node];
         syncs.entry(sync).or_insert([None; 5])[d.axis] = Some(d.position(target));
     }
+    same_as_sent(&sent, &text, &machine);
     let targets: Vec<[f64; 5]> = syncs
         .values()
         .filter_map(|t| {
@@ -177,6 +182,44 @@ fn run_on_vcan(program: &str) {
         "{program}: {checked} targets checked against {} trace rows, all within 2 counts",
         path.len()
     );
+}
+
+/// `run --trace` (what the controller sent, period by period) against `sim-drives --record`
+/// (what the drives took, SYNC by SYNC): node by node, the same targets in the same order,
+/// from the first SYNC (the record may lack the last period, sent as the run ended).
+fn same_as_sent(sent: &Path, record: &str, machine: &config::Machine) {
+    let text = std::fs::read_to_string(sent).expect("the run's trace");
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().expect("a header").split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let mut compared = 0;
+    for d in &machine.drives {
+        let col = header
+            .iter()
+            .position(|h| h.ends_with(&format!(":{}", d.node)))
+            .expect("a column per node");
+        let sent: Vec<i32> = rows.iter().map(|r| r[col].parse().unwrap()).collect();
+        let mut took: Vec<(u64, i32)> = record
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|f| f[1].parse::<u8>().ok() == Some(d.node))
+            .map(|f| (f[0].parse().unwrap(), f[2].parse().unwrap()))
+            .collect();
+        took.sort();
+        let took: Vec<i32> = took.into_iter().map(|t| t.1).collect();
+        assert!(
+            sent.len() >= took.len() && sent.len() - took.len() <= 1,
+            "node {}: {} targets sent, {} taken",
+            d.node,
+            sent.len(),
+            took.len()
+        );
+        let first_diff = took.iter().zip(&sent).position(|(a, b)| a != b);
+        assert_eq!(first_diff, None, "node {}: sent and taken differ", d.node);
+        compared += took.len();
+    }
+    println!("run --trace: {compared} targets, the same as sim-drives recorded");
 }
 
 #[test]

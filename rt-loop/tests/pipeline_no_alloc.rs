@@ -261,7 +261,10 @@ fn prove_on_a_virtual_clock<L: CanLink, D: CanLink>(link: L, drive_end: D) {
     );
     check_the_run(&pipeline, cycles, 100_000, events, faults, true);
     assert_eq!(pipeline.trace_dropped(), 0);
-    assert!(traced + 1 >= cycles, "{traced} rows traced over {cycles} periods");
+    assert!(
+        traced + 1 >= cycles,
+        "{traced} rows traced over {cycles} periods"
+    );
     let records = sim.take_records();
     assert!(
         records.len() as u64 > 5 * 100_000,
