@@ -227,6 +227,10 @@ fn vcan_master_configures_python_canopen_local_node() {
     assert_eq!(v("6060:00"), 8, "CSP");
     assert_eq!(v("6061:00"), 8);
     assert_eq!((v("60C2:01"), v("60C2:02")), (1, -2), "10 ms = 1 * 10^-2 s");
+    // What the drive guards by itself, written and read back (`configure`'s defaults:
+    // following control off, the quick-stop ramp).
+    assert_eq!(v("6065:00"), i64::from(u32::MAX), "following control off");
+    assert_eq!((v("6066:00"), v("605A:00"), v("605E:00")), (0, 2, 2));
     assert_eq!(v("1400:01"), 0x207, "RPDO1 re-enabled on 0x200 + node");
     assert_eq!(v("1400:02"), 1, "RPDO1 every SYNC");
     assert_eq!(

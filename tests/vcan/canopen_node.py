@@ -2,7 +2,8 @@
 """An independent CANopen device for tests/vcan_master.rs: python-canopen's LocalNode.
 
 Serves SDO and NMT on a SocketCAN interface with the objects the dnurbs master configures
-(CiA-301 communication and mapping parameters, CiA-402 0x6060/0x6061/0x6064/0x607A/0x60C2).
+(CiA-301 communication and mapping parameters, CiA-402 0x6060/0x6061/0x6064/0x607A/0x60C2,
+and what a drive guards by itself: 0x605A/0x605E/0x6065/0x6066/0x607D).
 python-canopen leaves the device application to its user; this script adds the parts a
 drive has and LocalNode does not: a boot-up message and pre-operational after an NMT reset,
 and 0x6061 (modes of operation display) following 0x6060.
@@ -40,6 +41,7 @@ def dictionary(node_id, position):
         (0x1600, "RPDO1 mapping", [(s, od.UNSIGNED32, 0) for s in range(1, 9)]),
         (0x1A00, "TPDO1 mapping", [(s, od.UNSIGNED32, 0) for s in range(1, 9)]),
         (0x60C2, "Interpolation time period", [(1, od.UNSIGNED8, 1), (2, od.INTEGER8, -3)]),
+        (0x607D, "Software position limit", [(1, od.INTEGER32, -(2**31)), (2, od.INTEGER32, 2**31 - 1)]),
     ]:
         record = od.ODRecord(name, index)
         count = 0 if index in (0x1600, 0x1A00) else len(entries)
@@ -49,9 +51,13 @@ def dictionary(node_id, position):
         d.add_object(record)
     d.add_object(variable("Controlword", 0x6040, 0, od.UNSIGNED16, "rw", 0))
     d.add_object(variable("Statusword", 0x6041, 0, od.UNSIGNED16, "ro", 0x0250))
+    d.add_object(variable("Quick stop option code", 0x605A, 0, od.INTEGER16, "rw", 2))
+    d.add_object(variable("Fault reaction option code", 0x605E, 0, od.INTEGER16, "rw", 2))
     d.add_object(variable("Modes of operation", 0x6060, 0, od.INTEGER8, "rw", 0))
     d.add_object(variable("Modes of operation display", 0x6061, 0, od.INTEGER8, "ro", 0))
     d.add_object(variable("Position actual value", 0x6064, 0, od.INTEGER32, "ro", position))
+    d.add_object(variable("Following error window", 0x6065, 0, od.UNSIGNED32, "rw", 0xFFFFFFFF))
+    d.add_object(variable("Following error time out", 0x6066, 0, od.UNSIGNED16, "rw", 0))
     d.add_object(variable("Target position", 0x607A, 0, od.INTEGER32, "rw", position))
     return d
 
@@ -91,7 +97,7 @@ def main():
     node.nmt.send_command(0x80)
     print("ready", flush=True)
     ok = started.wait(a.timeout)
-    values = {f"{i:04X}:{s:02X}": int.from_bytes(v, "little", signed=(i in (0x6060, 0x6061, 0x6064, 0x607A) or (i, s) == (0x60C2, 2)))
+    values = {f"{i:04X}:{s:02X}": int.from_bytes(v, "little", signed=(i in (0x605A, 0x605E, 0x6060, 0x6061, 0x6064, 0x607A, 0x607D) or (i, s) == (0x60C2, 2)))
               for i, subs in node.data_store.items() for s, v in subs.items()}
     with open(a.out, "w") as f:
         json.dump({"started": ok, "nmt_state": node.nmt.state, "values": values}, f, indent=1, sort_keys=True)
