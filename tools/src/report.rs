@@ -9,7 +9,7 @@
 
 use crate::exit::Outcome;
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 pub use rt_loop::thread::RtMode;
 
@@ -71,7 +71,18 @@ pub struct Report {
     pub stream: Option<StreamNotes>,
     /// What `--trace` wrote.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub trace: Option<crate::run::trace::TraceNotes>,
+    pub trace: Option<TraceNotes>,
+}
+
+/// What the trace holds, for the report.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TraceNotes {
+    pub file: PathBuf,
+    /// Rows written: one a period.
+    pub rows: u64,
+    /// Periods the real-time thread found no room for (the writer fell behind): the trace
+    /// is then not every period's.
+    pub dropped: u64,
 }
 
 /// `M66` waits that ended at their timeout.

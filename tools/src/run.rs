@@ -94,7 +94,7 @@ pub struct RunResult {
     /// How the planner streamed the program.
     pub stream: Option<StreamNotes>,
     /// What `--trace` wrote.
-    pub trace: Option<trace::TraceNotes>,
+    pub trace: Option<crate::report::TraceNotes>,
 }
 
 impl RunResult {

@@ -6,22 +6,12 @@
 //! each drive's counts), then each node's target as sent, `BUS:NODE` (counts for an axis,
 //! velocity units for a spindle, the output byte for an I/O module).
 
+use crate::report::TraceNotes;
 use config::Machine;
 use rt_loop::control::STAGES;
 use rt_loop::trace::{Consumer, TraceRow};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-
-/// What the trace holds, for the report.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct TraceNotes {
-    pub file: PathBuf,
-    /// Rows written: one a period.
-    pub rows: u64,
-    /// Periods the real-time thread found no room for (the writer fell behind): the trace
-    /// is then not every period's.
-    pub dropped: u64,
-}
 
 /// Which target of a row is which axis's drive, with its scale.
 struct AxisColumn {
