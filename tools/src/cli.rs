@@ -157,6 +157,13 @@ pub enum Command {
         /// Print the summary as one JSON object instead of text.
         #[arg(long)]
         json: bool,
+        /// Replay an operator's actions through the real-time thread's follower, one a
+        /// line, in order: `at 2.31s pause`, `after 1.5s resume`, `at line 40 override 30`,
+        /// `at 3s stop` (`#` starts a comment). Every setpoint, holds and overrides
+        /// included, is checked against every axis's velocity and acceleration limit and
+        /// its travel; a setpoint over one exits 2. Arc length only.
+        #[arg(long, value_name = "SCRIPT", conflicts_with = "method")]
+        operator: Option<PathBuf>,
         #[command(flatten)]
         shop: crate::shop::ShopArgs,
     },

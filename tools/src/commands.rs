@@ -14,6 +14,7 @@ pub mod fit;
 pub mod latency;
 pub mod machine;
 pub mod offline;
+pub mod operator;
 
 use crate::cli::{Command, MethodArg};
 use crate::exit::Outcome;
@@ -61,9 +62,19 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
         Command::Simulate {
             program,
             machine,
+            method: _,
+            trace,
+            json,
+            operator: Some(script),
+            shop,
+        } => operator::simulate_operator(&program, &machine, &script, trace, json, &shop),
+        Command::Simulate {
+            program,
+            machine,
             method,
             trace,
             json,
+            operator: None,
             shop,
         } => offline::simulate(
             &program,

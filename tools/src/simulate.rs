@@ -21,6 +21,8 @@ use nc_plan::stream::{ProgramSource, Stages};
 pub use nc_plan::verify::MAX_CYCLES;
 use serde::Serialize;
 
+pub mod operator;
+pub mod script;
 mod summary;
 pub use summary::Summarizer;
 
