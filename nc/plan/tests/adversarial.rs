@@ -597,7 +597,7 @@ struct Counts {
     long: AtomicU64,
     /// Accepted programs run through the follower with a stop, a pause, an override change,
     /// a slow planner ([`hold::Event`]).
-    held: [AtomicU64; 4],
+    held: [AtomicU64; 5],
     /// Of those, the ones run on the streamed chunks.
     on_stream: AtomicU64,
 }
@@ -821,6 +821,8 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     if on_stream {
         counts.on_stream.fetch_add(1, Ordering::Relaxed);
     }
+    // One program in four a second time, through an operator's session of several actions.
+    let session = hold::session(src).map(|s| (s, path.clone()));
     hold::check(
         path,
         &profile,
@@ -829,7 +831,20 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
         ev,
         src,
         stream.ok().filter(|_| on_stream),
-    )
+    )?;
+    if let Some((s, path)) = session {
+        counts.held[4].fetch_add(1, Ordering::Relaxed);
+        hold::check(
+            path,
+            &profile,
+            &cfg,
+            kin,
+            hold::Event::Session(s),
+            src,
+            None,
+        )?;
+    }
+    Ok(())
 }
 
 /// Cases per run: `ADV_CASES` (default 300; CI sets 10 000), shared by the two halves below
@@ -893,7 +908,7 @@ fn run_half(half: u64, cases: u32) {
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}, and again through an operator's session of several actions {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3], held[4]);
     if let Err(e) = result {
         panic!("{e}");
     }

@@ -1,6 +1,8 @@
 //! The same guarantee through a hold: every accepted program also runs through the real-time
 //! [`Follower`] with one operator or planner event at a generated moment (a stop request, a
-//! pause and resume, an override change and back, or a planner that falls behind), and its
+//! pause and resume, an override change and back, or a planner that falls behind), one in
+//! four a second time through an operator's session of two to six actions (pauses, override
+//! changes from 5 to 100 %, and for one in three a stop last: [`session`]), and its
 //! setpoints hold every axis's velocity and acceleration limit and the travel, by finite
 //! differences at the period, with no hard stop; a run that is not stopped ends at the
 //! program's end. The event comes from a hash of the program text, so the programs the seeds
@@ -54,6 +56,32 @@ pub enum Event {
         depth: usize,
         single: bool,
     },
+    /// An operator's session: several actions in one run ([`session`]).
+    Session(Session),
+}
+
+/// Most actions a session takes.
+pub const SESSION_ACTIONS: usize = 6;
+
+/// One action of a session.
+#[derive(Clone, Copy, Debug)]
+pub enum Act {
+    /// Pause; resume `rest` periods after the path is at rest.
+    Pause {
+        rest: u64,
+    },
+    /// Override `k` from here on.
+    Override {
+        k: f64,
+    },
+    Stop,
+}
+
+/// A session's actions, each at a fraction of the plan's duration, in order.
+#[derive(Clone, Copy, Debug)]
+pub struct Session {
+    pub actions: [(f64, Act); SESSION_ACTIONS],
+    pub n: usize,
 }
 
 impl Event {
@@ -64,8 +92,49 @@ impl Event {
             Event::Pause { .. } => 1,
             Event::Override { .. } => 2,
             Event::Underrun { .. } => 3,
+            Event::Session(_) => 4,
         }
     }
+}
+
+/// A session for one program in four (a function of its text alone): two to six pauses
+/// and override changes (5 to 150 %... of the planned feed: at most 100 %) at increasing
+/// moments, the override back to 100 % at the end, and for one in three a stop last.
+pub fn session(src: &str) -> Option<Session> {
+    let h = hash(src);
+    if (h >> 56) & 3 != 0 {
+        return None;
+    }
+    let mut x = h | 1;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let n = 2 + (next() * 4.0) as usize;
+    let mut actions = [(0.0, Act::Stop); SESSION_ACTIONS];
+    let mut at = 0.0;
+    for slot in actions.iter_mut().take(n - 1) {
+        at += next() / n as f64;
+        let act = if next() < 0.4 {
+            Act::Pause {
+                rest: 1 + (next() * 200.0) as u64,
+            }
+        } else {
+            Act::Override {
+                k: 0.05 + 0.95 * next(),
+            }
+        };
+        *slot = (at, act);
+    }
+    at += next() / n as f64;
+    actions[n - 1] = if next() < 1.0 / 3.0 {
+        (at, Act::Stop)
+    } else {
+        (at, Act::Override { k: 1.0 })
+    };
+    Some(Session { actions, n })
 }
 
 /// FNV-1a of the program text, then the splitmix64 finaliser (FNV's low bits depend only
@@ -134,6 +203,8 @@ pub fn check(
     let at = |x: f64| (x * planned as f64) as u64 + 1;
     let mut sps: Vec<Setpoint> = Vec::new();
     let (mut rest, mut back_at) = (0u64, None);
+    // A session: the next action, and the rest the pause under way waits for.
+    let (mut next_action, mut resume_after) = (0usize, None::<u64>);
     // Longest the run may take: the plan, a pause or an override's extra time, and the
     // holds of a slow planner, with room to spare.
     let limit = 4 * planned + 20_000 + 2 * 401 * n_chunks;
@@ -165,6 +236,31 @@ pub fn check(
                     f.set_override(1.0);
                 }
             }
+            Event::Session(s) => {
+                if let Some(r) = resume_after {
+                    if sps.last().is_some_and(|s| s.feed == 0.0) {
+                        rest += 1;
+                    }
+                    if rest >= r {
+                        f.resume();
+                        resume_after = None;
+                    }
+                } else if let Some(&(x, act)) = s.actions[..s.n].get(next_action) {
+                    // An action waits for the pause before it to end (an operator's hand).
+                    if i >= at(x) {
+                        match act {
+                            Act::Pause { rest: r } => {
+                                f.pause();
+                                rest = 0;
+                                resume_after = Some(r);
+                            }
+                            Act::Override { k } => f.set_override(k),
+                            Act::Stop => f.request_stop(),
+                        }
+                        next_action += 1;
+                    }
+                }
+            }
             _ => {}
         }
         // An operator stop in the program (none today): the operator resumes at once.
@@ -185,7 +281,14 @@ pub fn check(
     let counters = f.counters();
     prop_assert_eq!(counters.hard_stops, 0, "{:?} {:?}\n{}", ev, counters, src);
     let last = *sps.last().unwrap();
+    let stopped_by_session =
+        matches!(ev, Event::Session(s) if matches!(s.actions[s.n - 1].1, Act::Stop));
     match ev {
+        Event::Session(_) if stopped_by_session => prop_assert!(
+            last.done || f.is_stopped(),
+            "{ev:?}: neither stopped nor done after {} periods\n{src}",
+            sps.len()
+        ),
         Event::Stop { .. } => prop_assert!(
             last.done || f.is_stopped(),
             "{ev:?}: neither stopped nor done after {} periods\n{src}",
