@@ -8,7 +8,7 @@
 //! the [`Policy`] follows them.
 
 use super::find::{find_runs, moves_in};
-use super::{fit, Fitted};
+use super::Fitted;
 use crate::options::{Options, Policy, TOOL_MM};
 use nc_geom::program::{ActionKind, Block, LinearMove, NurbsBlock, NurbsKind, Program};
 
@@ -72,21 +72,16 @@ pub fn compress(
             *w = true;
         }
     }
-    // A run starts where the compressor is on, and ends at the next word (a path-control
-    // word among them): its whole run is under the fit at its start.
-    let mut runs = find_runs(
+    // A run starts where the compressor is on, within the tolerance in effect there, and
+    // ends at the next word (a path-control word among them): the whole run is under it.
+    let runs = find_runs(
         program,
         kin,
         opts,
-        |b| at[b].is_some(),
+        |b| at[b].map(|o| o.tol),
         |k| !word_before[k],
         |_, _| true,
     );
-    for run in &mut runs {
-        if let Some(o) = at[run.blocks.0].filter(|o| o.tol != opts.tol) {
-            run.fitted = fit(&run.points, o.tol, o.degree);
-        }
-    }
     let mut out = Compressed {
         moves_in: moves_in(program),
         blocks_in: n,

@@ -11,7 +11,7 @@
 //! the caller adds its own conditions for a run's first move and for each move that joins
 //! it.
 
-use super::{fit, Fitted, Point};
+use super::{fit, Fitted, Point, Tolerance};
 use crate::options::Options;
 use nalgebra::Vector3;
 use nc_geom::kinematics::{is_vertical, Kinematics, MachineKinematics};
@@ -164,19 +164,19 @@ pub fn is_corner(a: &LinearMove, m: &LinearMove, c: &LinearMove, corner_deg: f64
     d1.angle(&d2).to_degrees() > corner_deg
 }
 
-/// The runs of at least `opts.min_moves` moves, fitted. `may_start(b)`: block b may begin a
-/// run; `may_join(k)`: block k may follow block k - 1 in one; `may_end(k, e)`: a fitted
+/// The runs of at least `opts.min_moves` moves, fitted. `start(b)`: the tolerance a run
+/// beginning at block b is fitted within, or None where none may begin; `may_join(k)`: block k may follow block k - 1 in one; `may_end(k, e)`: a fitted
 /// block may end at block k of a run that could go on to block e (the run is cut back to
 /// the last such block, and the moves after it stay as they are).
 pub fn find_runs(
     program: &Program,
     kin: &MachineKinematics,
     opts: &Options,
-    may_start: impl Fn(usize) -> bool,
+    start: impl Fn(usize) -> Option<Tolerance>,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
 ) -> Vec<Found> {
-    find_open_runs(program, kin, opts, may_start, may_join, may_end).0
+    find_open_runs(program, kin, opts, start, may_join, may_end).0
 }
 
 /// [`find_runs`], and the first block of the run that reaches the program's last block,
@@ -186,7 +186,7 @@ pub fn find_open_runs(
     program: &Program,
     kin: &MachineKinematics,
     opts: &Options,
-    may_start: impl Fn(usize) -> bool,
+    start: impl Fn(usize) -> Option<Tolerance>,
     may_join: impl Fn(usize) -> bool,
     may_end: impl Fn(usize, usize) -> bool,
 ) -> (Vec<Found>, Option<usize>) {
@@ -216,7 +216,8 @@ pub fn find_open_runs(
     let mut open = None;
     let mut b = 1;
     while b < program.blocks.len() {
-        let Some(first) = linear(b).filter(|_| eligible(b) && may_start(b)) else {
+        let begun = linear(b).filter(|_| eligible(b));
+        let Some((first, tol)) = begun.and_then(|m| Some((m, start(b)?))) else {
             b += 1;
             continue;
         };
@@ -248,7 +249,7 @@ pub fn find_open_runs(
                 runs.push(Found {
                     blocks: (b, end),
                     reach: e,
-                    fitted: fit(&points, opts.tol, opts.degree),
+                    fitted: fit(&points, tol, opts.degree),
                     points,
                     feed_mm_min,
                     inverse_minutes,

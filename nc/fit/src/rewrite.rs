@@ -179,7 +179,7 @@ impl<W: Write> State<'_, W> {
                 &self.window,
                 self.kin,
                 self.opts,
-                |b| lines[b].plain && lines[b].g01,
+                |b| (lines[b].plain && lines[b].g01).then_some(self.opts.tol),
                 |k| lines[k].plain && lines[k - 1].no.checked_add(1) == Some(lines[k].no),
                 // The line after block k (the next move of the run, or the line after it).
                 |k, _| {

@@ -333,7 +333,10 @@ pub fn fit_program(
         program,
         kin,
         opts,
-        |b| plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.0.g01),
+        |b| {
+            let g01 = plain_line(b) && modes.get(line_of(b) - 1).is_some_and(|m| m.0.g01);
+            g01.then_some(opts.tol)
+        },
         |k| plain_line(k) && line_of(k) == line_of(k - 1) + 1,
         // The line after block k (the next move of the run, or the line after it).
         |k, _| {
