@@ -9,20 +9,8 @@ mod common;
 
 use common::{data, dnurbs, root};
 
-const PROGRAMS: [&str; 12] = [
-    "paper-example.nc",
-    "two-blocks-g2.nc",
-    "g01-5axis.nc",
-    "helix-ramp.nc",
-    "vertical-turns.nc",
-    "classics/butterfly.nc",
-    "classics/dual-spline.nc",
-    "classics/fan-5axis.nc",
-    "classics/figure-eight-circles.nc",
-    "classics/figure-eight-weights.nc",
-    "classics/star.nc",
-    "classics/helix-500.nc",
-];
+/// Beside the planner's test programs and classics (`nc_plan::fixtures::TEST_PROGRAMS`).
+const MORE: [&str; 1] = ["classics/helix-500.nc"];
 
 const REAL: [&str; 2] = ["linuxcnc-boat-xyzac.ngc", "linuxcnc-boat-xyzbc.ngc"];
 
@@ -35,8 +23,9 @@ fn no_method_on_any_shipped_machine_reports_a_setpoint_over_a_limit_as_success()
         .collect();
     files.sort();
     assert!(files.len() >= 4, "{files:?}");
-    let programs: Vec<_> = PROGRAMS
+    let programs: Vec<_> = nc_plan::fixtures::TEST_PROGRAMS
         .iter()
+        .chain(&MORE)
         .map(|p| data(p))
         .chain(
             REAL.iter()

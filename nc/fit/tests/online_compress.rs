@@ -9,7 +9,7 @@
 
 use nalgebra::Vector3;
 use nc_fit::compress::{compress, Compressed};
-use nc_fit::deviation::measure;
+use nc_fit::deviation::{measure, Deviation};
 use nc_fit::online::{Compressing, MAX_RUN};
 use nc_fit::options::{Options, Policy};
 use nc_geom::kinematics::MachineKinematics;
@@ -49,6 +49,22 @@ fn streamed_under(text: &str, policy: &Policy) -> (Vec<Block>, Vec<Action>, Opti
         }
     }
     (blocks, actions, c.compressed())
+}
+
+/// How far the path of `blocks` (what the compressor gave for `text`) lies from the path of
+/// `text` as parsed, both built on the small mill: measured, not taken from the fit.
+fn built_deviation(text: &str, blocks: Vec<Block>, tol_mm: f64) -> Deviation {
+    let input = nc_lang::parse(text).unwrap();
+    let output = Program {
+        blocks,
+        ..input.clone()
+    };
+    let (_, bl) = nc_plan::fixtures::small_mill(0.002);
+    let (a, b) = (
+        build(&input, &KIN, &bl).unwrap(),
+        build(&output, &KIN, &bl).unwrap(),
+    );
+    measure(&a, &b, &KIN, 0.005, tol_mm)
 }
 
 fn same_as_whole(name: &str, text: &str, opts: &Options) -> Compressed {
@@ -205,17 +221,7 @@ fn a_run_longer_than_the_window_is_fitted_in_pieces_within_the_tolerances() {
             "block {i} ends at {e:?}, not {want}"
         );
     }
-    let input = nc_lang::parse(&text).unwrap();
-    let output = Program {
-        blocks,
-        ..input.clone()
-    };
-    let (_, bl) = nc_plan::fixtures::small_mill(0.002);
-    let (a, b) = (
-        build(&input, &KIN, &bl).unwrap(),
-        build(&output, &KIN, &bl).unwrap(),
-    );
-    let dev = measure(&a, &b, &KIN, 0.005, opts.tol.mm);
+    let dev = built_deviation(&text, blocks, opts.tol.mm);
     // As nc/tests/fit.rs allows: the sampling resolves the distance to 0.5 um.
     assert!(dev.point_mm <= opts.tol.mm + 5e-7, "{dev:?}");
 }
@@ -323,17 +329,7 @@ fn g64_q_turns_the_compressor_on_with_its_tolerance_and_g61_keeps_the_moves() {
         "{done:?}"
     );
     // Measured on the built paths, not by the fit.
-    let input = nc_lang::parse(&s).unwrap();
-    let output = Program {
-        blocks,
-        ..input.clone()
-    };
-    let (_, bl) = nc_plan::fixtures::small_mill(0.002);
-    let (a, b) = (
-        build(&input, &KIN, &bl).unwrap(),
-        build(&output, &KIN, &bl).unwrap(),
-    );
-    let dev = measure(&a, &b, &KIN, 0.005, 0.02);
+    let dev = built_deviation(&s, blocks, 0.02);
     assert!(dev.point_mm <= 0.02 + 5e-7, "{dev:?}");
     // `--no-compress`: never; the machine's setting on: the G64 section at its tolerance.
     assert_eq!(
