@@ -821,7 +821,8 @@ fn check_with(src: &str, counts: &Counts, ev: hold::Event) -> Result<(), TestCas
     if on_stream {
         counts.on_stream.fetch_add(1, Ordering::Relaxed);
     }
-    // One program in four a second time, through an operator's session of several actions.
+    // The programs with a slow planner a second time, through an operator's session of
+    // several actions: every program meets an operator.
     let session = hold::session(src).map(|s| (s, path.clone()));
     hold::check(
         path,
@@ -908,7 +909,7 @@ fn run_half(half: u64, cases: u32) {
         .iter()
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
-    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}, and again through an operator's session of several actions {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3], held[4]);
+    eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}, and again through an operator's session of several actions {}: with an operator's action {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3], held[4], held[0] + held[1] + held[2] + held[4]);
     if let Err(e) = result {
         panic!("{e}");
     }
