@@ -13,20 +13,25 @@
 //! * [`CanLink::send`] reports a full transmit queue (`ENOBUFS` from a CAN driver, `EAGAIN`
 //!   from a socketpair) as [`Sent::Dropped`] and counts it: the cycle goes on, the caller
 //!   decides what a lost frame means.
-//! * [`CanLink::recv`] returns `None` when nothing is waiting. Remote and error frames are
-//!   counted and skipped (at most [`MAX_SKIPPED`] per call, so the loop is bounded).
+//! * [`CanLink::recv`] returns `None` when nothing is waiting. Remote frames are counted and
+//!   skipped, error frames counted by kind in [`BusErrors`] ([`CanLink::errors`]; at most
+//!   [`MAX_SKIPPED`] per call, so the loop is bounded).
+//! * An interface that is down (`ENETDOWN`, `ENODEV`) is [`LinkError::Down`].
 //! * [`CanLink::send_all`] and [`CanLink::recv_all`] move a cycle's frames in batches. On a
 //!   [`SocketLink`] each is one `sendmmsg`/`recvmmsg` system call instead of one call per
 //!   frame (the master sends 5 RPDOs and a SYNC and reads as many frames per period); these
 //!   two wrappers (`mmsg.rs`) are the crate's only `unsafe` code.
 //!
 //! Files: this one (the trait and its types), `mem.rs` ([`MemLink`]), `socket.rs`
-//! ([`SocketLink`]), `mmsg.rs` (the raw `can_frame` and the two system calls).
+//! ([`SocketLink`]), `mmsg.rs` (the raw `can_frame` and the two system calls), `errors.rs`
+//! (error frames by kind, and the in-memory link's fault injection).
 
+pub mod errors;
 mod mem;
 mod mmsg;
 mod socket;
 
+pub use errors::{BusErrors, LinkFaults, CAN_ERR_FLAG, ERR_MASK};
 pub use mem::MemLink;
 pub use socket::SocketLink;
 
@@ -51,6 +56,9 @@ pub enum Sent {
 pub enum LinkError {
     #[error("CAN socket error (errno {0})")]
     Os(i32),
+    /// The interface is down or gone (`ENETDOWN`, `ENODEV`): nothing reaches the bus.
+    #[error("CAN interface down ({})", if *.0 == nix::libc::ENODEV { "ENODEV" } else { "ENETDOWN" })]
+    Down(i32),
     #[error("CAN link closed by the other end")]
     Closed,
 }
@@ -59,6 +67,7 @@ impl LinkError {
     fn from_errno(e: i32) -> LinkError {
         match e {
             nix::libc::EPIPE | nix::libc::ECONNRESET => LinkError::Closed,
+            nix::libc::ENETDOWN | nix::libc::ENODEV => LinkError::Down(e),
             _ => LinkError::Os(e),
         }
     }
@@ -68,7 +77,7 @@ impl LinkError {
             ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
                 LinkError::Closed
             }
-            _ => LinkError::Os(e.raw_os_error().unwrap_or(0)),
+            _ => LinkError::from_errno(e.raw_os_error().unwrap_or(0)),
         }
     }
 }
@@ -79,6 +88,11 @@ pub trait CanLink {
     fn send(&mut self, frame: &CanFrame) -> Result<Sent, LinkError>;
     /// The next received data frame, or `None` if none is waiting. Never blocks.
     fn recv(&mut self) -> Result<Option<CanFrame>, LinkError>;
+
+    /// The error frames received so far, by kind (none on a link that has no controller).
+    fn errors(&self) -> BusErrors {
+        BusErrors::default()
+    }
 
     /// Queue `frames` in order without blocking; returns how many were dropped (full queue).
     /// A link may batch them into fewer system calls; the default sends one by one.

@@ -5,9 +5,11 @@
 //! `index:sub` and the abort code in words), so that an integrator can act on them.
 
 pub mod cyclic;
+pub mod health;
 pub mod setup;
 
 pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
+pub use health::{BusCondition, BusHealth, Reaction};
 pub use setup::{
     configure, configure_nodes, Clock, NodeSetup, Protections, SetupError, SetupErrorKind,
     SetupOptions, VelocitySetup, WallClock, FOLLOWING_OFF,

@@ -43,6 +43,22 @@ impl RawFrame {
         }
         CanFrame::new(self.can_id as u16, &self.data[..usize::from(self.len)])
     }
+
+    /// An error frame's id and data, or `None` for any other frame.
+    pub(super) fn error(&self) -> Option<(u32, [u8; 8])> {
+        (self.can_id & super::CAN_ERR_FLAG != 0).then_some((self.can_id, self.data))
+    }
+
+    /// A frame with this raw id and data (tests write error frames with it).
+    #[cfg(test)]
+    pub(super) fn raw(can_id: u32, data: [u8; 8]) -> RawFrame {
+        RawFrame {
+            can_id,
+            len: 8,
+            data,
+            ..RawFrame::default()
+        }
+    }
 }
 
 /// The headers of one `sendmmsg`/`recvmmsg` call, message i carrying one frame. Once aimed,

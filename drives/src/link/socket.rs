@@ -1,9 +1,9 @@
 //! [`SocketLink`]: a non-blocking SocketCAN socket, or one end of a socketpair.
 
 use super::mmsg::{recvmmsg, sendmmsg, RawFrame};
-use super::{CanLink, LinkError, Sent, BATCH, MAX_SKIPPED};
+use super::{BusErrors, CanLink, LinkError, Sent, BATCH, ERR_MASK, MAX_SKIPPED};
 use crate::frame::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame, Id, Socket, StandardId};
+use socketcan::{CanSocket, EmbeddedFrame, Frame, Id, Socket, SocketOptions, StandardId};
 use std::io::{self, ErrorKind};
 use std::os::fd::{AsRawFd, OwnedFd};
 
@@ -13,12 +13,16 @@ pub struct SocketLink {
     sock: CanSocket,
     dropped: u64,
     skipped: u64,
+    errors: BusErrors,
 }
 
 impl SocketLink {
-    /// Open a SocketCAN interface. Outside the real-time thread.
+    /// Open a SocketCAN interface, asking for every class of error frame ([`ERR_MASK`]).
+    /// Outside the real-time thread.
     pub fn open(interface: &str) -> io::Result<SocketLink> {
-        SocketLink::new(CanSocket::open(interface)?)
+        let sock = CanSocket::open(interface)?;
+        sock.set_error_filter(ERR_MASK)?;
+        SocketLink::new(sock)
     }
 
     /// Two connected ends of an in-process link (AF_UNIX SOCK_SEQPACKET socketpair).
@@ -45,6 +49,7 @@ impl SocketLink {
             sock,
             dropped: 0,
             skipped: 0,
+            errors: BusErrors::default(),
         })
     }
 
@@ -53,9 +58,16 @@ impl SocketLink {
         self.dropped
     }
 
-    /// Remote and error frames received and skipped.
+    /// Remote and extended frames received and skipped (error frames are counted in
+    /// [`CanLink::errors`]).
     pub fn skipped(&self) -> u64 {
         self.skipped
+    }
+}
+
+impl AsRawFd for SocketLink {
+    fn as_raw_fd(&self) -> std::os::fd::RawFd {
+        self.sock.as_raw_fd()
     }
 }
 
@@ -124,12 +136,13 @@ impl CanLink for SocketLink {
                 Err(e) => return Err(LinkError::from_errno(e)),
             };
             for r in &raw[..got] {
-                match r.to_frame() {
-                    Some(f) => {
+                match (r.to_frame(), r.error()) {
+                    (Some(f), _) => {
                         out[n] = f;
                         n += 1;
                     }
-                    None => self.skipped += 1,
+                    (None, Some((id, data))) => self.errors.record(id, &data),
+                    (None, None) => self.skipped += 1,
                 }
             }
             if got < want {
@@ -150,11 +163,21 @@ impl CanLink for SocketLink {
                     }
                     self.skipped += 1; // extended identifiers are not CANopen's
                 }
+                Ok(socketcan::CanFrame::Error(e)) => {
+                    let mut data = [0; 8];
+                    let d = e.data();
+                    data[..d.len().min(8)].copy_from_slice(&d[..d.len().min(8)]);
+                    self.errors.record(e.id_word(), &data);
+                }
                 Ok(_) => self.skipped += 1,
                 Err(e) if e.kind() == ErrorKind::WouldBlock => return Ok(None),
                 Err(e) => return Err(LinkError::from_io(&e)),
             }
         }
         Ok(None)
+    }
+
+    fn errors(&self) -> BusErrors {
+        self.errors
     }
 }

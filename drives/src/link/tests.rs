@@ -246,3 +246,110 @@ fn vcan_link_round_trip_on_a_real_interface() {
     assert_eq!(a.recv(), Ok(None));
     assert_eq!(a.recv_all(&mut buf), Ok(0));
 }
+
+/// An error frame as the kernel writes it: the flag and classes in the id, details in data.
+fn error_frame(class: u32, crtl: u8) -> (u32, [u8; 8]) {
+    (CAN_ERR_FLAG | class, [0, crtl, 0, 0, 0, 0, 0, 0])
+}
+
+#[test]
+fn error_frames_are_counted_by_kind_and_data_frames_pass() {
+    use super::errors::*;
+    let (a, b) = SocketLink::pair().unwrap();
+    let mut link = b;
+    let send = |frames: &[super::mmsg::RawFrame]| {
+        super::mmsg::sendmmsg(std::os::fd::AsRawFd::as_raw_fd(&a), frames).unwrap()
+    };
+    let raw = |(id, data): (u32, [u8; 8])| super::mmsg::RawFrame::raw(id, data);
+    let frames = [
+        raw(error_frame(ERR_CRTL, CRTL_TX_WARNING)),
+        super::mmsg::RawFrame::from(&f("181#3712A0860100")),
+        raw(error_frame(ERR_CRTL, CRTL_RX_PASSIVE | CRTL_RX_OVERFLOW)),
+        raw(error_frame(ERR_BUSOFF | ERR_RESTARTED, 0)),
+        raw(error_frame(ERR_TX_TIMEOUT, 0)),
+        raw(error_frame(ERR_LOSTARB, 0)),
+        raw(error_frame(ERR_PROT | ERR_BUSERROR, 0)),
+        raw(error_frame(ERR_ACK, 0)),
+        // An extended frame whose id has the bus-off bit: skipped, not an error.
+        raw((0x8000_0040, [0; 8])),
+    ];
+    assert_eq!(send(&frames), frames.len());
+    let mut out = [f("080#"); 16];
+    assert_eq!(link.recv_all(&mut out), Ok(1));
+    assert_eq!(out[0], f("181#3712A0860100"));
+    let e = link.errors();
+    assert_eq!(
+        e,
+        BusErrors {
+            warning: 1,
+            passive: 1,
+            bus_off: 1,
+            restarted: 1,
+            tx_timeout: 1,
+            lost_arbitration: 1,
+            protocol: 2,
+            overflow: 1,
+        }
+    );
+    assert_eq!(e.total(), 9);
+    assert_eq!(link.skipped(), 1);
+    // The one-frame receive counts them the same way.
+    let more = [raw(error_frame(ERR_BUSOFF, 0))];
+    assert_eq!(send(&more), 1);
+    assert_eq!(link.recv(), Ok(None));
+    assert_eq!(link.errors().bus_off, 2);
+    assert_eq!(link.errors().since(&e).bus_off, 1);
+    assert_eq!(link.errors().since(&e).total(), 1);
+}
+
+#[test]
+fn the_memory_link_meets_injected_faults_as_a_socket_would() {
+    use super::errors::*;
+    let (mut master, mut drives) = MemLink::pair(8);
+    let faults = master.faults();
+    let (id, data) = error_frame(ERR_CRTL, CRTL_TX_PASSIVE);
+    faults.error_frame(id, data);
+    assert_eq!(master.errors().passive, 1);
+    assert_eq!(
+        drives.errors().passive,
+        1,
+        "one interface: both ends see it"
+    );
+    faults.set_tx_full(true);
+    assert_eq!(master.send(&f("080#")), Ok(Sent::Dropped));
+    assert_eq!(master.send_all(&[f("080#"), f("080#")]), Ok(2));
+    assert_eq!(master.dropped(), 3);
+    faults.set_tx_full(false);
+    assert_eq!(master.send(&f("080#")), Ok(Sent::Queued));
+    faults.set_down(true);
+    let down = Err(LinkError::Down(nix::libc::ENETDOWN));
+    assert_eq!(master.send(&f("080#")), down);
+    assert_eq!(drives.recv(), down.map(|_| None));
+    assert_eq!(
+        LinkError::Down(nix::libc::ENETDOWN).to_string(),
+        "CAN interface down (ENETDOWN)"
+    );
+    faults.set_down(false);
+    assert_eq!(drives.recv(), Ok(Some(f("080#"))));
+}
+
+#[test]
+fn a_down_or_vanished_interface_is_told_apart_from_other_errors() {
+    assert_eq!(
+        LinkError::from_errno(nix::libc::ENETDOWN),
+        LinkError::Down(nix::libc::ENETDOWN)
+    );
+    assert_eq!(
+        LinkError::from_errno(nix::libc::ENODEV),
+        LinkError::Down(nix::libc::ENODEV)
+    );
+    assert_eq!(
+        LinkError::from_errno(nix::libc::EIO),
+        LinkError::Os(nix::libc::EIO)
+    );
+    let io = std::io::Error::from_raw_os_error(nix::libc::ENETDOWN);
+    assert_eq!(
+        LinkError::from_io(&io),
+        LinkError::Down(nix::libc::ENETDOWN)
+    );
+}

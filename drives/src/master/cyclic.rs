@@ -24,6 +24,7 @@
 //! its TPDO1 the inputs; it has no CiA-402 state machine and is supervised by heartbeat,
 //! NMT state, EMCY and feedback only).
 
+use super::health::{BusCondition, BusHealth, Reaction};
 use crate::cia402::{Goal, Sequencer, State, Statusword};
 use crate::frame::CanFrame;
 use crate::link::{CanLink, LinkError};
@@ -96,14 +97,34 @@ pub enum FaultCause {
     NoFeedback(u32),
     #[error("CAN link: {0}")]
     Link(LinkError),
+    #[error("{0}")]
+    Bus(BusCondition),
 }
 
-/// A fault with the node it came from.
+/// A fault with the node it came from ([`DriveFault::BUS`] for the bus itself).
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
-#[error("node {node}: {cause}")]
+#[error("{}: {cause}", NodeName(*node))]
 pub struct DriveFault {
     pub node: u8,
     pub cause: FaultCause,
+}
+
+impl DriveFault {
+    /// The node of a fault of the bus or the link, not of one drive (CANopen nodes are
+    /// 1..=127).
+    pub const BUS: u8 = 0;
+}
+
+/// "node 3", or "CAN bus" for [`DriveFault::BUS`].
+struct NodeName(u8);
+
+impl core::fmt::Display for NodeName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self.0 {
+            DriveFault::BUS => write!(f, "CAN bus"),
+            n => write!(f, "node {n}"),
+        }
+    }
 }
 
 /// Supervision limits.
@@ -125,6 +146,11 @@ pub struct Master<L: CanLink> {
     sup: Supervision,
     cycles: u64,
     dropped: u64,
+    /// Frames the last cycle's send dropped.
+    last_dropped: usize,
+    health: BusHealth,
+    /// The most severe feed hold or controlled stop the bus called for, until taken.
+    bus_pending: Option<BusCondition>,
     /// The clock value the master was created at, s.
     started: f64,
 }
@@ -190,6 +216,9 @@ impl<L: CanLink> Master<L> {
             sup,
             cycles: 0,
             dropped: 0,
+            last_dropped: 0,
+            health: BusHealth::default(),
+            bus_pending: None,
             started: now,
         })
     }
@@ -239,6 +268,34 @@ impl<L: CanLink> Master<L> {
         &self.link
     }
 
+    /// What the master has seen of the bus: error frames by kind, the reactions called for.
+    pub fn health(&self) -> &BusHealth {
+        &self.health
+    }
+
+    /// The feed hold or controlled stop the bus has called for since the last call, the
+    /// most severe if several (quick stops are the master's own fault, [`Master::fault`]).
+    pub fn take_bus_condition(&mut self) -> Option<BusCondition> {
+        self.bus_pending.take()
+    }
+
+    /// The period's bus condition: a quick stop is a fault, a hold or a stop waits to be
+    /// taken by the loop.
+    fn watch_bus(&mut self) {
+        let Some(c) = self.health.update(self.link.errors(), self.last_dropped) else {
+            return;
+        };
+        match c.reaction() {
+            Reaction::QuickStop => self.raise(DriveFault::BUS, FaultCause::Bus(c)),
+            Reaction::Hold | Reaction::Stop => {
+                if self.bus_pending.is_none_or(|p| c.reaction() > p.reaction()) {
+                    self.bus_pending = Some(c);
+                }
+            }
+            Reaction::Warn => {}
+        }
+    }
+
     fn raise(&mut self, node: u8, cause: FaultCause) {
         if self.fault.is_none() {
             self.fault = Some(DriveFault { node, cause });
@@ -255,8 +312,7 @@ impl<L: CanLink> Master<L> {
             let n = match self.link.recv_all(&mut buf[..want]) {
                 Ok(n) => n.min(want),
                 Err(e) => {
-                    let node = self.nodes.first().map_or(0, |n| n.node.get());
-                    self.raise(node, FaultCause::Link(e));
+                    self.raise(DriveFault::BUS, FaultCause::Link(e));
                     break;
                 }
             };
@@ -394,6 +450,7 @@ impl<L: CanLink> Master<L> {
             n.cycles_without_feedback = n.cycles_without_feedback.saturating_add(1);
         }
         self.receive(now);
+        self.watch_bus();
         self.supervise(now);
         let goal = self.goal;
         let hold = self.fault.is_some();
@@ -424,9 +481,15 @@ impl<L: CanLink> Master<L> {
             let _ = out.push(rpdo1_csp(n.node, cw.0, n.target));
         }
         let _ = out.push(sync::encode());
-        // The RPDOs and the SYNC in one batch (one system call on a socket).
-        if let Ok(dropped) = self.link.send_all(&out) {
-            self.dropped += dropped as u64;
+        // The RPDOs and the SYNC in one batch (one system call on a socket). A link that
+        // fails (the interface down) is the bus's fault: nothing reaches the drives.
+        self.last_dropped = 0;
+        match self.link.send_all(&out) {
+            Ok(dropped) => {
+                self.dropped += dropped as u64;
+                self.last_dropped = dropped;
+            }
+            Err(e) => self.raise(DriveFault::BUS, FaultCause::Link(e)),
         }
         self.fault
     }
