@@ -28,7 +28,10 @@
 //!
 //! A drive fault is handled by the master itself (quick stop, then disable, every target
 //! held at the last one commanded); the pipeline stops interpolating and waits for that to
-//! end. A drive lost to its supervision does not hold the run up.
+//! end. A drive lost to its supervision does not hold the run up. A condition of the bus
+//! itself ([`drives::master::health`]: error frames, a full transmit queue, the interface
+//! down) is a warning, a feed hold (the follower paused, as `ctl pause`), a controlled stop
+//! (along the path, [`StopReason::Bus`]) or the master's fault (quick stop).
 //!
 //! Each stage keeps what only it needs in its variant of the run's phase (the approach its
 //! move, the interpolating stages their settling count and spindle wait), so a stage cannot
@@ -54,7 +57,7 @@ pub use bus::BusDrives;
 pub use drive_loop::{drive_loop, GAP_NS};
 use drives::cia402::Goal;
 use drives::link::CanLink;
-use drives::master::{DriveFault, MAX_NODES};
+use drives::master::{BusCondition, DriveFault, MAX_NODES};
 use nc_follow::Follower;
 use nc_geom::kinematics::Joints;
 use nc_geom::program::Aux;
@@ -124,6 +127,8 @@ pub enum StopReason {
          stopped along the path, drives disabled"
     )]
     ProgramRefused { line: u32 },
+    #[error("CAN bus: {0}; stopped along the path, drives disabled")]
+    Bus(BusCondition),
 }
 
 impl StopReason {
@@ -132,10 +137,10 @@ impl StopReason {
         matches!(self, StopReason::Requested | StopReason::Operator)
     }
 
-    /// The drive that caused it, if one did.
+    /// The drive that caused it, if one did (not the bus).
     pub fn node(&self) -> Option<u8> {
         match self {
-            StopReason::Fault(f) => Some(f.node),
+            StopReason::Fault(f) if f.node != DriveFault::BUS => Some(f.node),
             _ => None,
         }
     }
@@ -411,7 +416,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         }
     }
 
-    fn stop(&mut self, reason: StopReason) {
+    pub(super) fn stop(&mut self, reason: StopReason) {
         self.set_reason(reason);
         self.follower.request_stop();
     }
@@ -464,6 +469,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             }
         }
         self.trace_period();
+        self.bus_reaction();
         if let Some(f) = fault {
             if self.reason.is_none() {
                 self.set_reason(StopReason::Fault(f));

@@ -14,8 +14,9 @@ pub const FAILED: u8 = 1;
 /// Bad input: the NC program, the machine file or a command-line value (nothing moved).
 /// clap uses 2 for usage errors too.
 pub const BAD_INPUT: u8 = 2;
-/// Stopped by a fault: a drive fault or lost drive, drives not enabled in time, a target
-/// outside the drive's counts, too many consecutive overruns.
+/// Stopped by a fault: a drive fault or lost drive, a bus fault (bus-off, TX timeout, a full
+/// transmit queue, the interface down), drives not enabled in time, a target outside the
+/// drive's counts, too many consecutive overruns.
 pub const STOPPED_FAULT: u8 = 3;
 /// Stopped by the operator: SIGINT/SIGTERM or `dnurbs ctl stop`.
 pub const STOPPED_OPERATOR: u8 = 4;
@@ -30,8 +31,8 @@ pub const TABLE: &str = "Exit codes (every subcommand):
      error in the program met ahead of the moving tool, by the planner or, for a program
      too long to check whole before it starts, the pre-pass: stopped along the path,
      drives disabled); `simulate` with a Taylor method whose setpoints go over a limit
-  3  stopped by a fault (drive fault or lost drive, enable timeout, count overflow,
-     too many consecutive overruns); the drives were stopped and disabled
+  3  stopped by a fault (drive fault or lost drive, bus fault, enable timeout, count
+     overflow, too many consecutive overruns); the drives were stopped and disabled
   4  stopped by the operator (SIGINT/SIGTERM, `dnurbs ctl stop`); stopped along the path,
      or before anything moved (a stop while `run` plans or sets up the drives); `fit`
      stopped before it wrote its output

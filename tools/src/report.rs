@@ -7,6 +7,10 @@
 //! dnurbs version and the start time, and the latency statistics. `latency.svg` plots the
 //! histograms; `latency.hlog` is written while the run goes.
 
+mod bus;
+
+pub use bus::BusNotes;
+
 use crate::exit::Outcome;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -55,6 +59,9 @@ pub struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input_timeouts: Option<InputTimeouts>,
     pub drives: Vec<DriveEnd>,
+    /// Per bus: error frames, dropped frames, the reactions they called for.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub buses: Vec<BusNotes>,
     #[serde(with = "crate::rt_serde::SummaryDef")]
     pub latency: rt_loop::stats::Summary,
     /// Spindle, coolant, tool, stop and dwell words of the program, one line each.
@@ -133,6 +140,9 @@ impl Report {
                 "axis {:<3} node {:>3}: target {:>11}  actual {:>11}  program end {end:>11} counts\n",
                 d.axis, d.node, d.target_counts, d.actual_counts
             ));
+        }
+        for b in &self.buses {
+            s.push_str(&b.line());
         }
         s.push_str(&crate::words::text(&self.program_words));
         if let Some(c) = &self.compressed {

@@ -24,7 +24,7 @@ pub mod simulated;
 pub mod trace;
 
 use crate::feed::{Input, Learned, Pace, Ready};
-use crate::report::{DriveEnd, Report, StreamNotes, AXES};
+use crate::report::{BusNotes, DriveEnd, Report, StreamNotes, AXES};
 use crate::setup::MachineSetup;
 use crate::InputError;
 use config::Machine;
@@ -81,6 +81,8 @@ pub struct RunResult {
     pub drives: Vec<(usize, u8, i32, i32)>,
     /// Per drive: the program's end point in counts (same order as `drives`).
     pub end_counts: Vec<Option<i32>>,
+    /// Per bus: error frames, dropped frames and the reactions they called for.
+    pub buses: Vec<BusNotes>,
     pub underruns: u64,
     pub hard_stops: u64,
     /// `M66` waits that ended at their timeout, and the line of the last.
@@ -132,6 +134,7 @@ impl RunResult {
                     program_end_counts: end,
                 })
                 .collect(),
+            buses: self.buses.clone(),
             latency: self.stats.summary(),
             program_words: self.program_words.clone(),
             compressed: self.compressed,
@@ -336,6 +339,7 @@ impl Staged {
             ready: self.ready,
             learned: self.learned,
             drive_axes,
+            bus_names: machine.buses.iter().map(|b| b.interface.clone()).collect(),
         };
         Ok((pipeline, finished))
     }
@@ -347,6 +351,8 @@ struct Finished {
     ready: Ready,
     learned: Arc<Learned>,
     drive_axes: Vec<(usize, config::bus::Drive)>,
+    /// Each bus's interface, in the machine file's order.
+    bus_names: Vec<String>,
 }
 
 impl Finished {
@@ -376,6 +382,11 @@ impl Finished {
             realtime,
             started: self.started,
             drives: pipeline.drive_positions().collect(),
+            buses: pipeline
+                .bus_health()
+                .zip(&self.bus_names)
+                .map(|((h, dropped), name)| BusNotes::new(name, h, dropped))
+                .collect(),
             end_counts,
             underruns: c.underruns,
             hard_stops: c.hard_stops,

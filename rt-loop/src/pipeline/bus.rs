@@ -2,10 +2,10 @@
 //! every period: axis positions to targets in counts, spindle speed and coolant outputs,
 //! the drives' states.
 
-use super::{Pipeline, StopReason};
+use super::{Pipeline, Stage, StopReason};
 use drives::cia402::{State, Statusword};
 use drives::link::CanLink;
-use drives::master::{Master, NodeKind, NodeStatus, MAX_NODES};
+use drives::master::{BusCondition, BusHealth, Master, NodeKind, NodeStatus, Reaction, MAX_NODES};
 use heapless::Vec as HVec;
 use machine::bus::Drive;
 use nc_geom::kinematics::Joints;
@@ -103,6 +103,34 @@ impl<L: CanLink> BusDrives<L> {
 }
 
 impl<L: CanLink> Pipeline<'_, L> {
+    /// A feed hold or a controlled stop the buses called for this period (a quick stop is
+    /// the master's fault). The hold pauses the path, as `dnurbs ctl pause` does: during
+    /// the approach it takes effect at the program's start.
+    pub(super) fn bus_reaction(&mut self) {
+        let worst = self
+            .buses
+            .iter_mut()
+            .filter_map(|b| b.master.take_bus_condition())
+            .max_by_key(BusCondition::reaction);
+        let Some(c) = worst else { return };
+        if matches!(self.stage(), Stage::Disabling | Stage::Finished) {
+            return;
+        }
+        match c.reaction() {
+            Reaction::Hold => self.follower.pause(),
+            Reaction::Stop => self.stop(StopReason::Bus(c)),
+            Reaction::Warn | Reaction::QuickStop => {}
+        }
+    }
+
+    /// Each bus's health (error frames by kind, the reactions called for) and the frames
+    /// its master could not send.
+    pub fn bus_health(&self) -> impl Iterator<Item = (&BusHealth, u64)> + '_ {
+        self.buses
+            .iter()
+            .map(|b| (b.master.health(), b.master.dropped()))
+    }
+
     /// Axis positions (mm, degrees) to targets; `false` if one did not fit.
     pub(super) fn set_targets(&mut self, axes: &[f64; 5]) -> Result<(), StopReason> {
         for b in self.buses.iter_mut() {

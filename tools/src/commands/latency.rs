@@ -66,6 +66,7 @@ pub fn latency(
         hard_stops: 0,
         input_timeouts: None,
         trace: None,
+        buses: Vec::new(),
         drives: Vec::new(),
         latency: stats.summary(),
     };
