@@ -249,3 +249,62 @@ fn vcan_master_configures_python_canopen_local_node() {
         report["values"]
     );
 }
+
+/// The simulated drives as an independent CiA-402 master expects them: python-canopen's
+/// `BaseNode402` (tests/vcan/canopen_homing.py) configures the PDOs of a `dnurbs sim-drives`
+/// node over SDO, selects homing mode, runs `homing()` (controlword bit 4, the statusword's
+/// homing bits) and ends Operation enabled; node 1 homes on its switch and index pulse
+/// (method 3), node 2 on its current position (method 35).
+#[test]
+#[ignore = "needs a SocketCAN interface and python-canopen: run by tests/vcan/run in the PREEMPT_RT guest"]
+fn vcan_python_canopen_base_node_402_homes_and_enables_sim_drives() {
+    let iface = std::env::var("DNURBS_VCAN").unwrap_or_else(|_| "vcan0".into());
+    let python = std::env::var("DNURBS_PYTHON").unwrap_or_else(|_| "python3".into());
+    let machine_file = data("vcan-machine.toml");
+    let boot = BootWatch::open(&iface);
+    let _sim = KillOnDrop(
+        std::process::Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+            .args(["sim-drives", "--iface", &iface, "--machine"])
+            .arg(&machine_file)
+            .spawn()
+            .expect("start dnurbs sim-drives"),
+    );
+    boot.wait(Duration::from_secs(60));
+    let home = |node: u8, method: i8, offset: i32| -> serde_json::Value {
+        let out = std::process::Command::new(&python)
+            .arg(root().join("tests/vcan/canopen_homing.py"))
+            .arg(&iface)
+            .args(["--node", &node.to_string()])
+            .args(["--method", &method.to_string()])
+            .args(["--offset", &offset.to_string()])
+            .output()
+            .expect("run the python-canopen master");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        println!(
+            "BaseNode402, node {node}, method {method}: {stdout}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let r: serde_json::Value = serde_json::from_str(stdout.trim())
+            .unwrap_or_else(|e| panic!("no JSON from the python master ({e}): {stdout}"));
+        assert!(out.status.success() && r.get("error").is_none(), "{r}");
+        assert_eq!(r["homed"], true, "{r}");
+        // `homing()` returns once attained, the motor perhaps still stopping; at rest the
+        // statusword says attained and target reached (bits 12 and 10, no error bit 13).
+        assert!(
+            ["ATTAINED", "TARGET REACHED"].contains(&r["homing_status"].as_str().unwrap_or("")),
+            "{r}"
+        );
+        assert_eq!(r["statusword"].as_u64().unwrap() & 0x3400, 0x1400, "{r}");
+        assert_eq!(r["state"], "OPERATION ENABLED", "{r}");
+        assert_eq!(r["op_mode"], "HOMING", "{r}");
+        r
+    };
+    // Node 1 starts at 0, on its switch's edge: it leaves the switch negative and stops
+    // on the index pulse at -10 000 counts, which becomes 1 000; at the index speed the
+    // stop overshoots by some 20 counts.
+    let r = home(1, 3, 1_000);
+    let pos = r["position"].as_i64().unwrap();
+    assert!((960..1_000).contains(&pos), "{r}");
+    let r = home(2, 35, -500);
+    assert_eq!(r["position"], -500, "{r}");
+}

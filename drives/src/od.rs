@@ -41,6 +41,16 @@ pub const QUICK_STOP_OPTION: u16 = 0x605A;
 pub const FAULT_REACTION_OPTION: u16 = 0x605E;
 /// Software position limit: sub 1 min, sub 2 max (i32, counts).
 pub const SOFTWARE_POSITION_LIMIT: u16 = 0x607D;
+/// Home offset (i32, counts): the position the home point becomes.
+pub const HOME_OFFSET: u16 = 0x607C;
+/// Homing method (i8).
+pub const HOMING_METHOD: u16 = 0x6098;
+/// Homing speeds: sub 1 while searching for the switch, sub 2 for the index (u32).
+pub const HOMING_SPEEDS: u16 = 0x6099;
+/// Homing acceleration (u32).
+pub const HOMING_ACCELERATION: u16 = 0x609A;
+/// Supported drive modes (u32): bit 2 profile velocity, bit 5 homing, bit 7 CSP.
+pub const SUPPORTED_DRIVE_MODES: u16 = 0x6502;
 /// Target position (i32).
 pub const TARGET_POSITION: u16 = 0x607A;
 /// Velocity actual value (i32, velocity units).
@@ -64,6 +74,8 @@ pub const INTERPOLATION_TIME_PERIOD: u16 = 0x60C2;
 pub const MODE_CSP: i8 = 8;
 /// Modes of operation value of profile velocity mode (the spindle).
 pub const MODE_PV: i8 = 3;
+/// Modes of operation value of homing mode.
+pub const MODE_HOMING: i8 = 6;
 
 /// CiA-401 digital inputs, 8 per sub-index (sub 0 count, sub 1 inputs 1..8, u8).
 pub const DIGITAL_INPUTS: u16 = 0x6000;

@@ -1,6 +1,6 @@
 //! Simulated CANopen slaves, the slave side of the bus, sans-I/O, for `dnurbs sim-drives`
 //! and for testing the master without hardware: CiA-402 drives (the axes in cyclic
-//! synchronous position mode, the spindle in profile velocity mode) and CiA-401 digital I/O
+//! synchronous position and homing modes, the spindle in profile velocity mode) and CiA-401 digital I/O
 //! modules (the coolant valves).
 //!
 //! A [`SimBus`] plays every configured node. It is pure: frames from the master go in through
@@ -43,8 +43,17 @@
 //!
 //! # Drives
 //!
-//! * **Modes.** 0x6060 accepts 8 (cyclic synchronous position, CSP) and 3 (profile
-//!   velocity, PV); 0x6061 shows the value written. In mode 0, the default, nothing moves.
+//! * **Modes.** 0x6060 accepts 8 (cyclic synchronous position, CSP), 3 (profile
+//!   velocity, PV) and 6 (homing, below); 0x6061 shows the value written; 0x6502 (supported
+//!   drive modes) says 0xA4. In mode 0, the default, nothing moves.
+//! * **Homing** (0x6061 = 6): methods 35/37 (the current position), 19 and 21 (the home
+//!   switch, active on the positive or the negative side of its edge), 3 and 5 (the switch,
+//!   then the index pulse), on the motor's [`HomeHardware`] (a switch at 0 and an index
+//!   every 10 000 counts by default; a switch that is not wired is a homing error once the
+//!   search has gone `search_limit` counts). 0x6098 refuses other methods. Started by the
+//!   controlword's bit 4 in Operation enabled, interrupted by clearing it; statusword bits 12
+//!   (attained), 13 (error) and 10 (at rest after either); the home point becomes 0x607C.
+//!   The procedure is in `homing.rs`.
 //!   Reset node restarts the state machine (Switch on disabled after the boot-up) and stops
 //!   the motor where it stands, which becomes the target position.
 //! * **Motor in CSP** (and modes other than 3): a first-order lag with time constant
@@ -175,6 +184,7 @@
 
 mod dictionary;
 mod drive;
+mod homing;
 mod io;
 mod lockstep;
 mod motor;
@@ -192,6 +202,7 @@ use crate::wire::heartbeat::NmtState;
 use crate::wire::nmt::{self, Target};
 use crate::wire::{cob, sync, NodeId};
 
+pub use homing::{HomeHardware, METHODS as HOMING_METHODS};
 pub use io::IO_FAULT_ERROR_CODE;
 pub use lockstep::Lockstep;
 pub use tables::{DEVICE_TYPE_IO, DEVICE_TYPE_SERVO};
@@ -224,6 +235,8 @@ pub struct SimNodeConfig {
     pub lag_s: f64,
     /// Position at power-on, counts. Drives only.
     pub initial_position: i32,
+    /// The home switch and the index homing mode finds. Drives only.
+    pub home: HomeHardware,
     pub faults: Faults,
 }
 
@@ -235,6 +248,7 @@ impl SimNodeConfig {
             profile: Profile::Drive,
             lag_s: 0.0,
             initial_position: 0,
+            home: HomeHardware::default(),
             faults: Faults::default(),
         }
     }

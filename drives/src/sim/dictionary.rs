@@ -181,7 +181,12 @@ impl Dictionary {
     /// The value rules of writable entries beyond type and length.
     fn check_value(&self, index: u16, sub: u8, raw: u32) -> Result<(), AbortCode> {
         let mode = raw as u8 as i8;
-        if index == od::MODES_OF_OPERATION && mode != od::MODE_CSP && mode != od::MODE_PV {
+        if index == od::MODES_OF_OPERATION
+            && ![od::MODE_CSP, od::MODE_PV, od::MODE_HOMING].contains(&mode)
+        {
+            return Err(AbortCode::ValueRangeExceeded);
+        }
+        if index == od::HOMING_METHOD && !super::homing::METHODS.contains(&mode) {
             return Err(AbortCode::ValueRangeExceeded);
         }
         for kind in [PdoKind::Rpdo, PdoKind::Tpdo] {

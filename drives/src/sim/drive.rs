@@ -1,9 +1,11 @@
 //! The application of a simulated CiA-402 drive: device control ([`DriveModel`]), the modes
-//! CSP (8) and profile velocity (3), the motor and the statusword. The node
+//! CSP (8), profile velocity (3) and homing (6, [`super::homing`]), the motor and the
+//! statusword. The node
 //! ([`SimNode`](super::node::SimNode)) calls it at the points of a SYNC the
 //! [module docs](super) describe.
 
 use super::dictionary::Dictionary;
+use super::homing::{HomeHardware, Homing};
 use super::motor::{Demand, Motor, Ramp};
 use super::tables::ERROR_REGISTER;
 use super::FAULT_ERROR_REGISTER;
@@ -28,11 +30,18 @@ pub struct Drive {
     in_window: Option<u64>,
     /// PV: it has stayed there for 0x606E ms.
     target_reached: bool,
+    homing: Homing,
+    home: HomeHardware,
 }
 
 impl Drive {
     /// At power-on, at `initial_position`, which becomes the target position too.
-    pub fn new(lag_s: f64, initial_position: i32, dict: &mut Dictionary) -> Self {
+    pub fn new(
+        lag_s: f64,
+        initial_position: i32,
+        home: HomeHardware,
+        dict: &mut Dictionary,
+    ) -> Self {
         dict.set(od::TARGET_POSITION, 0, initial_position as u32);
         Self {
             model: DriveModel::new(),
@@ -42,6 +51,8 @@ impl Drive {
             over_window: 0,
             in_window: None,
             target_reached: false,
+            homing: Homing::new(home),
+            home,
         }
     }
 
@@ -67,6 +78,7 @@ impl Drive {
         self.over_window = 0;
         self.in_window = None;
         self.target_reached = false;
+        self.homing = Homing::new(self.home);
         dict.set(od::TARGET_POSITION, 0, self.position() as u32);
     }
 
@@ -112,7 +124,11 @@ impl Drive {
             target
         };
         let csp = enabled && mode == od::MODE_CSP;
-        let demand = if mode == od::MODE_PV {
+        let demand = if mode == od::MODE_HOMING {
+            let cw = dict.get(od::CONTROLWORD, 0) as u16;
+            self.homing
+                .settle(enabled, cw, |i, s| dict.get(i, s), &mut self.motor)
+        } else if mode == od::MODE_PV {
             Demand::Velocity(pv_ramp(state, dict))
         } else if csp {
             Demand::Position(f64::from(target))
@@ -159,6 +175,9 @@ impl Drive {
         }
         if enabled && self.following_error {
             statusword |= Statusword::FOLLOWING_ERROR;
+        }
+        if mode == od::MODE_HOMING {
+            statusword |= self.homing.status(self.motor.velocity_units() == 0);
         }
         if mode == od::MODE_PV {
             if enabled && self.target_reached {

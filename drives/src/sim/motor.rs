@@ -67,6 +67,18 @@ impl Motor {
         self.velocity.round() as i32
     }
 
+    /// Re-reference the position by `delta` counts (homing), the motor unmoved: the demand
+    /// moves with it.
+    pub fn rebase(&mut self, delta: f64) {
+        if !delta.is_finite() {
+            return;
+        }
+        self.position = wrap(self.position + delta);
+        if let Demand::Position(d) = self.demand {
+            self.demand = Demand::Position(wrap(d + delta));
+        }
+    }
+
     pub fn set_demand(&mut self, demand: Demand) {
         self.demand = demand;
     }

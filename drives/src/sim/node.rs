@@ -56,9 +56,12 @@ impl SimNode {
     pub fn new(config: SimNodeConfig) -> Self {
         let mut dict = Dictionary::new(config.node, Table::of(config.profile));
         let app = match config.profile {
-            Profile::Drive => {
-                App::Drive(Drive::new(config.lag_s, config.initial_position, &mut dict))
-            }
+            Profile::Drive => App::Drive(Drive::new(
+                config.lag_s,
+                config.initial_position,
+                config.home,
+                &mut dict,
+            )),
             Profile::Io => App::Io(Io::default()),
         };
         let mut node = Self {

@@ -176,7 +176,7 @@ pub const COMMUNICATION: [Entry; COMMUNICATION_LEN] = [
     entry(od::TPDO1_MAPPING, 8, U32, Rw, 0),
 ];
 
-/// A CiA-402 drive (CSP and profile velocity). The default PDO mappings are CiA-402's
+/// A CiA-402 drive (CSP, profile velocity and homing). The default PDO mappings are CiA-402's
 /// predefined ones: RPDO1 maps the controlword, TPDO1 the statusword.
 #[rustfmt::skip]
 static DRIVE: Table = Table {
@@ -197,16 +197,23 @@ static DRIVE: Table = Table {
         entry(od::VELOCITY_WINDOW, 0, U16, Rw, 10),
         entry(od::VELOCITY_WINDOW_TIME, 0, U16, Rw, 0),
         entry(od::TARGET_POSITION, 0, I32, Rw, 0).map(Rpdo),
+        entry(od::HOME_OFFSET, 0, I32, Rw, 0),
         entry(od::SOFTWARE_POSITION_LIMIT, 0, U8, Ro, 2),
         entry(od::SOFTWARE_POSITION_LIMIT, 1, I32, Rw, i32::MIN as u32),
         entry(od::SOFTWARE_POSITION_LIMIT, 2, I32, Rw, i32::MAX as u32),
         entry(od::PROFILE_ACCELERATION, 0, U32, Rw, 10_000),
         entry(od::PROFILE_DECELERATION, 0, U32, Rw, 10_000),
         entry(od::QUICK_STOP_DECELERATION, 0, U32, Rw, 20_000),
+        entry(od::HOMING_METHOD, 0, I8, Rw, 35),
+        entry(od::HOMING_SPEEDS, 0, U8, Ro, 2),
+        entry(od::HOMING_SPEEDS, 1, U32, Rw, 20_000),
+        entry(od::HOMING_SPEEDS, 2, U32, Rw, 2_000),
+        entry(od::HOMING_ACCELERATION, 0, U32, Rw, 100_000),
         entry(od::INTERPOLATION_TIME_PERIOD, 0, U8, Ro, 2),
         entry(od::INTERPOLATION_TIME_PERIOD, 1, U8, Rw, 1),
         entry(od::INTERPOLATION_TIME_PERIOD, 2, I8, Rw, (-3i8) as u8 as u32),
         entry(od::TARGET_VELOCITY, 0, I32, Rw, 0).map(Rpdo),
+        entry(od::SUPPORTED_DRIVE_MODES, 0, U32, Ro, 0xA4),
     ],
 };
 

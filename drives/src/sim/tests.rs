@@ -4,6 +4,7 @@
 
 mod bus;
 mod faults;
+mod homing;
 mod io;
 mod robustness;
 mod sdo;

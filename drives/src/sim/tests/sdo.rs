@@ -161,9 +161,10 @@ fn a_wrong_data_length_aborts_with_0607_0010() {
 }
 
 #[test]
-fn a_mode_other_than_csp_aborts_with_0609_0030() {
+fn a_mode_the_drive_does_not_have_aborts_with_0609_0030() {
     let mut m = preop();
-    for mode in [0, 1, 6, 7, 9, -1, i8::MIN] {
+    // It has CSP (8), profile velocity (3) and homing (6).
+    for mode in [0, 1, 2, 4, 5, 7, 9, -1, i8::MIN] {
         let code = abort(&mut m, od::MODES_OF_OPERATION, 0, SdoValue::I8(mode));
         assert_eq!(code, AbortCode::ValueRangeExceeded, "mode {mode}");
     }
