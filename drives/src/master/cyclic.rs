@@ -25,6 +25,7 @@
 //! NMT state, EMCY and feedback only).
 
 use super::health::{BusCondition, BusHealth, Reaction};
+use super::homing::{HomingState, Job, START};
 use crate::cia402::{Goal, Sequencer, State, Statusword};
 use crate::frame::CanFrame;
 use crate::link::{CanLink, LinkError};
@@ -140,9 +141,12 @@ pub struct Supervision {
 #[derive(Debug)]
 pub struct Master<L: CanLink> {
     link: L,
-    nodes: HVec<NodeStatus, MAX_NODES>,
-    goal: Goal,
-    fault: Option<DriveFault>,
+    pub(super) nodes: HVec<NodeStatus, MAX_NODES>,
+    pub(super) goal: Goal,
+    pub(super) fault: Option<DriveFault>,
+    /// Each node's homing under way, and how its last ended (`homing.rs`).
+    pub(super) jobs: [Option<Job>; MAX_NODES],
+    pub(super) homing: [HomingState; MAX_NODES],
     sup: Supervision,
     cycles: u64,
     dropped: u64,
@@ -219,6 +223,8 @@ impl<L: CanLink> Master<L> {
             last_dropped: 0,
             health: BusHealth::default(),
             bus_pending: None,
+            jobs: [None; MAX_NODES],
+            homing: [HomingState::Idle; MAX_NODES],
             started: now,
         })
     }
@@ -330,11 +336,16 @@ impl<L: CanLink> Master<L> {
         let Some(i) = (match classify(frame) {
             Received::Tpdo { node, .. }
             | Received::Emcy { node }
-            | Received::Heartbeat { node } => self.nodes.iter().position(|n| n.node == node),
+            | Received::Heartbeat { node }
+            | Received::SdoResponse { node } => self.nodes.iter().position(|n| n.node == node),
             _ => None,
         }) else {
             return;
         };
+        if matches!(classify(frame), Received::SdoResponse { .. }) {
+            self.homing_answer(i, frame);
+            return;
+        }
         let n = &mut self.nodes[i];
         match classify(frame) {
             Received::Tpdo { n: 1, .. } if n.kind == NodeKind::Io => {
@@ -389,7 +400,8 @@ impl<L: CanLink> Master<L> {
                     })
                 }
                 _ if Statusword(n.statusword).following_error()
-                    && n.state == Some(State::OperationEnabled) =>
+                    && n.state == Some(State::OperationEnabled)
+                    && !self.in_homing_mode(i) =>
                 {
                     Some(FaultCause::FollowingError(n.statusword))
                 }
@@ -454,7 +466,13 @@ impl<L: CanLink> Master<L> {
         self.supervise(now);
         let goal = self.goal;
         let hold = self.fault.is_some();
-        let mut out: HVec<CanFrame, { MAX_NODES + 1 }> = HVec::new();
+        // SDO requests of the homings under way first, then the RPDOs and the SYNC.
+        let mut out: HVec<CanFrame, { 2 * MAX_NODES + 1 }> = HVec::new();
+        for f in self.homing_cycle() {
+            let _ = out.push(f);
+        }
+        let homing: [(bool, bool); MAX_NODES] =
+            core::array::from_fn(|i| (self.is_homing(i), self.homing_start_bit(i)));
         for (i, n) in self.nodes.iter_mut().enumerate() {
             let state = n.state.unwrap_or(State::SwitchOnDisabled);
             if n.kind == NodeKind::Io {
@@ -466,12 +484,18 @@ impl<L: CanLink> Master<L> {
                 let _ = out.push(rpdo1_io(n.node, n.target as u8));
                 continue;
             }
-            let cw = n.seq.step(state, goal);
+            let mut cw = n.seq.step(state, goal);
+            let (homes, start) = homing[i];
+            if start && state == State::OperationEnabled {
+                cw.0 |= START;
+            }
             n.target = match (n.kind, state, targets.get(i)) {
                 // After a fault: the last commanded target, whatever the state. A drive
                 // behind its target (its own lag) would otherwise see the target step back
                 // to where it is, a velocity reversal beyond any limit.
                 (NodeKind::Position, ..) if hold => n.target,
+                // Homing: where the drive stands, so that CSP resumes there.
+                (NodeKind::Position, ..) if homes => n.actual,
                 (_, State::OperationEnabled, Some(&t)) if !hold => t,
                 (NodeKind::Position, ..) => n.actual,
                 // A spindle stops: its drive ramps down (quick stop after a fault).
