@@ -243,6 +243,26 @@ pub(crate) struct RawAxis {
     pub acceleration: f64,
     pub jerk: f64,
     pub drive: Option<RawDrive>,
+    pub home: Option<RawHome>,
+}
+
+/// `[axes.*.home]`: how the axis is homed.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawHome {
+    /// "switch", "switch-index", "current" or "absolute".
+    pub method: String,
+    /// "positive" or "negative": the side of its edge the home switch is active on.
+    pub direction: Option<String>,
+    /// Axis position of the home point; default 0.
+    pub position: Option<f64>,
+    /// Axis units/s; defaults a tenth of the velocity limit, a tenth of the search.
+    pub search_velocity: Option<f64>,
+    pub latch_velocity: Option<f64>,
+    /// Axis units/s^2; default half the acceleration limit.
+    pub acceleration: Option<f64>,
+    /// 0..=9; default 0.
+    pub sequence: Option<i64>,
 }
 
 /// `[interpolation]`: every key optional.

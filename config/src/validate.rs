@@ -13,6 +13,7 @@ use machine::Machine;
 
 mod guard;
 mod hardware;
+mod home;
 mod io;
 mod motion;
 mod program;

@@ -173,6 +173,7 @@ fn a_switch_never_found_fails_with_the_drives_error_and_the_axis_stays_enabled()
         switch: (node == 2).then_some(0),
         index_pitch: 10_000,
         search_limit: 30_000,
+        ..HomeHardware::default()
     });
     rig.m.home(0, request(19, 0)).unwrap();
     rig.run_until(20_000, |m| ended(m, 0));

@@ -79,6 +79,55 @@ pub struct Drive {
     pub offset: i32,
     /// What the drive guards by itself, written in set-up.
     pub guard: Guard,
+    /// How the axis is homed (`[axes.*.home]`); `None` when the file says nothing.
+    pub home: Option<Home>,
+}
+
+/// How an axis finds its zero (`[axes.*.home]`): CiA-402 homing by the drive, or an
+/// absolute encoder that needs none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Home {
+    pub method: HomeMethod,
+    /// The axis position (mm or degrees) of the home point: the switch's edge, the index
+    /// pulse, or where the axis stands for [`HomeMethod::Current`].
+    pub position: f64,
+    /// Speeds while searching for the switch and for the index pulse, axis units/s.
+    pub search_velocity: f64,
+    pub latch_velocity: f64,
+    /// Axis units/s².
+    pub acceleration: f64,
+    /// Axes home in rising order of this; equal values home together.
+    pub sequence: u8,
+}
+
+/// The homing methods an axis may name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HomeMethod {
+    /// Where the axis stands is the home position (CiA-402 method 37).
+    Current,
+    /// The home switch's edge, the switch active on the `positive` (else negative) side
+    /// of it in axis direction (methods 19/21).
+    Switch { positive: bool },
+    /// The switch, then the first index pulse toward its inactive side (methods 3/5).
+    SwitchIndex { positive: bool },
+    /// An absolute encoder: the drive's position is trusted, no homing.
+    Absolute,
+}
+
+impl Drive {
+    /// The CiA-402 homing method (0x6098) for this drive, its sign applied; `None` for an
+    /// absolute encoder.
+    pub fn homing_method(&self, m: HomeMethod) -> Option<i8> {
+        let drive_positive = |positive: bool| positive == (self.sign > 0);
+        match m {
+            HomeMethod::Current => Some(37),
+            HomeMethod::Switch { positive } => Some(if drive_positive(positive) { 19 } else { 21 }),
+            HomeMethod::SwitchIndex { positive } => {
+                Some(if drive_positive(positive) { 3 } else { 5 })
+            }
+            HomeMethod::Absolute => None,
+        }
+    }
 }
 
 /// What an axis drive is told to guard by itself (`[axes.*.drive]`), so that it stops even
@@ -158,10 +207,35 @@ mod tests {
             sign: -1,
             offset: 500,
             guard: Guard::default(),
+            home: None,
         };
         assert_eq!(d.counts(1.5), Some(-14_500));
         assert!((d.position(-14_500) - 1.5).abs() < 1e-12);
         assert_eq!(d.counts(1e6), None);
         assert_eq!(d.counts(f64::NAN), None);
+    }
+
+    #[test]
+    fn a_drive_turned_the_other_way_finds_its_switch_on_the_other_side() {
+        let mut d = Drive {
+            axis: 0,
+            bus: 0,
+            node: 1,
+            counts_per_unit: 1.0,
+            sign: 1,
+            offset: 0,
+            guard: Guard::default(),
+            home: None,
+        };
+        let sw = |positive| HomeMethod::Switch { positive };
+        let idx = |positive| HomeMethod::SwitchIndex { positive };
+        assert_eq!(d.homing_method(sw(true)), Some(19));
+        assert_eq!(d.homing_method(sw(false)), Some(21));
+        assert_eq!(d.homing_method(idx(true)), Some(3));
+        assert_eq!(d.homing_method(HomeMethod::Current), Some(37));
+        assert_eq!(d.homing_method(HomeMethod::Absolute), None);
+        d.sign = -1;
+        assert_eq!(d.homing_method(sw(true)), Some(21));
+        assert_eq!(d.homing_method(idx(false)), Some(3));
     }
 }

@@ -23,6 +23,8 @@ mod realtime;
 pub mod simulated;
 pub mod trace;
 
+pub use buses::home_request;
+
 use crate::feed::{Input, Learned, Pace, Ready};
 use crate::report::{BusNotes, DriveEnd, Report, StreamNotes, AXES};
 use crate::setup::MachineSetup;

@@ -8,8 +8,9 @@
 //! the last flush whenever the process is stopped (Ctrl-C or SIGTERM need no handler).
 
 use crate::InputError;
+use config::bus::{Drive, Home, HomeMethod};
 use drives::link::{CanLink, SocketLink};
-use drives::sim::{Faults, SimBus, SimNodeConfig};
+use drives::sim::{Faults, HomeHardware, SimBus, SimNodeConfig};
 use drives::wire::NodeId;
 use std::io::Write;
 use std::time::{Duration, Instant};
@@ -73,6 +74,12 @@ pub fn sim_nodes(
         .filter_map(|d| {
             let mut c = SimNodeConfig::new(NodeId::new(d.node)?);
             c.initial_position = d.offset;
+            // The simulated home switch where the machine file's home point is; with an
+            // index, an index pulse there and the switch half a motor turn before it,
+            // on its active side.
+            if let Some(h) = d.home {
+                c.home = sim_home(d, h, c.home);
+            }
             c.lag_s = lag_s;
             c.faults = faults.for_node(d.node);
             Some(c)
@@ -186,5 +193,34 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
         if idle {
             std::thread::sleep(Duration::from_micros(100));
         }
+    }
+}
+
+/// The simulated home switch and index of drive `d` homed by `h`, so that homing ends at the
+/// home point the machine file names.
+fn sim_home(d: &Drive, h: Home, hw: HomeHardware) -> HomeHardware {
+    let Some(at) = d.counts(h.position) else {
+        return hw;
+    };
+    let active_positive = |positive: bool| positive == (d.sign > 0);
+    let half = i32::try_from(hw.index_pitch / 2).unwrap_or(i32::MAX);
+    match h.method {
+        HomeMethod::Switch { .. } => HomeHardware {
+            switch: Some(at),
+            ..hw
+        },
+        HomeMethod::SwitchIndex { positive } => {
+            let side = if active_positive(positive) {
+                half
+            } else {
+                -half
+            };
+            HomeHardware {
+                switch: Some(at.saturating_add(side)),
+                index_at: at,
+                ..hw
+            }
+        }
+        HomeMethod::Current | HomeMethod::Absolute => hw,
     }
 }

@@ -184,6 +184,11 @@ impl Check<'_, '_> {
         for (axis, (key, raw_axis, limits)) in keyed.iter().enumerate() {
             let path = |field: &'static str| ["axes", key, "drive", field];
             let Some(d) = raw_axis.and_then(|a| a.drive.as_ref()) else {
+                if raw_axis.is_some_and(|a| a.home.is_some()) {
+                    let rule = "needs [axes.{axis}.drive]: the drive homes the axis"
+                        .replace("{axis}", key);
+                    return Err(self.missing(&["axes", key, "drive"], rule));
+                }
                 if !buses.is_empty() {
                     let rule =
                         "missing: a machine with [[bus]] tables needs a drive on every axis \
@@ -234,6 +239,7 @@ impl Check<'_, '_> {
                 sign: sign as i8,
                 offset,
                 guard: super::guard::guard(self, &path, d, limits, counts_per_unit)?,
+                home: None,
             };
             if !limits.is_unlimited()
                 && (drive.counts(limits.min).is_none() || drive.counts(limits.max).is_none())
@@ -251,6 +257,10 @@ impl Check<'_, '_> {
                     Some(counts_per_unit.to_string()),
                     rule,
                 ));
+            }
+            let mut drive = drive;
+            if let Some(h) = raw_axis.and_then(|a| a.home.as_ref()) {
+                drive.home = Some(super::home::home(self, key, h, limits, &drive)?);
             }
             out.push(drive);
         }

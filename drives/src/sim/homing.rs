@@ -38,18 +38,22 @@ pub const METHODS: [i8; 6] = [3, 5, 19, 21, 35, 37];
 pub struct HomeHardware {
     /// Where the home switch changes state (counts), or `None` if none is wired.
     pub switch: Option<i32>,
-    /// Counts between two index pulses (one motor turn); pulses at its multiples.
+    /// Counts between two index pulses (one motor turn).
     pub index_pitch: u32,
+    /// Where one index pulse is; the others every `index_pitch` from it.
+    pub index_at: i32,
     /// Farthest a search goes before it is a homing error, counts.
     pub search_limit: u32,
 }
 
 impl Default for HomeHardware {
-    /// A switch at 0, an index every 10 000 counts, searches of at most 2 000 000 counts.
+    /// A switch at 0, an index pulse at 0 and every 10 000 counts, searches of at most
+    /// 2 000 000 counts.
     fn default() -> Self {
         HomeHardware {
             switch: Some(0),
             index_pitch: 10_000,
+            index_at: 0,
             search_limit: 2_000_000,
         }
     }
@@ -261,12 +265,15 @@ impl Homing {
 
     fn search_index(&mut self, dir: f64, from: f64, p: f64, motor: &mut Motor) {
         let pitch = f64::from(self.hw.index_pitch.max(1));
+        let at = f64::from(self.hw.index_at);
         // The first pulse strictly beyond the last position, in the direction of travel.
-        let next = if dir > 0.0 {
-            (self.last / pitch).floor() * pitch + pitch
-        } else {
-            (self.last / pitch).ceil() * pitch - pitch
-        };
+        let k = (self.last - at) / pitch;
+        let next = at
+            + if dir > 0.0 {
+                k.floor() * pitch + pitch
+            } else {
+                k.ceil() * pitch - pitch
+            };
         if (p - next) * dir >= 0.0 {
             self.home_at(next, motor);
         } else if self.too_far(from, p) || self.index_speed <= 0.0 {

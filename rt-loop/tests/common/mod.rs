@@ -140,6 +140,7 @@ fn axis_drives(counts_per_unit: [f64; 5]) -> Vec<Drive> {
             sign: 1,
             offset: 0,
             guard: machine::bus::Guard::default(),
+            home: None,
         })
         .collect()
 }

@@ -5,7 +5,8 @@ use super::node_setups;
 use config::Machine;
 use drives::link::CanLink;
 use drives::master::{
-    configure_nodes, Clock, Master, Protections, SetupOptions, Supervision, FOLLOWING_OFF,
+    configure_nodes, Clock, HomeRequest, Master, Protections, SetupOptions, Supervision,
+    FOLLOWING_OFF,
 };
 use rt_loop::pipeline::BusDrives;
 use std::time::Duration;
@@ -32,6 +33,38 @@ pub(crate) fn protections(
         fault_reaction_option: d.guard.fault_reaction_option,
         position_limits,
     }
+}
+
+/// The CiA-402 homing request for drive `d` (`[axes.*.home]` in counts), or `None` for an
+/// axis without homing or with an absolute encoder. The timeout allows crossing the whole
+/// travel (360 degrees for an endless axis) twice at the search velocity and once at the
+/// latch velocity, and 10 s more, at `period_s`.
+pub fn home_request(
+    d: &config::bus::Drive,
+    limits: &config::AxisLimits,
+    period_s: f64,
+) -> Option<HomeRequest> {
+    let h = d.home?;
+    let method = d.homing_method(h.method)?;
+    let counts = |v: f64| {
+        (v * d.counts_per_unit)
+            .round()
+            .clamp(1.0, f64::from(u32::MAX)) as u32
+    };
+    let span = if limits.is_unlimited() {
+        360.0
+    } else {
+        limits.max - limits.min
+    };
+    let timeout_s = 2.0 * span / h.search_velocity + span / h.latch_velocity + 10.0;
+    Some(HomeRequest {
+        method,
+        switch_speed: counts(h.search_velocity),
+        index_speed: counts(h.latch_velocity),
+        acceleration: counts(h.acceleration),
+        offset: d.counts(h.position)?,
+        timeout_cycles: (timeout_s / period_s).ceil().min(f64::from(u32::MAX)) as u32,
+    })
 }
 
 /// The set-up's timeouts and the cycle's supervision, from the machine file.
@@ -88,6 +121,129 @@ pub(super) fn set_up<L: CanLink, C: Clock>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_home_table_becomes_the_drives_homing_request_in_counts() {
+        let m = crate::demo::demo_machine().expect("the demo machine");
+        let x = config::bus::Drive {
+            home: Some(config::bus::Home {
+                method: config::bus::HomeMethod::SwitchIndex { positive: false },
+                position: -2.5,
+                search_velocity: 10.0,
+                latch_velocity: 1.0,
+                acceleration: 100.0,
+                sequence: 0,
+            }),
+            ..m.drives[0].clone()
+        };
+        let r = home_request(&x, &m.axes.x, m.period_s).expect("a request");
+        let cpu = x.counts_per_unit;
+        assert_eq!(r.method, if x.sign > 0 { 5 } else { 3 });
+        assert_eq!(r.switch_speed, (10.0 * cpu).round() as u32);
+        assert_eq!(r.index_speed, cpu.round() as u32);
+        assert_eq!(r.acceleration, (100.0 * cpu).round() as u32);
+        assert_eq!(Some(r.offset), x.counts(-2.5));
+        let span = m.axes.x.max - m.axes.x.min;
+        let want = ((2.0 * span / 10.0 + span / 1.0 + 10.0) / m.period_s).ceil() as u32;
+        assert_eq!(r.timeout_cycles, want);
+        let absolute = config::bus::Drive {
+            home: x.home.map(|h| config::bus::Home {
+                method: config::bus::HomeMethod::Absolute,
+                ..h
+            }),
+            ..x.clone()
+        };
+        assert_eq!(home_request(&absolute, &m.axes.x, m.period_s), None);
+        assert_eq!(home_request(&m.drives[0], &m.axes.x, m.period_s), None);
+    }
+
+    /// The machine file's `[axes.*.home]` from end to end on simulated drives: each axis's
+    /// simulated switch and index where its file says (`sim-drives`), the master homing
+    /// every axis with its request, and each ends at its home position (past it by the stop
+    /// from the search or latch velocity), the absolute axis untouched.
+    #[test]
+    fn a_simulated_machine_homes_where_its_file_says() {
+        use config::bus::{Home, HomeMethod};
+        let mut m = crate::demo::demo_machine().expect("the demo machine");
+        let home = |method, position: f64, limits: &config::AxisLimits| Home {
+            method,
+            position,
+            search_velocity: limits.velocity / 10.0,
+            latch_velocity: limits.velocity / 100.0,
+            acceleration: limits.acceleration / 2.0,
+            sequence: 0,
+        };
+        let limits = [&m.axes.x, &m.axes.y, &m.axes.z, &m.axes.tilt, &m.axes.c].map(|l| l.clone());
+        let methods = [
+            (HomeMethod::Switch { positive: false }, -5.0),
+            (HomeMethod::SwitchIndex { positive: true }, 4.0),
+            (HomeMethod::Current, 2.5),
+            (HomeMethod::Absolute, 0.0),
+            (HomeMethod::Switch { positive: true }, 3.0),
+        ];
+        for d in m.drives.iter_mut() {
+            let (method, pos) = methods[d.axis];
+            d.home = Some(home(method, pos, &limits[d.axis]));
+        }
+        let nodes = crate::simdrives::sim_nodes(&m, 0, 0.0, &Default::default());
+        let (link, drive_end) = drives::link::MemLink::pair(1024);
+        let mut sim = drives::sim::Lockstep::new(drive_end, nodes, m.period_s);
+        let mut bus = set_up(&m, 0, link, &mut sim, |c| Clock::now(c).as_secs_f64()).unwrap();
+        let cycle = |bus: &mut BusDrives<_>, sim: &mut drives::sim::Lockstep<_>| {
+            let now = sim.now();
+            let t: Vec<i32> = bus.master.status().iter().map(|n| n.target).collect();
+            bus.master.cycle(&t, now.as_secs_f64());
+            sim.advance_to(now);
+            sim.advance_to(now + Duration::from_secs_f64(m.period_s));
+        };
+        bus.master.set_goal(drives::cia402::Goal::Enabled);
+        for _ in 0..200 {
+            cycle(&mut bus, &mut sim);
+        }
+        assert!(bus.master.all_in(drives::cia402::State::OperationEnabled));
+        let drives_ = m.drives.clone();
+        for (i, d) in drives_.iter().enumerate() {
+            if let Some(r) = home_request(d, &limits[d.axis], m.period_s) {
+                bus.master.home(i, r).unwrap();
+            }
+        }
+        let running = |bus: &BusDrives<_>| {
+            (0..drives_.len())
+                .any(|i| matches!(bus.master.homing(i), drives::master::HomingState::Running))
+        };
+        for _ in 0..200_000 {
+            if !running(&bus) {
+                break;
+            }
+            cycle(&mut bus, &mut sim);
+        }
+        for (i, d) in drives_.iter().enumerate() {
+            let h = d.home.unwrap();
+            let l = &limits[d.axis];
+            let got = d.position(bus.master.status()[i].actual);
+            match (h.method, bus.master.homing(i)) {
+                (HomeMethod::Absolute, s) => {
+                    assert_eq!(s, drives::master::HomingState::Idle);
+                    assert_eq!(got, 0.0);
+                }
+                (method, drives::master::HomingState::Attained { .. }) => {
+                    let v = match method {
+                        HomeMethod::SwitchIndex { .. } => h.latch_velocity,
+                        _ => h.search_velocity,
+                    };
+                    // The stop from v at the homing acceleration, and a period at v.
+                    let slack = v * v / (2.0 * h.acceleration) + 2.0 * v * m.period_s + 1e-3;
+                    assert!(
+                        (got - h.position).abs() <= slack,
+                        "axis {}: at {got}, home {} (slack {slack}, limits {l:?})",
+                        d.axis,
+                        h.position
+                    );
+                }
+                (_, other) => panic!("axis {}: {other:?}", d.axis),
+            }
+        }
+    }
 
     #[test]
     fn a_drive_is_told_its_following_error_in_counts_and_its_travel() {

@@ -129,6 +129,7 @@ fn on_the_switch_and_the_index_pulse() {
         switch: Some(3_000),
         index_pitch: 10_000,
         search_limit: 1_000_000,
+        ..HomeHardware::default()
     };
     // Method 3: the switch is active above 3 000; from 25 000 the motor moves negative past
     // the edge, on at the index speed to the first pulse below it (0), which becomes the
@@ -158,6 +159,7 @@ fn a_switch_that_is_never_found_is_a_homing_error() {
         switch: None,
         index_pitch: 10_000,
         search_limit: 40_000,
+        ..HomeHardware::default()
     };
     let mut m = ready(0, hw, 19, 0);
     let seen = home(&mut m, RUN, 10_000);
