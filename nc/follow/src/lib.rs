@@ -43,6 +43,7 @@ mod chunk;
 mod follower;
 mod gates;
 mod hold;
+pub mod jog;
 mod queue;
 mod tracker;
 
