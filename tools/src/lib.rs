@@ -11,6 +11,7 @@ pub mod feed;
 pub mod report;
 mod rt_serde;
 pub mod run;
+pub mod serve;
 pub mod setup;
 pub mod shop;
 pub mod simdrives;
