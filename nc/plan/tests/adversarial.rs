@@ -910,6 +910,13 @@ fn run_half(half: u64, cases: u32) {
         .map(|c| c.load(Ordering::Relaxed))
         .collect();
     eprintln!("adversarial (seed {seed}): {cases} cases: accepted and within every limit {acc} ({arcs} with arcs, {turning} with an arc turning the tool, {interpreted} with parameters, a loop or a canned cycle, {compensated} with cutter compensation; through the follower with a stop {}, a pause {}, an override change {}, a slow planner {}, and again through an operator's session of several actions {}: with an operator's action {}; {on_stream} of them on the streamed chunks), refused with a position {refd} ({pre} of them by the pre-pass, for a programmed point outside the travel), too long to interpolate here {long}", held[0], held[1], held[2], held[3], held[4], held[0] + held[1] + held[2] + held[4]);
+    let seen = &hold::JERK_SEEN;
+    let runs: Vec<u64> = seen
+        .runs
+        .iter()
+        .map(|c| c.load(Ordering::Relaxed))
+        .collect();
+    eprintln!("adversarial (seed {seed}), both halves so far: per-axis jerk inside a block through the follower, measured and not guaranteed, runs whose largest is within the limit {}, up to 1.5x {}, 2x {}, 4x {}, over 4x {}; the largest {:.2}x", runs[0], runs[1], runs[2], runs[3], runs[4], f64::from_bits(seen.worst.load(Ordering::Relaxed)));
     if let Err(e) = result {
         panic!("{e}");
     }

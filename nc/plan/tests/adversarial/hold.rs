@@ -20,7 +20,9 @@
 //! makes an exact stop, passed at its floor speed, and the follower stepped past it into
 //! phases it did not have (now it waits there, at rest like the plan).
 //!
-//! Jerk is not checked here: through a hold it is bounded along the path, not per axis.
+//! Jerk is not checked here: through a hold it is bounded along the path, not per axis. It
+//! is measured ([`JerkSeen`]): each run's largest per-axis jerk inside a block by finite
+//! differences, against the axis's limit, counted in the summary.
 
 use super::PERIOD;
 use nc_follow::{Follower, Queues};
@@ -31,6 +33,7 @@ use nc_plan::config::PlanConfig;
 use nc_plan::profile::FeedProfile;
 use nc_plan::stream::{chunks, cut};
 use proptest::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// One event during the run, at `at` (a fraction of the plan's duration).
 #[derive(Clone, Copy, Debug)]
@@ -59,6 +62,43 @@ pub enum Event {
     },
     /// An operator's session: several actions in one run ([`session`]).
     Session(Session),
+}
+
+/// Runs by their largest per-axis jerk inside a block, as a multiple of the axis's limit:
+/// up to 1, 1.5, 2, 4, and over 4; and the largest of all (f64 bits).
+pub struct JerkSeen {
+    pub runs: [AtomicU64; 5],
+    pub worst: AtomicU64,
+}
+
+pub static JERK_SEEN: JerkSeen = JerkSeen {
+    runs: [const { AtomicU64::new(0) }; 5],
+    worst: AtomicU64::new(0),
+};
+
+/// Count a run's setpoints in [`JERK_SEEN`].
+fn measure_jerk(cfg: &PlanConfig, sps: &[Setpoint]) {
+    let mut worst = 0.0f64;
+    for w in sps.windows(4) {
+        if w.iter().any(|s| s.block != w[0].block) {
+            continue;
+        }
+        for (j, ax) in cfg.axes.iter().enumerate() {
+            let [q0, q1, q2, q3] = [0, 1, 2, 3].map(|i| w[i].joints[j]);
+            let jk = (q3 - 3.0 * q2 + 3.0 * q1 - q0).abs() / PERIOD.powi(3);
+            if ax.jerk > 0.0 && jk.is_finite() {
+                worst = worst.max(jk / ax.jerk);
+            }
+        }
+    }
+    let bucket = [1.0 + 1e-6, 1.5, 2.0, 4.0]
+        .iter()
+        .position(|&b| worst <= b)
+        .unwrap_or(4);
+    JERK_SEEN.runs[bucket].fetch_add(1, Ordering::Relaxed);
+    JERK_SEEN
+        .worst
+        .fetch_max(worst.to_bits(), Ordering::Relaxed);
 }
 
 /// Most actions a session takes.
@@ -280,6 +320,7 @@ pub fn check(
         }
     }
     feeder.feed(&mut std::iter::empty());
+    measure_jerk(cfg, &sps);
     let counters = f.counters();
     prop_assert_eq!(counters.hard_stops, 0, "{:?} {:?}\n{}", ev, counters, src);
     let last = *sps.last().unwrap();
