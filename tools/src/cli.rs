@@ -193,7 +193,9 @@ pub enum Command {
     /// Simulate a machine's drives on a CAN interface (tests without hardware).
     ///
     /// Boot-up, NMT slave, SDO server, PDO mapping, CiA-402 state machine, CSP motor model,
-    /// heartbeats, with fault injection. Stop it with Ctrl-C or --duration.
+    /// homing mode (methods 35/37, 19/21, 3/5, on a home switch and an index pulse where the
+    /// machine file's [axes.*.home] puts the home point, else at 0 counts), heartbeats, with
+    /// fault injection. Stop it with Ctrl-C or --duration.
     #[command(after_help = crate::exit::TABLE)]
     SimDrives {
         /// CAN interface, e.g. vcan0 (`ip link add dev vcan0 type vcan`).
