@@ -6,7 +6,8 @@ way python-canopen's CiA-402 profile does it: its PDOs configured over SDO (RPDO
 controlword, applied on receipt; TPDO1 the statusword and the position actual value, every
 SYNC), the network's SYNC producer running, NMT start, homing mode and method by SDO, then
 `BaseNode402.homing()` (Operation enabled, controlword bit 4, the statusword's homing bits
-until attained), then `state = 'OPERATION ENABLED'` again to check the drive stays there.
+until attained), then the drive at rest (target reached), then `state = 'OPERATION
+ENABLED'` again to check the drive stays there.
 Prints one JSON line: whether it homed, the state, the mode, the position actual value.
 
     canopen_homing.py IFACE --node 1 --method 3 --offset 1000
@@ -14,6 +15,7 @@ Prints one JSON line: whether it homed, the state, the mode, the position actual
 import argparse
 import json
 import sys
+import time
 
 import canopen
 from canopen import objectdictionary as od
@@ -94,7 +96,12 @@ def main():
         node.sdo[0x6098].raw = a.method
         node.sdo[0x607C].raw = a.offset
         result["homed"] = node.homing(timeout=60)
-        result["homing_status"] = node._homing_status()
+        # homing() returns once attained, the motor perhaps still stopping: wait for rest.
+        status = node._homing_status()
+        deadline = time.monotonic() + 10.0
+        while status == "ATTAINED" and time.monotonic() < deadline:
+            status = node._homing_status()
+        result["homing_status"] = status
         node.state = "OPERATION ENABLED"
         result["state"] = node.state
         result["op_mode"] = node.op_mode
