@@ -52,31 +52,30 @@ struct Plan {
     t: f64,
     /// The velocity it ends at (0: at rest once over).
     v_end: f64,
-    /// An incremental move to a target within the travel (no travel check needed).
-    to_target: bool,
-    /// Where the final rest is, exactly (an incremental move's target).
+    /// An incremental move's target, where the final rest is, exactly (within the travel:
+    /// no travel check needed).
     land: Option<f64>,
 }
 
 impl Plan {
-    /// Resting at `p`.
-    fn rest(p: f64) -> Self {
-        let mut phases = [Phase::default(); PHASES];
-        phases[0] = Phase {
-            dur: f64::INFINITY,
-            s0: 0.0,
-            ..Phase::default()
-        };
+    /// No phase yet: from `origin`, positions counted in direction `dir`, ending at `v_end`.
+    fn new(origin: f64, dir: f64, v_end: f64) -> Self {
         Plan {
-            phases,
-            n: 1,
-            origin: p,
-            dir: 1.0,
+            phases: [Phase::default(); PHASES],
+            n: 0,
+            origin,
+            dir,
             t: 0.0,
-            v_end: 0.0,
-            to_target: false,
+            v_end,
             land: None,
         }
+    }
+
+    /// Resting at `p`.
+    fn rest(p: f64) -> Self {
+        let mut plan = Plan::new(p, 1.0, 0.0);
+        plan.hold(None);
+        plan
     }
 
     /// Position, velocity and acceleration at time `t` of the plan.
@@ -176,23 +175,12 @@ impl Plan {
 
 /// A plan from `(p, v, a)` to the velocity `v1` at zero acceleration, then on at `v1`.
 fn change_plan(p: f64, v: f64, a: f64, v1: f64, lim: &JogLimits) -> Plan {
-    let mut plan = Plan {
-        phases: [Phase::default(); PHASES],
-        n: 0,
-        origin: p,
-        dir: 1.0,
-        t: 0.0,
-        v_end: v1,
-        to_target: false,
-        land: None,
-    };
+    let mut plan = Plan::new(p, 1.0, v1);
+    // A phase of no length carries the starting velocity and acceleration.
     plan.phases[0] = Phase {
-        t0: 0.0,
-        dur: 0.0,
-        s0: 0.0,
         v0: v,
         a0: a,
-        j: 0.0,
+        ..Phase::default()
     };
     plan.n = 1;
     for (j, dur) in change(v, a, v1, lim.acceleration, lim.jerk) {
@@ -338,9 +326,7 @@ impl Jog {
         let (p, _, _) = self.state();
         let d = target - p;
         let len = d.abs();
-        let mut plan = Plan::rest(p);
-        plan.n = 0;
-        plan.dir = d.signum();
+        let mut plan = Plan::new(p, d.signum(), 0.0);
         let (a, j) = (lim.acceleration, lim.jerk);
         let vc = speed.min(reachable(0.0, len / 2.0, a, j));
         if len > 0.0 && vc > 0.0 {
@@ -354,9 +340,7 @@ impl Jog {
             }
         }
         // Lands on the target exactly.
-        plan.v_end = 0.0;
         plan.hold(Some(len));
-        plan.to_target = true;
         plan.land = Some(target);
         self.plan = plan;
         self.deadman = None;
@@ -374,7 +358,7 @@ impl Jog {
             }
         }
         let next = self.plan.t + self.period;
-        if !self.plan.to_target && self.would_leave_travel(next) {
+        if self.plan.land.is_none() && self.would_leave_travel(next) {
             self.deadman = None;
             self.limited = true;
             self.replan(0.0);
