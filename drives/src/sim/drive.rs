@@ -31,7 +31,6 @@ pub struct Drive {
     /// PV: it has stayed there for 0x606E ms.
     target_reached: bool,
     homing: Homing,
-    home: HomeHardware,
 }
 
 impl Drive {
@@ -52,7 +51,6 @@ impl Drive {
             in_window: None,
             target_reached: false,
             homing: Homing::new(home),
-            home,
         }
     }
 
@@ -78,7 +76,7 @@ impl Drive {
         self.over_window = 0;
         self.in_window = None;
         self.target_reached = false;
-        self.homing = Homing::new(self.home);
+        self.homing = Homing::new(self.homing.hardware());
         dict.set(od::TARGET_POSITION, 0, self.position() as u32);
     }
 

@@ -93,6 +93,7 @@ pub struct Homing {
     /// The home offset 0x607C at the start: the position the home point becomes.
     offset: i32,
     acc: f64,
+    switch_speed: f64,
     index_speed: f64,
     /// Controlword bit 4 at the last look.
     start_bit: bool,
@@ -109,6 +110,7 @@ impl Homing {
             method: 0,
             offset: 0,
             acc: 0.0,
+            switch_speed: 0.0,
             index_speed: 0.0,
             start_bit: false,
             last: 0.0,
@@ -154,7 +156,7 @@ impl Homing {
         }
         self.last = motor.position();
         match self.phase {
-            Phase::Switch { dir, .. } => self.velocity(dir * self.switch_speed(&dict_value)),
+            Phase::Switch { dir, .. } => self.velocity(dir * self.switch_speed),
             Phase::Index { dir, .. } => self.velocity(dir * self.index_speed),
             Phase::Stopping => {
                 if motor.velocity_units() == 0 {
@@ -167,6 +169,11 @@ impl Homing {
             }
             Phase::Idle => Demand::Position(motor.position()),
         }
+    }
+
+    /// The switch and index it homes on.
+    pub fn hardware(&self) -> HomeHardware {
+        self.hw
     }
 
     /// The homing bits of the statusword.
@@ -185,10 +192,6 @@ impl Homing {
         }
     }
 
-    fn switch_speed(&self, dict_value: &impl Fn(u16, u8) -> u32) -> f64 {
-        f64::from(dict_value(od::HOMING_SPEEDS, 1))
-    }
-
     fn velocity(&self, v: f64) -> Demand {
         Demand::Velocity(Ramp {
             target: v,
@@ -200,6 +203,7 @@ impl Homing {
     fn begin(&mut self, dict_value: &impl Fn(u16, u8) -> u32, motor: &mut Motor) {
         self.method = dict_value(od::HOMING_METHOD, 0) as u8 as i8;
         self.acc = f64::from(dict_value(od::HOMING_ACCELERATION, 0));
+        self.switch_speed = f64::from(dict_value(od::HOMING_SPEEDS, 1));
         self.index_speed = f64::from(dict_value(od::HOMING_SPEEDS, 2));
         self.end = None;
         let p = motor.position();
@@ -217,7 +221,7 @@ impl Homing {
                 return;
             }
         };
-        if self.switch_speed(dict_value) <= 0.0 || self.acc <= 0.0 {
+        if self.switch_speed <= 0.0 || self.acc <= 0.0 {
             self.finish(End::Error);
             return;
         }
