@@ -50,22 +50,11 @@ impl BusNotes {
 
     /// One line of `summary.txt`.
     pub fn line(&self) -> String {
-        let list = |m: &BTreeMap<&str, u64>| {
-            m.iter()
-                .map(|(k, n)| format!("{n} {k}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let frames: BTreeMap<&str, u64> = self
-            .error_frames
-            .iter()
-            .map(|(&k, &n)| (k, u64::from(n)))
-            .collect();
         let mut s = format!("bus {}: ", self.interface);
-        if frames.is_empty() {
+        if self.error_frames.is_empty() {
             s.push_str("no error frames");
         } else {
-            s.push_str(&format!("error frames: {}", list(&frames)));
+            s.push_str(&format!("error frames: {}", list(&self.error_frames)));
         }
         match self.dropped_frames {
             0 => s.push_str(", no frame dropped"),
@@ -83,6 +72,14 @@ impl BusNotes {
         s.push('\n');
         s
     }
+}
+
+/// `n key, n key` in the map's order.
+fn list<N: std::fmt::Display>(m: &BTreeMap<&str, N>) -> String {
+    m.iter()
+        .map(|(k, n)| format!("{n} {k}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 #[cfg(test)]
