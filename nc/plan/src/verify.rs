@@ -19,7 +19,10 @@
 //!   the jerk is measured on each side of it, on the four setpoints that end on the
 //!   junction and the four that start there: the bound between phases ([`reserve`]) needs
 //!   the jerk within its limit up to the corner, and a step of a joint at the junction
-//!   (which no speed makes small) shows there.
+//!   (which no speed makes small) shows there. Where the jerk changes fast from one
+//!   stencil to the next, it is also measured between the plan's phases ([`phases`]): a
+//!   hold shifts the phase, and a feature passed within a period shows a different jerk at
+//!   another.
 //! * chord error: the largest distance of the cutter path between two setpoints from the
 //!   straight chord between them (the drives interpolate linearly), measured at the quarter
 //!   points of a curve's parameter interval and at every segment junction the chord spans.
@@ -197,6 +200,8 @@ fn check_marked(
     // The last four samples, newest last; padded with the start pose (the drives are there).
     let first = sample(&ip.step(), 0, profile, &mut cursor);
     let mut win = [first; 4];
+    // The two setpoints before the window's oldest (the jerk of the stencils before).
+    let mut older = [first; 2];
     // Padding past the end: three more copies of the last setpoint.
     let mut tail = 0;
     let mut done = first.cycle == 0 && path.segments.is_empty();
@@ -217,6 +222,7 @@ fn check_marked(
         if let Some(m) = usable.checked_sub(1).map(|i| &e.trace.marks[i]) {
             ip.resume(&m.ip);
             win = m.win;
+            older = m.older;
             cursor = m.cursor;
             out.margins = m.margins;
             out.violations = e.checked.violations[..m.violations].to_vec();
@@ -238,13 +244,15 @@ fn check_marked(
             out.margins.cycles += 1;
             sample(&sp, ip.segment(), profile, &mut cursor)
         };
+        older = [older[1], win[0]];
         win = [win[1], win[2], win[3], next];
         check_travel(&next, cfg, &mut out);
-        check_window(&win, &ctx, &mut out);
+        check_window(&win, &older, &ctx, &mut out);
         if !done && next.cycle % every == 0 {
             trace.marks.push(TraceMark {
                 ip: ip.mark(),
                 win,
+                older,
                 cursor,
                 margins: out.margins,
                 violations: out.violations.len(),
@@ -257,6 +265,7 @@ fn check_marked(
 mod chord;
 mod corner;
 mod junction;
+mod phases;
 mod sample;
 mod stencil;
 mod trace;

@@ -11,7 +11,7 @@ use super::sample::{Ctx, Sample};
 use nc_geom::kinematics::Joints;
 
 /// Joints at path position s, near `prev`.
-fn joints_at(ctx: &Ctx, s: f64, prev: &Joints) -> Option<Joints> {
+pub(super) fn joints_at(ctx: &Ctx, s: f64, prev: &Joints) -> Option<Joints> {
     let k = ctx
         .profile
         .seg_start

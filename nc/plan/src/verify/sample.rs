@@ -49,3 +49,9 @@ pub(super) struct Ctx<'a> {
     pub(super) cfg: &'a PlanConfig,
     pub(super) smooth: &'a [bool],
 }
+
+/// Does the stencil `w` cross a junction that is not G2-continuous?
+pub(super) fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
+    let (a, b) = (w[0].seg, w[w.len() - 1].seg);
+    (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
+}

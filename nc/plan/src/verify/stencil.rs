@@ -5,7 +5,8 @@
 
 use super::chord::chord_error;
 use super::corner;
-use super::sample::{Ctx, Sample};
+use super::phases;
+use super::sample::{crosses_corner, Ctx, Sample};
 use super::{Checked, Quantity, Violation, SLACK};
 use crate::config::PlanConfig;
 use nc_geom::limits::reserve;
@@ -62,13 +63,9 @@ pub(super) fn check_travel(x: &Sample, cfg: &PlanConfig, out: &mut Checked) {
     }
 }
 
-/// Does the stencil `w` cross a junction that is not G2-continuous?
-pub(super) fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
-    let (a, b) = (w[0].seg, w[w.len() - 1].seg);
-    (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
-}
-
-pub(super) fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
+/// The checks over the stencil `w`; `older` are the two setpoints before `w[0]` (oldest
+/// first), for the jerk of the two stencils before ([`phases`]).
+pub(super) fn check_window(w: &[Sample; 4], older: &[Sample; 2], ctx: &Ctx, out: &mut Checked) {
     let cfg = ctx.cfg;
     let (ts, m) = (cfg.period, &mut out.margins);
     let mut found: Option<Violation> = None;
@@ -86,6 +83,9 @@ pub(super) fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
         }
     };
     let jerk_ok = !crosses_corner(w, ctx.smooth);
+    // The jerk between the plan's phases, where it changes fast from one stencil to the
+    // next or peaks between them.
+    let between = phases::measure(w, older, ctx);
     let kink = if w[1].seg < w[2].seg {
         corner::stencil(w, ctx)
     } else {
@@ -141,7 +141,13 @@ pub(super) fn check_window(w: &[Sample; 4], ctx: &Ctx, out: &mut Checked) {
                 }
             }
         }
-        if jerk_ok {
+        // The aligned stencil's jerk where it lies inside a stretch, and the jerk between
+        // phases where it was measured (up to a corner the stencil crosses).
+        let aligned = if jerk_ok { jerk } else { 0.0 };
+        if let Some(jerk) = between
+            .map(|b| b[j].max(aligned))
+            .or(jerk_ok.then_some(jerk))
+        {
             m.jerk[j] = m.jerk[j].max(jerk / jerk_limit);
             if jerk > jerk_limit * (1.0 + SLACK) || jerk.is_nan() {
                 keep(

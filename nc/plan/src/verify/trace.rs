@@ -31,8 +31,9 @@ impl Trace {
     /// one, a check starts from the program's start).
     pub fn oldest(&self, until: f64) -> Option<(usize, usize, f64)> {
         let m = self.marks.first().filter(|m| m.win[3].t < until)?;
-        let seg = m.win.iter().map(|w| w.seg).fold(m.ip.segment(), usize::min);
-        Some((seg, m.cursor.min(m.ip.phase()), m.win[0].t))
+        let seg = m.win.iter().chain(&m.older).map(|w| w.seg);
+        let seg = seg.fold(m.ip.segment(), usize::min);
+        Some((seg, m.cursor.min(m.ip.phase()), m.older[0].t))
     }
 
     /// The segments and phases before `segments` and `phases` are gone from the planner's
@@ -42,7 +43,7 @@ impl Trace {
         for m in &mut self.marks {
             m.ip.rebase(segments, phases);
             m.cursor -= phases;
-            for w in &mut m.win {
+            for w in m.win.iter_mut().chain(&mut m.older) {
                 w.seg -= segments;
             }
         }
@@ -53,6 +54,8 @@ impl Trace {
 pub(super) struct TraceMark {
     pub(super) ip: Mark,
     pub(super) win: [Sample; 4],
+    /// The two samples before `win[0]`.
+    pub(super) older: [Sample; 2],
     pub(super) cursor: usize,
     pub(super) margins: Margins,
     /// Violations recorded before the mark.

@@ -1,0 +1,83 @@
+//! The jerk between the plan's phases. The check measures each axis's jerk on the
+//! setpoints the plan gives, one phase of the period. A hold, an override or a wait for
+//! data shifts the phase at which the drives' setpoints meet the path, and where the
+//! joints' motion changes within a period (a sharp feature inside a segment, a curvature
+//! peak passed slowly) the jerk at another phase can be well over what the plan's phase
+//! shows: the third difference weighs the motion of three periods by a kernel that peaks
+//! between setpoints. Where an axis's jerk changes by more than [`JERK_STEP`] of its limit
+//! from one stencil to the next, or peaks between them, the stencil is also measured at
+//! [`SUBPHASES`] - 1 phases between each two of the last three ([`measure`]), and a stencil
+//! over a corner up to the corner; elsewhere the jerk varies little within a period, and
+//! the phase changes it little. Found by the generated-input suite through holds: a
+//! curvature peak inside a NURBS segment passed at 0.2 mm/s showed 0.56 of the limit at
+//! the plan's phases and 1.13x at another.
+
+use super::corner::joints_at;
+use super::sample::{crosses_corner, Ctx, Sample};
+use nc_geom::kinematics::Joints;
+
+/// Change of an axis's jerk between two consecutive stencils, as a share of its planned
+/// jerk, above which the stencil is measured between the plan's phases.
+pub(super) const JERK_STEP: f64 = 0.25;
+
+/// Phases a period is cut into for the measurement between phases.
+pub(super) const SUBPHASES: usize = 8;
+
+/// Each axis's largest |jerk| between the plan's phases about the stencil `w` (`older`
+/// the two setpoints before it), where the jerk changes fast or peaks between the last
+/// stencils ([`JERK_STEP`]); `None` where it does not, or where a corner is too close
+/// behind. A stencil over a corner is measured up to the corner: the stencils shifted
+/// back from it that end before the corner.
+pub(super) fn measure(w: &[Sample; 4], older: &[Sample; 2], ctx: &Ctx) -> Option<[f64; 5]> {
+    let x = [&older[0], &older[1], &w[0], &w[1], &w[2], &w[3]];
+    if crosses_corner(&[older[0], w[2]], ctx.smooth) {
+        return None;
+    }
+    let whole = !crosses_corner(&[older[0], w[3]], ctx.smooth);
+    let ts = ctx.cfg.period;
+    let steps = (0..5).any(|j| {
+        let jerk = |i: usize| {
+            (x[i + 3].q[j] - 3.0 * x[i + 2].q[j] + 3.0 * x[i + 1].q[j] - x[i].q[j]) / ts.powi(3)
+        };
+        let step = JERK_STEP * ctx.cfg.axes[j].planned_jerk(ts);
+        let (j0, j1) = (jerk(0), jerk(1));
+        if whole {
+            let j2 = jerk(2);
+            (j2 - j1).abs() > step || (j2 - 2.0 * j1 + j0).abs() > step
+        } else {
+            (j1 - j0).abs() > step
+        }
+    });
+    if steps {
+        between(w, ctx)
+    } else {
+        None
+    }
+}
+
+/// Each axis's largest |jerk| over the stencil `w` shifted back by 1/8 to 15/8 of a
+/// period, those inside one G2-continuous stretch: the setpoints a hold might give between
+/// the stencil two before `w` and `w`. `None` where a joint cannot be computed.
+fn between(w: &[Sample; 4], ctx: &Ctx) -> Option<[f64; 5]> {
+    let ts = ctx.cfg.period;
+    let near = ctx.profile.near(w[0].t - 3.0 * ts, w[3].t + ts);
+    let seg = |s: f64| ctx.profile.seg_start.partition_point(|&x| x <= s);
+    let mut worst = [0.0f64; 5];
+    for m in (1..2 * SUBPHASES).filter(|m| m % SUBPHASES != 0) {
+        let shift = ts * m as f64 / SUBPHASES as f64;
+        let s = [0, 1, 2, 3].map(|i| near.motion_at(w[i].t - shift).s);
+        let (a, b) = (seg(s[0]), seg(s[3]));
+        if (a..b).any(|k| !ctx.smooth.get(k).copied().unwrap_or(false)) {
+            continue;
+        }
+        let mut q: [Joints; 4] = [[0.0; 5]; 4];
+        for (i, x) in q.iter_mut().enumerate() {
+            *x = joints_at(ctx, s[i], &w[i].q)?;
+        }
+        for (j, worst) in worst.iter_mut().enumerate() {
+            let jerk = (q[3][j] - 3.0 * q[2][j] + 3.0 * q[1][j] - q[0][j]) / (ts * ts * ts);
+            *worst = worst.max(jerk.abs());
+        }
+    }
+    Some(worst)
+}
