@@ -116,16 +116,19 @@ pub fn jerk_note(m: &config::Machine) -> Option<String> {
             .planned_jerk(m.period_s);
             let unit = if j >= 3 { "deg" } else { "mm" };
             let said = format!("{name} {:.4e} -> {planned:.4e} {unit}/s^3", l.jerk);
-            (planned < l.jerk).then_some(said)
+            let kept = l.jerk * (1.0 - nc_geom::limits::JERK_RESERVE);
+            (planned < kept * (1.0 - 1e-12)).then_some(said)
         })
         .collect();
     (!lowered.is_empty()).then(|| {
         format!(
-            "planned at a jerk of {} of the axis's acceleration a period ({} ms) where the \
-             file's is higher: {}; the setpoint check keeps in reserve the acceleration a \
-             jerk adds within a period, and a higher jerk would leave the ramps too little",
+            "planned at a jerk of {} of the axis's acceleration a period ({} ms), less the \
+             {} % every plan keeps for a hold, where the file's is higher: {}; the setpoint \
+             check keeps in reserve the acceleration a jerk adds within a period, and a \
+             higher jerk would leave the ramps too little",
             nc_geom::limits::JERK_RISE,
             m.period_s * 1e3,
+            nc_geom::limits::JERK_RESERVE * 100.0,
             lowered.join(", ")
         )
     })

@@ -16,6 +16,14 @@ pub struct AxisLimit {
 /// axis's acceleration: see [`AxisLimit::planned_jerk`].
 pub const JERK_RISE: f64 = 0.098;
 
+/// Share of every axis's jerk a plan leaves unused, for a feed hold, a stop or an override
+/// change. Slowing down along the path adds `3 k k' q'' + k'' q'` to an axis's jerk (k the
+/// override, primes in time and plan time), so a plan at its jerk limit could not change
+/// k at all while any axis accelerates. `nc_follow` spends what is left, and no more. It
+/// costs machining time only where the plan is jerk-limited: docs/measurements.md says
+/// how much on the README's programs.
+pub const JERK_RESERVE: f64 = 0.15;
+
 impl AxisLimit {
     /// The jerk a plan keeps to on this axis, and its setpoint check holds it to: the
     /// limit, or [`JERK_RISE`] times the acceleration per `period` where that is less. The
@@ -27,9 +35,10 @@ impl AxisLimit {
     /// check allowed half of, and a plain raster was refused on its first ramp (the
     /// xyzac-trt-mill with every jerk 1e9: `the X axis acceleration would reach 2.6949e3
     /// mm/s^2 ... 1.797x its limit of 1.5000e3`). At this jerk the reserve leaves 95 %:
-    /// a ramp reaches the acceleration in ten periods or more.
+    /// a ramp reaches the acceleration in ten periods or more. Of that, a plan uses all but
+    /// [`JERK_RESERVE`].
     pub fn planned_jerk(&self, period: f64) -> f64 {
-        self.jerk.min(JERK_RISE * self.acceleration / period)
+        self.jerk.min(JERK_RISE * self.acceleration / period) * (1.0 - JERK_RESERVE)
     }
 }
 

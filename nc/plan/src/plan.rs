@@ -223,8 +223,25 @@ mod tests {
         );
         assert!(
             msg.contains(
-                "1.020x the 2.9400e5 mm/s^3 a plan may use of its limit of 1.0000e9 mm/s^3 \
-                 (a plan's jerk is at most 0.098 x the acceleration per period)"
+                "1.200x the 2.4990e5 mm/s^3 a plan may use of its limit of 1.0000e9 mm/s^3 \
+                 (a plan's jerk is at most 0.098 x the acceleration per period, and 85.0 % of \
+                 that: the rest is kept for feed holds and overrides)"
+            ),
+            "{msg}"
+        );
+        // A jerk within the rise: the plan keeps the reserve of the file's.
+        let slow = AxisLimit { jerk: 5e4, ..x };
+        let msg = refusal(
+            Quantity::Jerk,
+            "mm/s^3",
+            6.0e4,
+            slow.planned_jerk(1e-3),
+            slow.jerk,
+        );
+        assert!(
+            msg.contains(
+                "the 4.2500e4 mm/s^3 a plan may use of its limit of 5.0000e4 mm/s^3 (85.0 %: \
+                 the rest is kept for feed holds and overrides)"
             ),
             "{msg}"
         );
@@ -238,7 +255,7 @@ mod tests {
         );
         assert!(
             msg.contains(
-                "of its limit of 3.0000e3 mm/s^2 (95.0 %: the rest is kept for feed holds and overrides)"
+                "of its limit of 3.0000e3 mm/s^2 (95.7 %: the rest is kept for feed holds and overrides)"
             ),
             "{msg}"
         );

@@ -5,7 +5,7 @@
 use crate::config::PlanConfig;
 use crate::verify::{Quantity, Violation, MAX_CYCLES};
 use nc_geom::kinematics::{MachineKinematics, Tilt};
-use nc_geom::limits::{JERK_RISE, V_FLOOR};
+use nc_geom::limits::{JERK_RESERVE, JERK_RISE, V_FLOOR};
 use nc_geom::program::SrcPos;
 use nc_geom::scurve::Phase;
 use nc_geom::segment::Path;
@@ -100,10 +100,13 @@ pub(super) fn against(quantity: Quantity, limit: f64, machine: f64, unit: &str) 
     if (limit - machine).abs() <= 1e-9 * machine.abs() {
         return format!("its limit of {limit:.4e} {unit}");
     }
+    let kept = 100.0 * (1.0 - JERK_RESERVE);
+    let rise = limit < machine * (1.0 - JERK_RESERVE) * (1.0 - 1e-9);
     let why = match quantity {
-        Quantity::Jerk => {
-            format!("a plan's jerk is at most {JERK_RISE} x the acceleration per period")
-        }
+        Quantity::Jerk if rise => format!(
+            "a plan's jerk is at most {JERK_RISE} x the acceleration per period, and \
+             {kept:.1} % of that: the rest is kept for feed holds and overrides"
+        ),
         _ => format!(
             "{:.1} %: the rest is kept for feed holds and overrides",
             100.0 * limit / machine
