@@ -6,7 +6,7 @@ use crate::chunk::{Chunk, Start};
 use crate::gates::Gates;
 use crate::hold::{AxisHold, HoldConfig};
 use crate::queue::{Inlet, LOOKAHEAD};
-use crate::tracker::Tracker;
+use crate::tracker::{Jerk, Tracker};
 use heapless::Deque;
 use nc_geom::kinematics::{Joints, MachineKinematics, RotaryLimits};
 use nc_geom::program::Aux;
@@ -59,6 +59,8 @@ pub struct Follower<'q> {
     pose: Pose,
     joints: Joints,
     block: u32,
+    /// Where the segment of the last pose starts along the path.
+    seg_start: f64,
     counters: StreamCounters,
     pending: Pending,
 }
@@ -104,6 +106,7 @@ impl<'q> Follower<'q> {
             pose: start.pose,
             joints: start.joints,
             block: 1,
+            seg_start: 0.0,
             counters: StreamCounters::default(),
         }
     }
@@ -228,6 +231,13 @@ impl<'q> Follower<'q> {
             .map_or(0, |(seg, _)| seg.src.line)
     }
 
+    /// Where the segment of the last setpoint starts along the path: setpoints with the
+    /// same value lie on one segment, inside which the plan's jerk is limited (a junction
+    /// that is not G2-continuous is not).
+    pub fn segment_start(&self) -> f64 {
+        self.seg_start
+    }
+
     /// How far into the program the tool is, 0..=1 ([`Chunk::progress`] of the chunk at
     /// hand).
     pub fn progress(&self) -> f64 {
@@ -335,20 +345,26 @@ impl<'q> Follower<'q> {
             .max(1e-9)
             .max(self.motion.v);
         let rmax = self.hold.acc / vb;
-        let mut jmax = self.hold.jerk / vb;
+        let mut jerk = Jerk {
+            path: self.hold.jerk / vb,
+            cap: 1.0,
+        };
         let avail_end = self.local.back().map_or(self.motion.s, |c| c.s1);
         let room = avail_end - self.motion.s;
-        let stop = |t: &Tracker, jmax: f64| t.stop_distance(vb, rmax, jmax, ts, &self.axis_hold);
+        let axes = &self.axis_hold;
+        let stop = |t: &Tracker, jerk: Jerk| t.stop_distance(vb, rmax, jerk, ts, axes);
         // Held at rest for data, closer to its end than the least stop distance: creep on
         // with a gentler jerk whose stop fits in half the room. The planner may be unable to
         // push more (the queue's depth is in the chunks held here) until the first is left.
         if !self.complete && self.tracker.at_rest() && room > 0.0 {
-            let d0 = stop(&self.tracker, jmax);
+            let d0 = stop(&self.tracker, jerk);
             if d0 >= room {
-                jmax *= 0.5 * room / d0;
+                let gentler = 0.5 * room / d0;
+                jerk.path *= gentler;
+                jerk.cap *= gentler;
             }
         }
-        let underrun = !self.complete && room <= stop(&self.tracker, jmax);
+        let underrun = !self.complete && room <= stop(&self.tracker, jerk);
         let target = self.target(underrun);
         // At rest (the plan at rest, or already held), the override drops to 0 at once:
         // nothing moves. Otherwise a program whose first chunk is shorter than the distance
@@ -356,12 +372,9 @@ impl<'q> Follower<'q> {
         if target == 0.0 && self.motion.v == 0.0 {
             self.tracker.rest();
         }
-        let rate = self
-            .tracker
-            .rate_bound(target, rmax, jmax, ts, &self.axis_hold);
-        let k_old = self.tracker.k;
-        self.tracker.track(target, rate, jmax, ts);
-        self.tau + 0.5 * (k_old + self.tracker.k) * ts
+        let axes = &self.axis_hold;
+        let rate = self.tracker.rate_bound(target, rmax, jerk, ts, axes);
+        self.tau + self.tracker.track(target, rate, jerk, ts, axes)
     }
 
     /// The override's target: 0 for a stop, for an underrun (the path that has arrived ends
@@ -520,6 +533,7 @@ impl<'q> Follower<'q> {
         let s = self.motion.s;
         if let Some((seg, s0)) = self.local.front().and_then(|c| c.segment_at(s)) {
             self.block = seg.block;
+            self.seg_start = s0;
             self.pose = seg.pose(s - s0);
         }
         self.joints = self.pose.joints(&self.kin, &self.joints, &self.lim);

@@ -37,6 +37,20 @@
 //! the axes (times [`HOLD_SHARE`], for the discretisation), evaluated at the highest k the
 //! period can reach: the bound grows as k falls, so a stop can always begin (f < 1) and then
 //! slows down faster and faster; a resume eases into the plan as k nears 1.
+//!
+//! **And every axis's jerk.** The axis's jerk is `k^3 q''' + 3 k k' q'' + k'' q'`. The
+//! plan's check measured `|q'''| <= p` (its jerk margin; a plan keeps
+//! `nc_geom::limits::JERK_RESERVE` of the limit J), so a hold may spend
+//! `B(k) = s J - p k^3` (s is [`HOLD_JERK_SHARE`]): half on the rate,
+//! `|k'| <= B / (6 k a)` (a = f A, the plan's acceleration), half on the rate's change,
+//! `|k''| <= B / (2 w)`. Both bounds grow as k falls: a stop may change its rate faster as
+//! it slows down. A resume, whose bounds tighten as k rises, takes its rate's bound where
+//! k will be once the rate is braked at the bound for k = 1, and brakes toward its target
+//! at what the target allows, so that the bound never falls under the rate. The plan time
+//! a period covers is the integral of k, quadratic within it; a target is taken at once
+//! only at a rate that one step of k'' ends. And `nc_plan::verify` measures the plan's
+//! jerk between its own phases where it changes fast: a hold shifts the phase at which
+//! the drives' setpoints meet the plan.
 #![forbid(unsafe_code)]
 
 mod chunk;
@@ -45,9 +59,11 @@ mod gates;
 mod hold;
 pub mod jog;
 mod queue;
+mod stop;
 mod tracker;
 
 pub use chunk::{phase_vmax, Chunk, Start, MAX_CHUNK_SEGMENTS, REST_V};
 pub use follower::{Follower, StreamCounters};
-pub use hold::{stop_length, HoldConfig, HOLD_SHARE};
+pub use hold::{HoldConfig, HOLD_JERK_SHARE, HOLD_SHARE};
 pub use queue::{Feeder, Inlet, Queues, LOOKAHEAD, MAX_DEPTH, MIN_DEPTH, QUEUE_N};
+pub use stop::stop_length;

@@ -32,24 +32,29 @@ impl Tracker {
     /// most `v` (a bound, not the exact figure), at period `ts`.
     ///
     /// The check runs before this period's step, which may still raise the override (by at
-    /// most `r Ts + jmax Ts^2`, its rate by `jmax Ts`); the stop is bounded from there, so
-    /// that a hold that begins next period still fits. At rest the distance is next to
-    /// nothing, so a hold creeps on toward the end of the data it has rather than wait for
-    /// data that cannot come (the queue full of what it holds).
+    /// most `r Ts + j Ts^2`, its rate by `j Ts`); the stop is bounded from there, so that a
+    /// hold that begins next period still fits. At rest the distance is next to nothing, so
+    /// a hold creeps on toward the end of the data it has rather than wait for data that
+    /// cannot come (the queue full of what it holds).
     pub(crate) fn stop_distance(
         &self,
         v: f64,
         rmax: f64,
-        jmax: f64,
+        jerk: Jerk,
         ts: f64,
         axes: &AxisHold,
     ) -> f64 {
-        let rise = self.r.max(0.0) + jmax * ts;
-        let k_next = (self.k + self.r.max(0.0) * ts + jmax * ts * ts).min(1.0);
-        let kpk = (k_next + rise * rise / (2.0 * jmax)).min(1.0);
-        // The rate's ramps: up to rmax and back, or a triangle if it never gets there.
-        let ramps = (2.0 * rmax / jmax).min(2.0 * (kpk / jmax).sqrt());
-        let t = rise / jmax + axes.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
+        let step = jerk.at(axes, self.k);
+        // Braking a rising rate, k rises: the least the axes allow, at k = 1.
+        let low = jerk.at(axes, 1.0);
+        let rise = self.r.max(0.0) + step * ts;
+        let k_next = (self.k + self.r.max(0.0) * ts + step * ts * ts).min(1.0);
+        let kpk = (k_next + rise * rise / (2.0 * low)).min(1.0);
+        // The rate's ramps: down to -rmax at what the axes allow at kpk, and back to 0 at
+        // what they allow at 0, or a triangle if it never gets there.
+        let ramp = |j: f64| (rmax / j).min((kpk / j).sqrt());
+        let ramps = ramp(jerk.at(axes, kpk)) + ramp(jerk.at(axes, 0.0));
+        let t = rise / low + axes.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
         v * kpk * t
     }
 
@@ -60,41 +65,113 @@ impl Tracker {
     /// most one jerk step up, the path's bound and the axes' bound at the present k. (A
     /// bound of a whole jerk step, jmax Ts^2, would be most of the range where the plan is
     /// slow and jmax large: the rate would stay at the bound for k = 1 through the whole
-    /// stop, far slower than the stop distance assumes.)
+    /// stop, far slower than the stop distance assumes.) While k rises, the bound is taken
+    /// where k would be once the rate is braked to 0 at what the axes allow at k = 1: the
+    /// rate can always come down to a bound that tightens as k rises without a step in k''.
     pub(crate) fn rate_bound(
         &self,
         target: f64,
         rmax: f64,
-        jmax: f64,
+        jerk: Jerk,
+        ts: f64,
+        axes: &AxisHold,
+    ) -> Rates {
+        let low = jerk.at(axes, 1.0);
+        // The bound at where k would be once a rate `r` is braked to 0.
+        let braked = |r: f64| {
+            let k_hi = (self.k + ts * r).min(1.0);
+            axes.rate((k_hi + r * r / (2.0 * low)).min(1.0))
+        };
+        let down = rmax.min(braked(self.r.max(0.0)));
+        if target <= self.k {
+            return Rates { down, up: down };
+        }
+        // Rising: the highest rate r that the bound at its own braking point allows. That
+        // bound falls as r rises, so the set is an interval from 0, found by bisection
+        // (bounded: 24 steps, to 6e-8 of the top). Next period, braked at `low`, the point
+        // stays where it is, and so does the bound: it never falls under the rate.
+        let top = rmax.min(axes.rate(self.k));
+        if !top.is_finite() || top <= braked(top) {
+            return Rates { down, up: top };
+        }
+        let (mut lo, mut hi) = (0.0, top);
+        for _ in 0..24 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= braked(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Rates { down, up: lo }
+    }
+
+    /// Move the override one period `ts` toward `target` with its rate within `rates` and
+    /// its change within what the path and the axes allow at the period's highest k
+    /// ([`Jerk::at`]), braking toward the target at what they allow at the target or here,
+    /// whichever is less (the axes allow more as k falls). Where a bound has fallen below
+    /// the present rate, the rate drops to it at once: the axes' acceleration comes before
+    /// the override's smoothness. Returns the plan time the period covers, the integral of
+    /// k over it (k quadratic within the period).
+    pub(crate) fn track(
+        &mut self,
+        target: f64,
+        rates: Rates,
+        jerk: Jerk,
         ts: f64,
         axes: &AxisHold,
     ) -> f64 {
-        let up = if target > self.k {
-            (self.r + jmax * ts).min(rmax).min(axes.rate(self.k))
-        } else {
-            0.0
-        };
-        let k_hi = (self.k + ts * self.r.max(up).max(0.0)).min(1.0);
-        rmax.min(axes.rate(k_hi))
-    }
-
-    /// Move the override one period `ts` toward `target` with rate <= rmax, rate change <=
-    /// jmax. Where rmax has fallen below the present rate (it tightens as k nears 1), the
-    /// rate drops to it at once: the axes' acceleration comes before the override's
-    /// smoothness.
-    pub(crate) fn track(&mut self, target: f64, rmax: f64, jmax: f64, ts: f64) {
-        let d = target - self.k;
-        let want = d.signum() * rmax.min((2.0 * jmax * d.abs()).sqrt());
-        let dr = (want - self.r).clamp(-jmax * ts, jmax * ts);
-        let r_new = (self.r + dr).clamp(-rmax, rmax);
-        let mut k = self.k + 0.5 * (self.r + r_new) * ts;
+        let (k0, r0) = (self.k, self.r);
+        let d = target - k0;
+        let k_hi = (k0 + ts * r0.max(0.0) + jerk.path * ts * ts).min(1.0);
+        let step = jerk.at(axes, k_hi);
+        let brake_j = step.min(jerk.at(axes, target));
+        // The rate from which braking at brake_j, a step a period, still stops at the
+        // target: r^2 / 2j + r Ts within what is left after this period at the present rate.
+        let left = (d.abs() - 0.5 * (r0 * d.signum()).max(0.0) * ts).max(0.0);
+        let brake = brake_j * ((ts * ts + 2.0 * left / brake_j).sqrt() - ts);
+        let toward = if d > 0.0 { rates.up } else { rates.down };
+        let want = d.signum() * toward.min(brake.max(0.0));
+        let dr = (want - r0).clamp(-step * ts, step * ts);
+        let r_new = (r0 + dr).clamp(-rates.down, rates.up);
+        let mut k = k0 + 0.5 * (r0 + r_new) * ts;
         let mut r = r_new;
-        if (target - k) * d <= 0.0 || d.abs() < 1e-12 {
-            // Reached (or passed) the target this period.
+        let mut covered = k0 * ts + r0 * ts * ts / 2.0 + (r_new - r0) * ts * ts / 6.0;
+        // Reached (or passed) the target this period at a rate a step of brake_j ends. A
+        // target that moved closer than the rate can brake for (a lower override while k
+        // rises) is passed and come back to, not met with a step in the rate. (Never past
+        // 0 or 1: the plan is not run backwards nor above its speed.)
+        let slow = r_new.abs() <= brake_j * ts || !(0.0..=1.0).contains(&k);
+        if ((target - k) * d <= 0.0 || d.abs() < 1e-12) && slow {
             k = target;
             r = 0.0;
+            covered = 0.5 * (k0 + target) * ts;
         }
         self.k = k.clamp(0.0, 1.0);
         self.r = r;
+        covered.max(0.0)
+    }
+}
+
+/// The bounds of the override's rate for a period: of a falling k (`down`, as a magnitude)
+/// and of a rising one (`up`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Rates {
+    pub(crate) down: f64,
+    pub(crate) up: f64,
+}
+
+/// The change of the override's rate a period may make: the path's `path` (its jerk over
+/// the hold's speed scale), and what the axes allow at k ([`AxisHold::jerk`]) times `cap`
+/// (below 1 where a hold creeps on with a gentler jerk).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Jerk {
+    pub(crate) path: f64,
+    pub(crate) cap: f64,
+}
+
+impl Jerk {
+    pub(crate) fn at(&self, axes: &AxisHold, k: f64) -> f64 {
+        self.path.min(self.cap * axes.jerk(k))
     }
 }
