@@ -134,6 +134,10 @@ fn text_of(r: &Replay, setup: &MachineSetup, script_file: &Path) -> String {
         "axis acceleration  {}  (of limit, from the setpoints)\n",
         fractions(&r.acceleration_fraction)
     );
+    s += &format!(
+        "axis jerk          {}  (of limit, from the setpoints, inside segments)\n",
+        fractions(&r.jerk_fraction)
+    );
     if r.outside_travel.is_empty() {
         s += "axis travel        within limits\n";
     } else {
@@ -143,7 +147,7 @@ fn text_of(r: &Replay, setup: &MachineSetup, script_file: &Path) -> String {
         );
     }
     if r.over.is_empty() {
-        s += "limits             axis velocity and acceleration within limits, holds and overrides included\n";
+        s += "limits             axis velocity, acceleration and jerk within limits, holds and overrides included\n";
     } else {
         let each: Vec<String> = r
             .over

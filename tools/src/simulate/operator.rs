@@ -48,9 +48,11 @@ pub struct Replay {
     pub ending: &'static str,
     /// The source line where it ended.
     pub line: u32,
-    /// Largest fraction of each axis's velocity and acceleration limit, and the travel.
+    /// Largest fraction of each axis's velocity and acceleration limit, of its jerk limit
+    /// inside a segment, and the travel.
     pub velocity_fraction: [f64; 5],
     pub acceleration_fraction: [f64; 5],
+    pub jerk_fraction: [f64; 5],
     pub over: Vec<Over>,
     pub outside_travel: Vec<&'static str>,
     /// Why the program was refused, if it was.
@@ -147,7 +149,7 @@ pub fn replay<E: ProgramSource>(
         }
         let sp = f.step();
         take(&sp);
-        check.push(&sp, f.line());
+        check.push(&sp, f.line(), f.segment_start());
         periods += 1;
         if sp.done {
             ending = "end";
@@ -178,24 +180,29 @@ pub fn replay<E: ProgramSource>(
         line: f.line(),
         velocity_fraction: [0.0; 5],
         acceleration_fraction: [0.0; 5],
+        jerk_fraction: [0.0; 5],
         over: Vec::new(),
         outside_travel: Vec::new(),
         refusal,
     }))
 }
 
-/// The worst (fraction, t, line) of each axis's velocity and acceleration over its limit.
-type Worst = [[Option<(f64, f64, u32)>; 2]; 5];
+/// The worst (fraction, t, line) of each axis's velocity, acceleration and jerk over its
+/// limit.
+type Worst = [[Option<(f64, f64, u32)>; 3]; 5];
 
 /// The setpoints' finite differences against the axes' limits, as they come.
 struct Check {
     names: [&'static str; 5],
     limits: [config::AxisLimits; 5],
     ts: f64,
-    /// The last two positions (mm, degrees).
-    q: [Option<[f64; 5]>; 2],
+    /// The last three positions (mm, degrees), oldest first, and where the segment of each
+    /// starts ([`Follower::segment_start`]).
+    q: [Option<[f64; 5]>; 3],
+    seg: [f64; 3],
     vfrac: [f64; 5],
     afrac: [f64; 5],
+    jfrac: [f64; 5],
     worst: Worst,
     outside: [bool; 5],
     still: u32,
@@ -207,16 +214,18 @@ impl Check {
             names: setup.axis_names,
             limits: setup.limits.clone(),
             ts: setup.period,
-            q: [None; 2],
+            q: [None; 3],
+            seg: [f64::NAN; 3],
             vfrac: [0.0; 5],
             afrac: [0.0; 5],
-            worst: [[None; 2]; 5],
+            jfrac: [0.0; 5],
+            worst: [[None; 3]; 5],
             outside: [false; 5],
             still: 0,
         }
     }
 
-    fn push(&mut self, sp: &Setpoint, line: u32) {
+    fn push(&mut self, sp: &Setpoint, line: u32, seg: f64) {
         let q: [f64; 5] = core::array::from_fn(|j| {
             if j >= 3 {
                 sp.joints[j].to_degrees()
@@ -225,6 +234,9 @@ impl Check {
             }
         });
         let t = sp.cycle as f64 * self.ts;
+        // The jerk inside one segment (over a junction that is not G2-continuous the plan's
+        // own jerk is not limited).
+        let one_segment = self.seg.iter().all(|&s| s == seg);
         for j in 0..5 {
             let l = &self.limits[j];
             self.outside[j] |= q[j] < l.min - 1e-9 || q[j] > l.max + 1e-9;
@@ -234,24 +246,31 @@ impl Check {
                     worst[j][k] = Some((frac, t, line));
                 }
             };
-            if let Some(p) = self.q[1] {
-                let v = (q[j] - p[j]).abs() / self.ts / l.velocity;
+            let ts = self.ts;
+            if let Some(p) = self.q[2] {
+                let v = (q[j] - p[j]).abs() / ts / l.velocity;
                 self.vfrac[j] = self.vfrac[j].max(v);
                 note(0, v, &mut self.worst);
-                if let Some(pp) = self.q[0] {
-                    let a =
-                        (q[j] - 2.0 * p[j] + pp[j]).abs() / (self.ts * self.ts) / l.acceleration;
+                if let Some(pp) = self.q[1] {
+                    let a = (q[j] - 2.0 * p[j] + pp[j]).abs() / (ts * ts) / l.acceleration;
                     self.afrac[j] = self.afrac[j].max(a);
                     note(1, a, &mut self.worst);
+                    if let (Some(ppp), true) = (self.q[0], one_segment) {
+                        let jk = (q[j] - 3.0 * p[j] + 3.0 * pp[j] - ppp[j]).abs() / ts.powi(3);
+                        let jk = jk / l.jerk;
+                        self.jfrac[j] = self.jfrac[j].max(jk);
+                        note(2, jk, &mut self.worst);
+                    }
                 }
             }
         }
-        self.still = if self.q[1] == Some(q) {
+        self.still = if self.q[2] == Some(q) {
             self.still + 1
         } else {
             0
         };
-        self.q = [self.q[1], Some(q)];
+        self.q = [self.q[1], self.q[2], Some(q)];
+        self.seg = [self.seg[1], self.seg[2], seg];
     }
 
     /// Three periods without a move: at rest.
@@ -262,8 +281,9 @@ impl Check {
     fn finish(self, mut r: Replay) -> Replay {
         r.velocity_fraction = self.vfrac;
         r.acceleration_fraction = self.afrac;
+        r.jerk_fraction = self.jfrac;
         for (j, w) in self.worst.iter().enumerate() {
-            for (k, quantity) in ["velocity", "acceleration"].into_iter().enumerate() {
+            for (k, quantity) in ["velocity", "acceleration", "jerk"].into_iter().enumerate() {
                 if let Some((fraction, t_s, line)) = w[k] {
                     r.over.push(Over {
                         axis: self.names[j],
