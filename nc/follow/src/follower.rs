@@ -364,7 +364,8 @@ impl<'q> Follower<'q> {
                 jerk.cap *= gentler;
             }
         }
-        let underrun = !self.complete && room <= stop(&self.tracker, jerk);
+        // (A stop distance that is not a number holds too.)
+        let underrun = !self.complete && !(room > stop(&self.tracker, jerk));
         let target = self.target(underrun);
         // At rest (the plan at rest, or already held), the override drops to 0 at once:
         // nothing moves. Otherwise a program whose first chunk is shorter than the distance
@@ -373,7 +374,7 @@ impl<'q> Follower<'q> {
             self.tracker.rest();
         }
         let axes = &self.axis_hold;
-        let rate = self.tracker.rate_bound(target, rmax, jerk, ts, axes);
+        let rate = self.tracker.rate_bound(rmax, jerk, ts, axes);
         self.tau + self.tracker.track(target, rate, jerk, ts, axes)
     }
 

@@ -83,7 +83,7 @@ impl AxisHold {
         let p: [f64; 5] = core::array::from_fn(|j| {
             let p = margins.jerk[j] * hold.axes[j].planned_jerk(hold.period);
             if p.is_finite() {
-                p.clamp(0.0, 0.9 * l[j])
+                p.max(0.0).min(0.9 * l[j])
             } else {
                 0.9 * l[j]
             }
@@ -149,8 +149,11 @@ impl AxisHold {
     /// at k = 1 no sum would bound well), plus the sum over [`STOP_STEPS`] steps of k of
     /// dk / (the jerk's bound at the step's top), that bound falling as k rises.
     pub(crate) fn time_to_zero(&self, kk: f64, r: f64) -> f64 {
-        if kk <= 0.0 || r <= 0.0 {
+        if kk <= 0.0 {
             return 0.0;
+        }
+        if !(r > 0.0) {
+            return f64::INFINITY;
         }
         let dk = kk / STOP_STEPS as f64;
         let jerk: f64 = (1..=STOP_STEPS)

@@ -26,7 +26,8 @@
 //! and its rate of change to `hold_jerk / v`, with `v` the highest planned speed from the
 //! chunk at hand to the program's end ([`Chunk::vmax_ahead`]), so holding adds at most
 //! `hold_acc` of path acceleration and `hold_jerk` of path jerk to the plan's own. `v` never
-//! rises while the tool moves on, so neither limit ever tightens under a hold in progress.
+//! rises while the tool moves on, so neither path limit ever tightens under a hold in
+//! progress (the axes' bounds below tighten as k rises, and are met by braking ahead).
 //!
 //! **Every axis's acceleration holds during a hold.** With the plan's joint trajectory
 //! q(tau) and tau advancing at the rate k, an axis moves at `k q'` and accelerates at

@@ -5,6 +5,9 @@
 
 use crate::hold::AxisHold;
 
+#[cfg(test)]
+mod tests;
+
 /// The override and its rate.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Tracker {
@@ -50,46 +53,32 @@ impl Tracker {
         let rise = self.r.max(0.0) + step * ts;
         let k_next = (self.k + self.r.max(0.0) * ts + step * ts * ts).min(1.0);
         let kpk = (k_next + rise * rise / (2.0 * low)).min(1.0);
-        // The rate's ramps: down to -rmax at what the axes allow at kpk, and back to 0 at
-        // what they allow at 0, or a triangle if it never gets there.
-        let ramp = |j: f64| (rmax / j).min((kpk / j).sqrt());
-        let ramps = ramp(jerk.at(axes, kpk)) + ramp(jerk.at(axes, 0.0));
+        // The rate's ramps down to -rmax and back to 0, or a triangle if it never gets
+        // there, at what the axes allow at kpk (the least over the stop).
+        let j = jerk.at(axes, kpk);
+        let ramps = 2.0 * (rmax / j).min((kpk / j).sqrt());
         let t = rise / low + axes.time_to_zero(kpk, rmax) + ramps + 3.0 * ts;
         v * kpk * t
     }
 
-    /// The rate bound for the coming period toward `target`: the path's `rmax` and the
-    /// axes' bound at the highest override this period can reach (the bound falls as k
-    /// rises), so that it holds over the whole period. Within the period the rate moves
-    /// linearly from r to the new rate, which is at most r toward a lower target, else at
-    /// most one jerk step up, the path's bound and the axes' bound at the present k. (A
-    /// bound of a whole jerk step, jmax Ts^2, would be most of the range where the plan is
-    /// slow and jmax large: the rate would stay at the bound for k = 1 through the whole
-    /// stop, far slower than the stop distance assumes.) While k rises, the bound is taken
-    /// where k would be once the rate is braked to 0 at what the axes allow at k = 1: the
-    /// rate can always come down to a bound that tightens as k rises without a step in k''.
-    pub(crate) fn rate_bound(
-        &self,
-        target: f64,
-        rmax: f64,
-        jerk: Jerk,
-        ts: f64,
-        axes: &AxisHold,
-    ) -> Rates {
+    /// The bounds of the rate for the coming period, from the path's `rmax` and the
+    /// axes' ([`AxisHold::rate`], which falls as k rises): for a falling k, the axes' bound
+    /// at the period's highest k; for a rising one, the bound where k would come to rest
+    /// if the rate were braked at what the axes allow at k = 1.
+    pub(crate) fn rate_bound(&self, rmax: f64, jerk: Jerk, ts: f64, axes: &AxisHold) -> Rates {
+        // A falling k: the axes' bound at the highest k of the period (it grows as k falls).
+        let down = rmax.min(axes.rate((self.k + ts * self.r.max(0.0)).min(1.0)));
+        // A rising k: the highest rate `rc` below the bound where k would come to rest if
+        // the rate were braked from `rc` at what the axes allow at k = 1 (`low`), after this
+        // period: `k + (r + rc) Ts / 2 + rc^2 / 2 low`. Braking at `low` keeps that point
+        // where it is, so the bound there never falls under the rate, and one step of
+        // braking always meets it. The bound falls as `rc` rises: the set is an interval
+        // from 0, found by bisection (bounded: 24 steps, to 6e-8 of the top).
         let low = jerk.at(axes, 1.0);
-        // The bound at where k would be once a rate `r` is braked to 0.
-        let braked = |r: f64| {
-            let k_hi = (self.k + ts * r).min(1.0);
-            axes.rate((k_hi + r * r / (2.0 * low)).min(1.0))
+        let braked = |rc: f64| {
+            let point = self.k + 0.5 * (self.r + rc) * ts + rc * rc / (2.0 * low);
+            axes.rate(point.clamp(0.0, 1.0))
         };
-        let down = rmax.min(braked(self.r.max(0.0)));
-        if target <= self.k {
-            return Rates { down, up: down };
-        }
-        // Rising: the highest rate r that the bound at its own braking point allows. That
-        // bound falls as r rises, so the set is an interval from 0, found by bisection
-        // (bounded: 24 steps, to 6e-8 of the top). Next period, braked at `low`, the point
-        // stays where it is, and so does the bound: it never falls under the rate.
         let top = rmax.min(axes.rate(self.k));
         if !top.is_finite() || top <= braked(top) {
             return Rates { down, up: top };
@@ -132,22 +121,28 @@ impl Tracker {
         let brake = brake_j * ((ts * ts + 2.0 * left / brake_j).sqrt() - ts);
         let toward = if d > 0.0 { rates.up } else { rates.down };
         let want = d.signum() * toward.min(brake.max(0.0));
-        let dr = (want - r0).clamp(-step * ts, step * ts);
-        let r_new = (r0 + dr).clamp(-rates.down, rates.up);
+        // (max and min, not clamp: no panic whatever the limits.)
+        let dr = (want - r0).max(-step * ts).min(step * ts);
+        let r_new = (r0 + dr).max(-rates.down).min(rates.up);
         let mut k = k0 + 0.5 * (r0 + r_new) * ts;
         let mut r = r_new;
         let mut covered = k0 * ts + r0 * ts * ts / 2.0 + (r_new - r0) * ts * ts / 6.0;
         // Reached (or passed) the target this period at a rate a step of brake_j ends. A
         // target that moved closer than the rate can brake for (a lower override while k
-        // rises) is passed and come back to, not met with a step in the rate. (Never past
-        // 0 or 1: the plan is not run backwards nor above its speed.)
-        let slow = r_new.abs() <= brake_j * ts || !(0.0..=1.0).contains(&k);
+        // rises) is passed and come back to, not met with a step in the rate.
+        let slow = r_new.abs() <= brake_j * ts;
         if ((target - k) * d <= 0.0 || d.abs() < 1e-12) && slow {
             k = target;
             r = 0.0;
             covered = 0.5 * (k0 + target) * ts;
         }
-        self.k = k.clamp(0.0, 1.0);
+        // Never past 0 or 1: the plan is not run backwards nor above its speed.
+        if !(0.0..=1.0).contains(&k) {
+            k = k.max(0.0).min(1.0);
+            r = 0.0;
+            covered = 0.5 * (k0 + k) * ts;
+        }
+        self.k = k;
         self.r = r;
         covered.max(0.0)
     }

@@ -942,18 +942,15 @@ fn run_half(half: u64, cases: u32) {
     );
 }
 
-/// The faults the run through the follower found (see `hold.rs`), kept as they were
-/// generated: each text gives its event by its own hash. The first three came from the CI
-/// seeds; `hold-c-accelerates-while-data-waits` from the long run (seed 7 000 012: a kink
-/// where C turns fastest, narrower than the planner's stations); then a slow creeping run
-/// that the check once ended with a stop the drives never got; the last from the long run
-/// (seed 7 000 006: a G06.5 block whose tool leaves the vertical with C turning fast, where
-/// the path turned C to where the tilt reached 1e-7, not to where it starts, and jumped
-/// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration).
 /// The per-axis jerk through a hold, checked since the override's rate and its change are
-/// bounded per axis: an operator's session that lowers the override to 8 % and raises it
-/// back to 100 % within a second on an A/C move (C at 1.075x its jerk when the override
-/// snapped to its target from a rate of two steps).
+/// bounded per axis; each text gives its event by its own hash. An operator's session that
+/// lowers the override to 8 % and raises it back within a second on an A/C move (C at
+/// 1.075x its jerk: the override snapped to its target from a rate of two steps); a
+/// session whose target flips above k while k falls (C at 1.30x: the rising rate's bound
+/// clamped the falling rate); an override of 99.8 % on a compensated arc program (Y at
+/// 1.015x: the plan's own jerk at a phase its check had not sampled, a stencil ending
+/// just before a corner); a slow planner on a G06.2 with extreme weights (Y at 1.07x: a
+/// curvature peak just after a corner, which the check had not measured between phases).
 #[test]
 fn the_jerk_faults_found_stay_fixed() {
     let cases = [
@@ -962,6 +959,7 @@ fn the_jerk_faults_found_stay_fixed() {
             "../../../tests/data/adversarial/override-changes-then-a-stop-on-an-ac-move.nc"
         ),
         include_str!("../../../tests/data/adversarial/override-998-on-a-compensated-arc.nc"),
+        include_str!("../../../tests/data/adversarial/underrun-in-a-weighted-g062.nc"),
     ];
     for src in cases {
         let ev = hold::event(src);
@@ -973,6 +971,14 @@ fn the_jerk_faults_found_stay_fixed() {
     }
 }
 
+/// The faults the run through the follower found (see `hold.rs`), kept as they were
+/// generated: each text gives its event by its own hash. The first three came from the CI
+/// seeds; `hold-c-accelerates-while-data-waits` from the long run (seed 7 000 012: a kink
+/// where C turns fastest, narrower than the planner's stations); then a slow creeping run
+/// that the check once ended with a stop the drives never got; the last from the long run
+/// (seed 7 000 006: a G06.5 block whose tool leaves the vertical with C turning fast, where
+/// the path turned C to where the tilt reached 1e-7, not to where it starts, and jumped
+/// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration).
 #[test]
 fn the_hold_faults_found_stay_fixed() {
     let cases: [(&str, hold::Event); 7] = [

@@ -4,13 +4,14 @@
 //! joints' motion changes within a period (a sharp feature inside a segment, a curvature
 //! peak passed slowly) the jerk at another phase can be well over what the plan's phase
 //! shows: the third difference weighs the motion of three periods by a kernel that peaks
-//! between setpoints. Where an axis's jerk changes by more than [`JERK_STEP`] of its limit
-//! from one stencil to the next, or peaks between them, the stencil is also measured at
-//! [`SUBPHASES`] - 1 phases between each two of the last three ([`measure`]), and a stencil
-//! over a corner up to the corner; elsewhere the jerk varies little within a period, and
-//! the phase changes it little. Found by the generated-input suite through holds: a
-//! curvature peak inside a NURBS segment passed at 0.2 mm/s showed 0.56 of the limit at
-//! the plan's phases and 1.13x at another.
+//! between setpoints. Where an axis's jerk changes by more than [`JERK_STEP`] of its
+//! planned jerk from one stencil to the next, or peaks between them, the stencil is also
+//! measured at [`SUBPHASES`] - 1 phases between each two of the last three ([`measure`]);
+//! a stencil over a corner up to the corner, and the first after a corner where their jerk
+//! is large; elsewhere the jerk varies little within a period, and the phase changes it
+//! little. Found by the generated-input suite through holds: a curvature peak inside a
+//! NURBS segment passed at 0.2 mm/s showed 0.56 of the limit at the plan's phases and 1.13x
+//! at another; one right after a corner between two G06.2 segments, 1.07x.
 
 use super::corner::joints_at;
 use super::sample::{crosses_corner, Ctx, Sample};
@@ -25,29 +26,32 @@ pub(super) const SUBPHASES: usize = 8;
 
 /// Each axis's largest |jerk| between the plan's phases about the stencil `w` (`older`
 /// the two setpoints before it), where the jerk changes fast or peaks between the last
-/// stencils ([`JERK_STEP`]); `None` where it does not, or where a corner is too close
-/// behind. A stencil over a corner is measured up to the corner: the stencils shifted
-/// back from it that end before the corner.
+/// stencils ([`JERK_STEP`]); `None` where it does not. Where a corner lies among the last
+/// stencils, what lies on one side of it: a stencil over the corner is measured up to it
+/// (the shifted stencils that end before it) where the jerk changed fast before it, and
+/// the first stencils after a corner where their jerk is a good part of the limit (no
+/// stencil before them to compare with: a curvature peak right after the corner).
 pub(super) fn measure(w: &[Sample; 4], older: &[Sample; 2], ctx: &Ctx) -> Option<[f64; 5]> {
     let x = [&older[0], &older[1], &w[0], &w[1], &w[2], &w[3]];
-    if crosses_corner(&[older[0], w[2]], ctx.smooth) {
-        return None;
-    }
-    let whole = !crosses_corner(&[older[0], w[3]], ctx.smooth);
     let ts = ctx.cfg.period;
-    let steps = (0..5).any(|j| {
-        let jerk = |i: usize| {
-            (x[i + 3].q[j] - 3.0 * x[i + 2].q[j] + 3.0 * x[i + 1].q[j] - x[i].q[j]) / ts.powi(3)
-        };
-        let step = JERK_STEP * ctx.cfg.axes[j].planned_jerk(ts);
-        let (j0, j1) = (jerk(0), jerk(1));
-        if whole {
-            let j2 = jerk(2);
-            (j2 - j1).abs() > step || (j2 - 2.0 * j1 + j0).abs() > step
-        } else {
-            (j1 - j0).abs() > step
-        }
-    });
+    let jerk = |i: usize, j: usize| {
+        (x[i + 3].q[j] - 3.0 * x[i + 2].q[j] + 3.0 * x[i + 1].q[j] - x[i].q[j]) / ts.powi(3)
+    };
+    let step = |j: usize| JERK_STEP * ctx.cfg.axes[j].planned_jerk(ts);
+    let behind = crosses_corner(&[older[0], w[2]], ctx.smooth);
+    let over = crosses_corner(&[w[0], w[3]], ctx.smooth);
+    let steps = match (behind, over) {
+        // All three stencils on one stretch: a fast change, or a peak between them.
+        (false, false) => (0..5).any(|j| {
+            let (j0, j1, j2) = (jerk(0, j), jerk(1, j), jerk(2, j));
+            (j2 - j1).abs() > step(j) || (j2 - 2.0 * j1 + j0).abs() > step(j)
+        }),
+        // Over a corner, the two before it on one stretch.
+        (false, true) => (0..5).any(|j| (jerk(1, j) - jerk(0, j)).abs() > step(j)),
+        // Just after a corner.
+        (true, false) => (0..5).any(|j| jerk(2, j).abs() > step(j)),
+        (true, true) => false,
+    };
     if steps {
         between(w, ctx)
     } else {
