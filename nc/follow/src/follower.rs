@@ -13,6 +13,7 @@ use nc_geom::program::Aux;
 use nc_geom::scurve::Motion;
 use nc_geom::segment::Pose;
 use nc_geom::setpoint::Setpoint;
+use std::cmp::Ordering as Cmp;
 use std::sync::atomic::Ordering;
 
 /// Counters of a streamed run.
@@ -365,7 +366,8 @@ impl<'q> Follower<'q> {
             }
         }
         // (A stop distance that is not a number holds too.)
-        let underrun = !self.complete && !(room > stop(&self.tracker, jerk));
+        let fits = room.partial_cmp(&stop(&self.tracker, jerk)) == Some(Cmp::Greater);
+        let underrun = !self.complete && !fits;
         let target = self.target(underrun);
         // At rest (the plan at rest, or already held), the override drops to 0 at once:
         // nothing moves. Otherwise a program whose first chunk is shorter than the distance

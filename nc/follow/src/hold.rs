@@ -152,7 +152,7 @@ impl AxisHold {
         if kk <= 0.0 {
             return 0.0;
         }
-        if !(r > 0.0) {
+        if r.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return f64::INFINITY;
         }
         let dk = kk / STOP_STEPS as f64;

@@ -138,7 +138,7 @@ impl Tracker {
         }
         // Never past 0 or 1: the plan is not run backwards nor above its speed.
         if !(0.0..=1.0).contains(&k) {
-            k = k.max(0.0).min(1.0);
+            k = if k > 1.0 { 1.0 } else { 0.0 };
             r = 0.0;
             covered = 0.5 * (k0 + k) * ts;
         }
