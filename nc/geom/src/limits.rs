@@ -34,8 +34,8 @@ impl AxisLimit {
     /// none, as LinuxCNC has none) left the ramps planned at 90 % of an acceleration the
     /// check allowed half of, and a plain raster was refused on its first ramp (the
     /// xyzac-trt-mill with every jerk 1e9: `the X axis acceleration would reach 2.6949e3
-    /// mm/s^2 ... 1.797x its limit of 1.5000e3`). At this jerk the reserve leaves 95 %:
-    /// a ramp reaches the acceleration in ten periods or more. Of that, a plan uses all but
+    /// mm/s^2 ... 1.797x its limit of 1.5000e3`). At this jerk the reserve leaves about
+    /// 96 %: a ramp reaches the acceleration in ten periods or more. Of that, a plan uses all but
     /// [`JERK_RESERVE`].
     pub fn planned_jerk(&self, period: f64) -> f64 {
         self.jerk.min(JERK_RISE * self.acceleration / period) * (1.0 - JERK_RESERVE)
@@ -65,7 +65,7 @@ pub struct Margins {
 /// plan at exactly its limit could not begin to slow down; and after a hold the setpoints
 /// fall at other phases of the plan than the ones measured here, which sees the velocity
 /// and the acceleration averaged over the period. Between phases the velocity differs by at
-/// most `J Ts^2 / 8` and the acceleration by `J Ts / 2` (J the axis's jerk limit, kept inside
+/// most `J Ts^2 / 8` and the acceleration by `J Ts / 2` (J the axis's planned jerk, kept inside
 /// blocks; corners are measured at their worst phase, `nc_plan::verify`): [`reserve`] adds that.
 pub const HOLD_RESERVE: f64 = 1e-3;
 

@@ -327,7 +327,15 @@ impl<'a> Summarizer<'a> {
             axis_velocity_fraction: axis_map(&names, self.vfrac.map(|w| w.frac)),
             axis_acceleration_fraction: axis_map(&names, self.afrac.map(|w| w.frac)),
             limits_exceeded: exceeded(&names, &self.vfrac, &self.afrac),
-            axis_jerk_fraction: axis_map(&names, plan.margins.jerk),
+            // The check measures the jerk against the planned jerk; the summary's fraction
+            // is of the axis's limit, like the others.
+            axis_jerk_fraction: axis_map(
+                &names,
+                core::array::from_fn(|j| {
+                    let ax = &self.setup.plan.axes[j];
+                    plan.margins.jerk[j] * ax.planned_jerk(self.setup.plan.period) / ax.jerk
+                }),
+            ),
             axis_travel_ok: self.travel_ok,
             tool_axis_deviation_max_deg: self.tool_dev,
             end_position_error_mm: end_err,
