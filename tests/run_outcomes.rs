@@ -227,11 +227,11 @@ fn dense_pass(moves: usize, feed: f64, dwell_every: usize) -> String {
 /// within the travel, its top (Y260) is not, which only the planner sees.
 #[test]
 fn an_error_met_ahead_of_the_tool_stops_it_along_the_path_with_exit_2() {
-    // 570 mm of moves at F1500, with a dwell every 58 mm: each dwell is a stop, where a
+    // 570 mm of moves at F600, with a dwell every 58 mm: each dwell is a stop, where a
     // window ends, so the planner reads no further ahead than the queue it fills, and meets
-    // the arc while the tool is on its way (at F3000 the queue's chunks, cut for the longer
-    // stop that keeps each axis's jerk, reached the arc before the tool moved).
-    let mut src = dense_pass(11_400, 1500.0, 1_160);
+    // the arc while the tool is on its way (at F3000 and F1500 the queue's chunks, cut for
+    // the longer stop that keeps each axis's jerk, reached the arc before the tool moved).
+    let mut src = dense_pass(11_400, 600.0, 1_160);
     let arc_line = src.lines().count() + 2;
     src.push_str("G01 X0 Y230\nG02 X60 Y230 I30 J0\nM30\n");
     let (rep, targets) = run_program(&src, "arc-past-the-travel.nc");
