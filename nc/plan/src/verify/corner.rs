@@ -7,18 +7,13 @@
 //! measures the stencil centred on the kink: the setpoints the interpolator would give one
 //! period before the junction, on it, and one period after.
 
-use super::sample::{Ctx, Sample};
+use super::sample::{corner_among, segment_at, Ctx, Sample};
 use nc_geom::kinematics::Joints;
 
 /// Joints at path position s, near `prev`.
 pub(super) fn joints_at(ctx: &Ctx, s: f64, prev: &Joints) -> Option<Joints> {
-    let k = ctx
-        .profile
-        .seg_start
-        .partition_point(|&x| x <= s)
-        .saturating_sub(1)
-        .min(ctx.path.segments.len().checked_sub(1)?);
-    let seg = &ctx.path.segments[k];
+    let k = segment_at(ctx, s);
+    let seg = ctx.path.segments.get(k)?;
     Some(
         seg.pose(s - ctx.profile.seg_start[k])
             .joints(ctx.kin, prev, &ctx.cfg.rotary),
@@ -73,11 +68,8 @@ pub(super) fn stencil(w: &[Sample; 4], ctx: &Ctx) -> Option<Kink> {
     let on = joints_at(ctx, s_j, &w[1].q)?;
     let after = joints_at(ctx, near.motion_at(hi + ts).s, &w[2].q)?;
     // A side is one-sided only if no other kink lies within its three periods.
-    let kink_between = |s0: f64, s1: f64| {
-        let seg = |s: f64| profile.seg_start.partition_point(|&x| x <= s);
-        let (a, b) = (seg(s0).min(seg(s1)), seg(s0).max(seg(s1)));
-        (a..b).any(|i| i != k && !smooth.get(i).copied().unwrap_or(false))
-    };
+    let kink_between =
+        |s0: f64, s1: f64| corner_among(segment_at(ctx, s0), segment_at(ctx, s1), smooth, Some(k));
     let side = |dir: f64| -> Option<Side> {
         let s3 = near.motion_at(hi + dir * 3.0 * ts).s;
         if kink_between(s_j, s3) {

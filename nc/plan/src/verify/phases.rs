@@ -14,7 +14,7 @@
 //! at another; one right after a corner between two G06.2 segments, 1.07x.
 
 use super::corner::joints_at;
-use super::sample::{crosses_corner, Ctx, Sample};
+use super::sample::{corner_among, crosses_corner, segment_at, Ctx, Sample};
 use nc_geom::kinematics::Joints;
 
 /// Change of an axis's jerk between two consecutive stencils, as a share of its planned
@@ -65,13 +65,16 @@ pub(super) fn measure(w: &[Sample; 4], older: &[Sample; 2], ctx: &Ctx) -> Option
 fn between(w: &[Sample; 4], ctx: &Ctx) -> Option<[f64; 5]> {
     let ts = ctx.cfg.period;
     let near = ctx.profile.near(w[0].t - 3.0 * ts, w[3].t + ts);
-    let seg = |s: f64| ctx.profile.seg_start.partition_point(|&x| x <= s);
     let mut worst = [0.0f64; 5];
     for m in (1..2 * SUBPHASES).filter(|m| m % SUBPHASES != 0) {
         let shift = ts * m as f64 / SUBPHASES as f64;
         let s = [0, 1, 2, 3].map(|i| near.motion_at(w[i].t - shift).s);
-        let (a, b) = (seg(s[0]), seg(s[3]));
-        if (a..b).any(|k| !ctx.smooth.get(k).copied().unwrap_or(false)) {
+        if corner_among(
+            segment_at(ctx, s[0]),
+            segment_at(ctx, s[3]),
+            ctx.smooth,
+            None,
+        ) {
             continue;
         }
         let mut q: [Joints; 4] = [[0.0; 5]; 4];

@@ -52,6 +52,21 @@ pub(super) struct Ctx<'a> {
 
 /// Does the stencil `w` cross a junction that is not G2-continuous?
 pub(super) fn crosses_corner(w: &[Sample], smooth: &[bool]) -> bool {
-    let (a, b) = (w[0].seg, w[w.len() - 1].seg);
-    (a + 1..=b).any(|k| !smooth.get(k).copied().unwrap_or(false))
+    corner_among(w[0].seg, w[w.len() - 1].seg, smooth, None)
+}
+
+/// Is a junction that is not G2-continuous among those between segments `a` and `b`
+/// (the starts of the segments after the first up to the last), other than `except`?
+pub(super) fn corner_among(a: usize, b: usize, smooth: &[bool], except: Option<usize>) -> bool {
+    (a.min(b) + 1..=a.max(b))
+        .filter(|&k| Some(k) != except)
+        .any(|k| !smooth.get(k).copied().unwrap_or(false))
+}
+
+/// The segment path position `s` lies on: a junction counts with the segment it starts,
+/// the path's end (where the drives hold the last pose) with the last segment.
+pub(super) fn segment_at(ctx: &Ctx, s: f64) -> usize {
+    let n = ctx.path.segments.len().saturating_sub(1);
+    let k = ctx.profile.seg_start.partition_point(|&x| x <= s);
+    k.saturating_sub(1).min(n)
 }
