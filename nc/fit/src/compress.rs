@@ -124,6 +124,7 @@ pub fn compress(
             actions,
             end: program.end,
             tilt_word: program.tilt_word,
+            rerun: program.rerun.clone(),
         },
         Some(out),
     )

@@ -132,6 +132,10 @@ pub struct Program {
     /// The tilting-axis letter the program's angle words use (`'A'` or `'B'`) and where it
     /// first stood; `None` if the program gives no angles. The machine must match it.
     pub tilt_word: Option<(char, SrcPos)>,
+    /// Source lines run more than once or inside a subroutine (in a loop's second pass
+    /// and after, or called), as sorted, disjoint, inclusive ranges: a restart from one
+    /// of them would not say which pass (`nc_lang::restart`).
+    pub rerun: Vec<(u32, u32)>,
 }
 
 /// What the tool does along a move besides its geometry: the tool-length offset at the

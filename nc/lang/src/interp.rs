@@ -140,6 +140,8 @@ pub(crate) struct Interp<S> {
     pub max_loop_lines: u64,
     /// Main-program lines run so far for the first time (the next new line's index).
     fresh: usize,
+    /// Source lines run again or inside a subroutine ([`nc_geom::program::Program::rerun`]).
+    pub rerun: Vec<(u32, u32)>,
     /// `#<_value>` and `#<_value_returned>`.
     pub value: f64,
     pub value_returned: bool,
@@ -156,6 +158,26 @@ pub(crate) struct Interp<S> {
     block_delete: bool,
     percent: Percent,
     finished: bool,
+}
+
+/// Add `line` to sorted, disjoint, inclusive ranges of lines, merging neighbours: a loop's
+/// or a subroutine's body is one range however often it runs.
+pub(crate) fn note_line(ranges: &mut Vec<(u32, u32)>, line: u32) {
+    let i = ranges.partition_point(|r| r.1.saturating_add(1) < line);
+    match ranges.get(i).copied() {
+        Some((a, b)) if a <= line && line <= b => {}
+        Some((a, b)) if b.saturating_add(1) == line => {
+            ranges[i] = (a, line);
+            if let Some(&(c, d)) = ranges.get(i + 1) {
+                if c == line.saturating_add(1) {
+                    ranges[i] = (a, d);
+                    ranges.remove(i + 1);
+                }
+            }
+        }
+        Some((a, b)) if a == line.saturating_add(1) => ranges[i] = (line, b),
+        _ => ranges.insert(i, (line, line)),
+    }
 }
 
 pub(crate) fn err(kind: InterpError, pos: SrcPos) -> ParseError {
@@ -182,6 +204,7 @@ impl<S: LineSource> Interp<S> {
             budget: setup.max_loop_lines,
             max_loop_lines: setup.max_loop_lines,
             fresh: 0,
+            rerun: Vec::new(),
             value: 0.0,
             value_returned: false,
             line: 0,
@@ -259,6 +282,8 @@ impl<S: LineSource> Interp<S> {
             } else if let Err(e) = self.again(&line) {
                 self.finished = true;
                 return Err(e);
+            } else {
+                note_line(&mut self.rerun, line.line);
             }
             let levels = self.frames.len();
             let stepped = self.step(&line, index, &*state, words);

@@ -122,6 +122,7 @@ mod parser;
 mod path;
 mod polar;
 mod predefined;
+pub mod restart;
 mod rotation;
 mod rules;
 mod saved;
@@ -223,5 +224,6 @@ pub fn parse_lines<S: LineSource>(lines: S, setup: &Setup) -> Result<Program, Pa
     }
     program.end = entries.end();
     program.tilt_word = entries.tilt_word();
+    program.rerun = entries.rerun().to_vec();
     Ok(program)
 }

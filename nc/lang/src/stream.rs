@@ -88,6 +88,12 @@ impl<'s, S: LineSource> Entries<'s, S> {
         self.parser.comp.held_moves()
     }
 
+    /// Source lines run again or inside a subroutine so far
+    /// ([`nc_geom::program::Program::rerun`]).
+    pub fn rerun(&self) -> &[(u32, u32)] {
+        &self.interp.rerun
+    }
+
     /// Motion blocks read so far.
     pub fn blocks(&self) -> usize {
         self.parser.drained

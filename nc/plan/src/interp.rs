@@ -365,6 +365,7 @@ pub(crate) mod tests {
             end: None,
             actions: Vec::new(),
             tilt_word: None,
+            rerun: Vec::new(),
         }
     }
 
