@@ -11,24 +11,11 @@
 //! once more with on-line compression on (`run --compress`), under the same checks.
 
 mod common;
+use common::{posts, POSTS};
 
 use dnurbs_tools::run::RunOptions;
 use dnurbs_tools::setup::MachineSetup;
 use dnurbs_tools::shop::{parse_setup, ShopArgs};
-
-use std::path::PathBuf;
-
-const POSTS: [&str; 5] = [
-    "fusion-fanuc-3axis.nc",
-    "mastercam-fanuc-3axis.nc",
-    "nx-5axis-g43-4.nc",
-    "hypermill-5axis-g93.nc",
-    "powermill-3axis-incremental.nc",
-];
-
-fn posts(name: &str) -> PathBuf {
-    common::root().join("tests/data/posts").join(name)
-}
 
 fn machine() -> config::Machine {
     config::load(&posts("machine.toml")).expect("the posts machine")

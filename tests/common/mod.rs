@@ -30,6 +30,21 @@ pub fn machine_text(name: &str) -> String {
     )
 }
 
+/// The CAM-post programs of `tests/data/posts` (see its README), with their machine,
+/// `machine.toml`, and tool table, `tool.tbl`.
+pub const POSTS: [&str; 5] = [
+    "fusion-fanuc-3axis.nc",
+    "mastercam-fanuc-3axis.nc",
+    "nx-5axis-g43-4.nc",
+    "hypermill-5axis-g93.nc",
+    "powermill-3axis-incremental.nc",
+];
+
+/// A file of `tests/data/posts`.
+pub fn posts(name: &str) -> PathBuf {
+    root().join("tests/data/posts").join(name)
+}
+
 /// Run `dnurbs` with the given arguments.
 pub fn dnurbs(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dnurbs"))

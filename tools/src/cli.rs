@@ -160,10 +160,30 @@ pub enum Command {
         /// Replay an operator's actions through the real-time thread's follower, one a
         /// line, in order: `at 2.31s pause`, `after 1.5s resume`, `at line 40 override 30`,
         /// `at 3s stop` (`#` starts a comment). Every setpoint, holds and overrides
-        /// included, is checked against every axis's velocity and acceleration limit and
-        /// its travel; a setpoint over one exits 2. Arc length only.
+        /// included, is checked against every axis's velocity and acceleration limit, its
+        /// jerk inside a segment and its travel; a setpoint over one exits 2. Arc length
+        /// only.
         #[arg(long, value_name = "SCRIPT", conflicts_with = "method")]
         operator: Option<PathBuf>,
+        /// Restart the program from line N, as after a broken tool: the lines before it
+        /// are read without moving, and the spindle, coolant, outputs and path mode they
+        /// left come on before the tool comes down (their stops and dwells are skipped);
+        /// the tool, standing where the program starts, goes back along its axis by
+        /// --clearance, over above the pose where line N's first move starts, and down
+        /// onto it (at the feed in effect there). The summary says what was restored and
+        /// the approach. Refused inside a NURBS block's control points, on a line run in a
+        /// loop or a subroutine, and after the last move.
+        #[arg(long, value_name = "N", conflicts_with = "operator", value_parser = clap::value_parser!(u32).range(1..))]
+        from_line: Option<u32>,
+        /// With --from-line: how far the tool backs off along its axis, and stands above
+        /// the restart pose before it comes down, mm (0 < MM <= 1000).
+        #[arg(
+            long,
+            value_name = "MM",
+            default_value_t = 10.0,
+            requires = "from_line"
+        )]
+        clearance: f64,
         #[command(flatten)]
         shop: crate::shop::ShopArgs,
     },

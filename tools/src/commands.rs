@@ -67,6 +67,7 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             json,
             operator: Some(script),
             shop,
+            ..
         } => operator::simulate_operator(&program, &machine, &script, trace, json, &shop),
         Command::Simulate {
             program,
@@ -75,6 +76,8 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             trace,
             json,
             operator: None,
+            from_line,
+            clearance,
             shop,
         } => offline::simulate(
             &program,
@@ -82,6 +85,7 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             method.map(method_of),
             trace,
             json,
+            from_line.map(|line| (line, clearance)),
             &shop,
         ),
         Command::Check {

@@ -112,6 +112,13 @@ pub enum InputError {
     /// no bus, a bus over its load at this period).
     #[error("{0}")]
     MachineUse(String),
+    /// `--from-line`: the program cannot restart from that line.
+    #[error("{file}: --from-line {line}: {error}")]
+    Restart {
+        file: String,
+        line: u32,
+        error: nc_lang::restart::RestartError,
+    },
     /// A command-line value clap could not check alone.
     #[error("{0}")]
     Usage(String),

@@ -22,6 +22,7 @@ pub use nc_plan::verify::MAX_CYCLES;
 use serde::Serialize;
 
 pub mod operator;
+pub mod restart;
 pub mod script;
 mod summary;
 pub use summary::Summarizer;
@@ -167,6 +168,9 @@ pub struct Summary {
     /// What on-line compression did, when it was on.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compressed: Option<Compression>,
+    /// `--from-line`: what the restart restored and its approach.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub restart: Option<restart::RestartNote>,
 }
 
 /// An axis over its velocity or acceleration limit ([`Summary::limits_exceeded`]): the
@@ -351,6 +355,7 @@ impl Summary {
                 .compressed
                 .map(|c| c.line())
                 .unwrap_or_default()
+            + &self.restart.as_ref().map(|r| r.text()).unwrap_or_default()
             + &crate::words::text(&self.program_words)
     }
 }

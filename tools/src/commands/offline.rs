@@ -24,6 +24,7 @@ pub fn simulate(
     method: Option<Method>,
     trace: Option<PathBuf>,
     json: bool,
+    from_line: Option<(u32, f64)>,
     shop: &ShopArgs,
 ) -> anyhow::Result<Outcome> {
     let machine = load_machine(machine)?;
@@ -74,7 +75,18 @@ pub fn simulate(
     // error in it is listed; a longer one is read a line at a time. Either way it is
     // compressed (when that is on), built, planned and interpolated as it is read.
     let size = std::fs::metadata(program).map_or(0, |m| m.len());
-    let (rolled, words) = if size <= crate::feed::CHECK_WHOLE_BYTES {
+    let mut restarted = None;
+    let (rolled, words) = if let Some((line, clearance)) = from_line {
+        // A restart reads the whole program first, whatever its length.
+        let prog = load_program(program, &parse).inspect_err(|_| discard())?;
+        let (prog, note) =
+            crate::simulate::restart::restart(&prog, program, line, clearance, &setup)
+                .inspect_err(|_| discard())?;
+        restarted = Some(note);
+        let words = crate::words::describe(&prog);
+        let rolled = roll(ProgramEntries::new(prog), &setup, step, take).map_err(refused)?;
+        (rolled, words)
+    } else if size <= crate::feed::CHECK_WHOLE_BYTES {
         let prog = load_program(program, &parse).inspect_err(|_| discard())?;
         let words = crate::words::describe(&prog);
         let rolled = roll(ProgramEntries::new(prog), &setup, step, take).map_err(refused)?;
@@ -112,6 +124,7 @@ pub fn simulate(
     summary.program_words = words;
     summary.compressed = compressed.map(crate::simulate::Compression::from);
     summary.spindle_waits = spindle_waits;
+    summary.restart = restarted;
     if json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {

@@ -340,6 +340,7 @@ impl<'a> Summarizer<'a> {
             tool_axis_deviation_max_deg: self.tool_dev,
             end_position_error_mm: end_err,
             program_words: Vec::new(),
+            restart: None,
             spindle_waits: None,
             compressed: None,
         }
