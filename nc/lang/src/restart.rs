@@ -25,7 +25,7 @@ use nalgebra::Vector3;
 use nc_geom::kinematics::{Joints, Kinematics, MachineKinematics};
 use nc_geom::program::{
     Action, ActionKind, Aux, Block, Coolant, LinearMove, MoveTooling, Orientation, PathMode,
-    Program, Spindle, Wait,
+    Program, Spindle, SrcPos, Wait,
 };
 use nc_geom::segment::{BuildError, BuildLimits, Builder};
 use std::collections::BTreeMap;
@@ -147,14 +147,16 @@ pub fn from_line(
 
     // The actions: before the restart, folded; from it on, kept.
     let before = |a: &Action| a.before_block < m || (a.before_block == m && a.pos.line < line);
+    let folded: Vec<&Action> = program.actions.iter().filter(|a| before(a)).collect();
     let mut modal = Modal::default();
-    for a in program.actions.iter().filter(|a| before(a)) {
+    for a in &folded {
         fold(&mut modal, &a.kind);
     }
+    // Each restored word where the program last set it.
     let mut actions: Vec<Action> = restored(&modal)
         .into_iter()
         .map(|kind| Action {
-            pos: blocks[m].pos(),
+            pos: set_at(&folded, &kind).unwrap_or(blocks[m].pos()),
             before_block: 2,
             kind,
         })
@@ -366,6 +368,20 @@ fn restored(m: &Modal) -> Vec<ActionKind> {
         out.push(ActionKind::Coolant(Coolant::Flood));
     }
     out
+}
+
+/// Where the last of `folded` that set what `kind` restores stands.
+fn set_at(folded: &[&Action], kind: &ActionKind) -> Option<SrcPos> {
+    use ActionKind as K;
+    let sets = |a: &ActionKind| match (kind, a) {
+        (K::PathMode(_), K::PathMode(_)) => true,
+        (K::DigitalOutput { index: i, .. }, K::DigitalOutput { index: j, .. }) => i == j,
+        (K::AnalogOutput { index: i, .. }, K::AnalogOutput { index: j, .. }) => i == j,
+        (K::Spindle { .. }, K::Spindle { .. } | K::Speed { .. }) => true,
+        (K::Coolant(c), K::Coolant(d)) => c == d,
+        _ => false,
+    };
+    folded.iter().rev().find(|a| sets(&a.kind)).map(|a| a.pos)
 }
 
 /// The wait the kept actions ask before a move, as the parser sets it: their dwells

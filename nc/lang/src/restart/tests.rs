@@ -76,6 +76,9 @@ fn the_blocks_from_the_line_on_are_the_programs_and_the_state_is_restored() {
     assert_eq!(r.modal.aux.spindle_rpm, 1200.0);
     assert!(r.modal.aux.flood && !r.modal.aux.mist);
     assert_eq!(r.modal.tool, Some(3));
+    // Each restored where the program set it: the spindle on line 3, the flood on 4.
+    let at: Vec<u32> = r.program.actions.iter().map(|a| a.pos.line).collect();
+    assert_eq!(at, [3, 4, 10]);
     let kinds: Vec<_> = r
         .program
         .actions
