@@ -88,6 +88,8 @@ pub enum RestartError {
     Clearance { value: f64 },
     #[error("the program has no moves")]
     NoMoves,
+    #[error("the machine's position is not known (joints {joints:?}, tool length {tool_length}): home it first")]
+    Standing { joints: Joints, tool_length: f64 },
     /// The program up to the restart line does not build for this machine.
     #[error(transparent)]
     Build(#[from] BuildError),
@@ -106,6 +108,12 @@ pub fn from_line(
     if !(clearance_mm > 0.0 && clearance_mm <= MAX_CLEARANCE_MM) {
         return Err(RestartError::Clearance {
             value: clearance_mm,
+        });
+    }
+    if !(standing.joints.iter().all(|x| x.is_finite()) && standing.tool_length.is_finite()) {
+        return Err(RestartError::Standing {
+            joints: standing.joints,
+            tool_length: standing.tool_length,
         });
     }
     let blocks = &program.blocks;
@@ -221,7 +229,8 @@ pub fn from_line(
             ..tooling
         },
     });
-    let plunge_rapid = feed.is_none() || matches!(&blocks[first], Block::Linear(l) if l.rapid);
+    let plunge_rapid =
+        feed.is_none() || matches!(blocks.get(first), Some(Block::Linear(l)) if l.rapid);
     let mut out = vec![
         start,
         step(up, here_angles, true, Wait::default()),

@@ -254,3 +254,81 @@ fn the_approach_turns_c_to_where_the_whole_run_has_it_turns_included() {
         }
     }
 }
+
+#[test]
+fn a_program_of_one_move_restarts_onto_its_start_and_ends_there() {
+    let p = parse("G0 X1 Y2 Z3\nM30\n").unwrap();
+    let r = go(&p, 1, &UP_HIGH, 10.0).unwrap();
+    assert_eq!(r.program.blocks.len(), 4);
+    assert!(close(r.approach[2], [1.0, 2.0, 3.0]));
+    let Block::Linear(down) = &r.program.blocks[3] else {
+        panic!()
+    };
+    assert!(down.rapid, "no feed in effect: {down:?}");
+    assert!(matches!(
+        go(&p, 2, &UP_HIGH, 10.0),
+        Err(RestartError::PastTheEnd { line: 2, last: 1 })
+    ));
+    assert_eq!(
+        go(&parse("M30\n").unwrap(), 1, &UP_HIGH, 10.0),
+        Err(RestartError::NoMoves)
+    );
+}
+
+/// Any line, clearance and standing: a restart or a refusal, never a panic; a restart's
+/// blocks from the line on are the program's, its approach finite.
+mod generated {
+    use super::*;
+    use proptest::prelude::*;
+
+    const PROGRAMS: [&str; 4] = [
+        JOB,
+        "G0 X0 Y0 Z10\nG81 X5 Y5 Z-3 R2 F200\nX10\nG80\nG0 Z20\nM30\n",
+        "G0 X0 Y0 Z5\n#1=0\no100 while [#1 lt 3]\nG1 X[#1] F100\n#1=[#1+1]\no100 endwhile\nG1 Y5\nM30\n",
+        "G0 X0 Y0 Z0 A0 C0\nG06.2 P3 K0 X0 Y0 Z0 R1 F600\nK0 X10 Y10 Z0 R1\nK0 X20 Y0 Z0 R1\nK1 X30 Y10 Z0 R1\nK1\nK1\nK1\nG1 X40 A30 C400\nG2 X50 R5 C-30\nM30\n",
+    ];
+
+    fn value() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            -1e3..1e3f64,
+            Just(0.0),
+            Just(f64::NAN),
+            Just(f64::INFINITY),
+            Just(-1e300),
+            Just(1e300),
+        ]
+    }
+
+    #[test]
+    fn a_restart_or_a_refusal() {
+        let cases = (
+            0..PROGRAMS.len(),
+            prop_oneof![0..40u32, Just(u32::MAX)],
+            value(),
+            proptest::array::uniform5(value()),
+            value(),
+        );
+        let mut runner =
+            test_support::generated::seeded_runner(ProptestConfig::with_cases(2000), 55);
+        runner
+            .run(&cases, |(which, line, clearance, joints, tool_length)| {
+                let p = parse(PROGRAMS[which]).unwrap();
+                let standing = Standing {
+                    joints,
+                    tool_length,
+                };
+                if let Ok(r) = go(&p, line, &standing, clearance) {
+                    let first = r.block.max(1);
+                    let (ours, theirs) = (
+                        5.min(r.program.blocks.len()),
+                        (first + 1).min(p.blocks.len()),
+                    );
+                    prop_assert_eq!(&r.program.blocks[ours..], &p.blocks[theirs..]);
+                    prop_assert!(r.approach.iter().flatten().all(|x| x.is_finite()));
+                    prop_assert!(clearance > 0.0 && joints.iter().all(|x| x.is_finite()));
+                }
+                Ok(())
+            })
+            .unwrap();
+    }
+}
