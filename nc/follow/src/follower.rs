@@ -49,6 +49,10 @@ pub struct Follower<'q> {
     motion: Motion,
     stop_requested: bool,
     holding: bool,
+    /// Held for data closer to its end than the least stop distance, the path creeps on
+    /// with its jerk scaled by this, chosen at rest, until it is at rest again or the
+    /// whole jerk's stop fits ([`Follower::plan_time`]).
+    creep: Option<f64>,
     /// The operator's feed override (0..=1) and pause: the tracker's target when the
     /// data suffices.
     feed_override: f64,
@@ -99,6 +103,7 @@ impl<'q> Follower<'q> {
             motion: Motion::default(),
             stop_requested: false,
             holding: false,
+            creep: None,
             feed_override: 1.0,
             paused: false,
             gates: Gates::default(),
@@ -357,13 +362,24 @@ impl<'q> Follower<'q> {
         // Held at rest for data, closer to its end than the least stop distance: creep on
         // with a gentler jerk whose stop fits in half the room. The planner may be unable to
         // push more (the queue's depth is in the chunks held here) until the first is left.
-        if !self.complete && self.tracker.at_rest() && room > 0.0 {
+        // The gentler jerk is kept while the path moves (a lower jerk is always safe, and
+        // the rate was built with it), until it is at rest again or the whole jerk's stop
+        // fits: dropping it as soon as the path moved made the whole jerk's longer stop
+        // hold the path at once, and it crept on by a fraction of the room per hold,
+        // never leaving the first chunk (the long run's seed 31 000 003: 1e-6 mm in 50 s).
+        if self.complete || room <= 0.0 {
+            self.creep = None;
+        } else if self.tracker.at_rest() {
             let d0 = stop(&self.tracker, jerk);
-            if d0 >= room {
-                let gentler = 0.5 * room / d0;
-                jerk.path *= gentler;
-                jerk.cap *= gentler;
-            }
+            self.creep = (d0 >= room).then(|| 0.5 * room / d0);
+        } else if self.creep.is_some()
+            && room.partial_cmp(&stop(&self.tracker, jerk)) == Some(Cmp::Greater)
+        {
+            self.creep = None;
+        }
+        if let Some(gentler) = self.creep {
+            jerk.path *= gentler;
+            jerk.cap *= gentler;
         }
         // (A stop distance that is not a number holds too.)
         let fits = room.partial_cmp(&stop(&self.tracker, jerk)) == Some(Cmp::Greater);

@@ -984,10 +984,22 @@ fn the_jerk_faults_found_stay_fixed() {
 /// that the check once ended with a stop the drives never got; the last from the long run
 /// (seed 7 000 006: a G06.5 block whose tool leaves the vertical with C turning fast, where
 /// the path turned C to where the tilt reached 1e-7, not to where it starts, and jumped
-/// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration).
+/// 5.6e-5 rad; a stop shifted the phase onto the jump: C at 1.12x its acceleration). And,
+/// first in the list, the long run's seed 31 000 003 on fceb365: a slow planner pushing one
+/// segment at a time into a queue two deep, the first two chunks 1 um long together, shorter
+/// than the least stop; the path crept on with a gentler jerk, dropped it as soon as it
+/// moved, was held again by the whole jerk's longer stop, and covered 1e-6 mm in 50 s.
 #[test]
 fn the_hold_faults_found_stay_fixed() {
-    let cases: [(&str, hold::Event); 7] = [
+    let cases: [(&str, hold::Event); 8] = [
+        (
+            include_str!("../../../tests/data/adversarial/underrun-stuck-before-the-end.nc"),
+            hold::Event::Underrun {
+                every: 337,
+                depth: 2,
+                single: true,
+            },
+        ),
         (
             include_str!("../../../tests/data/adversarial/hold-creeps-off-the-vertical.nc"),
             hold::Event::Underrun {
