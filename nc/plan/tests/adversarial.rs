@@ -988,15 +988,25 @@ fn the_jerk_faults_found_stay_fixed() {
 /// first in the list, the long run's seed 31 000 003 on fceb365: a slow planner pushing one
 /// segment at a time into a queue two deep, the first two chunks 1 um long together, shorter
 /// than the least stop; the path crept on with a gentler jerk, dropped it as soon as it
-/// moved, was held again by the whole jerk's longer stop, and covered 1e-6 mm in 50 s.
+/// moved, was held again by the whole jerk's longer stop, and covered 1e-6 mm in 50 s; and
+/// the same run's seed 30 000 000, the same on G06.5 spans of a micrometre (every 198
+/// periods, a queue three deep).
 #[test]
 fn the_hold_faults_found_stay_fixed() {
-    let cases: [(&str, hold::Event); 8] = [
+    let cases: [(&str, hold::Event); 9] = [
         (
             include_str!("../../../tests/data/adversarial/underrun-stuck-before-the-end.nc"),
             hold::Event::Underrun {
                 every: 337,
                 depth: 2,
+                single: true,
+            },
+        ),
+        (
+            include_str!("../../../tests/data/adversarial/underrun-stuck-on-tiny-spans.nc"),
+            hold::Event::Underrun {
+                every: 198,
+                depth: 3,
                 single: true,
             },
         ),
