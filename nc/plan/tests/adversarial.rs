@@ -977,6 +977,27 @@ fn the_jerk_faults_found_stay_fixed() {
     }
 }
 
+/// Open (issue 56): the long run on 8c8179e (seed 31 000 003, after 108 922 programs) found
+/// one more creep for data that makes no progress, with a slow planner pushing one segment
+/// a chunk into a queue two deep: a G82 drilling cycle with a dwell, then a G06.2 block
+/// with weights from 0.002 to 770. No limit was broken.
+/// `cargo test --release -p nc-plan --test adversarial -- --ignored a_stuck_creep_still_open`
+/// shows it.
+#[test]
+#[ignore = "open: a creep for data that makes no progress, issue 56"]
+fn a_stuck_creep_still_open() {
+    let src = include_str!("../../../tests/data/adversarial/underrun-stuck-still-open.nc");
+    let counts = Counts::default();
+    let ev = hold::Event::Underrun {
+        every: 150,
+        depth: 2,
+        single: true,
+    };
+    if let Err(e) = check_with(src, &counts, ev) {
+        panic!("{e}");
+    }
+}
+
 /// The faults the run through the follower found (see `hold.rs`), kept as they were
 /// generated: each text gives its event by its own hash. The first three came from the CI
 /// seeds; `hold-c-accelerates-while-data-waits` from the long run (seed 7 000 012: a kink
