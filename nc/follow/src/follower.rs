@@ -393,7 +393,43 @@ impl<'q> Follower<'q> {
         }
         let axes = &self.axis_hold;
         let rate = self.tracker.rate_bound(rmax, jerk, ts, axes);
-        self.tau + self.tracker.track(target, rate, jerk, ts, axes)
+        let covered = self.tracker.track(target, rate, jerk, ts, axes);
+        self.tau + self.dwell(covered)
+    }
+
+    /// The plan time a period covers, `covered` by the override, or where the plan stands
+    /// still (a dwell) and the operator has not held it, at the operator's override up to
+    /// the dwell's end. The path does not move there whatever the override does, so a hold
+    /// for data must not stretch the dwell: its override, kept low by the stop distance
+    /// from the plan's speed ahead, let the dwell pass at a fraction of the rate, and the
+    /// queue (its depth in the chunks held here) never had room for the data the hold
+    /// waited for (the long run's seed 31 000 003: a G82 dwell of 0.2 s at k ~ 0.002).
+    /// The override itself is left as the hold has it: the path leaves the dwell with a
+    /// stop that fits.
+    fn dwell(&self, covered: f64) -> f64 {
+        if self.stop_requested || self.paused {
+            return covered;
+        }
+        let rate = self.hold.period * self.feed_override;
+        match self.still_until(self.tau) {
+            Some(end) if rate > covered => rate.min(end - self.tau).max(covered),
+            _ => covered,
+        }
+    }
+
+    /// Where the plan stands still at plan time `tau` in the chunk at hand (a phase at rest
+    /// with nothing to change it), the time its stillness ends. Bounded by the chunk's
+    /// phases.
+    fn still_until(&self, tau: f64) -> Option<f64> {
+        let c = self.local.front()?;
+        let mut i = self.phase;
+        while i + 1 < c.phases.len() && c.phases.get(i + 1).is_some_and(|p| tau >= p.t0) {
+            i += 1;
+        }
+        let p = c.phases.get(i)?;
+        let end = p.t0 + p.dur;
+        let still = p.v0 == 0.0 && p.a0 == 0.0 && p.j == 0.0;
+        (still && tau >= p.t0 && tau < end).then_some(end)
     }
 
     /// The override's target: 0 for a stop, for an underrun (the path that has arrived ends
