@@ -111,6 +111,7 @@ mod io;
 mod length;
 mod line;
 mod machine_move;
+pub mod mdi;
 mod modal;
 mod moves;
 mod name;

@@ -9,7 +9,7 @@ use super::modal::Setup;
 use super::parser::Parser;
 use super::source::LineSource;
 use super::word::Word;
-use nc_geom::program::{Action, Block, SrcPos};
+use nc_geom::program::{Action, Block, Orientation, SrcPos};
 use std::collections::VecDeque;
 
 /// One thing a program says: a motion block with its index among the program's motion
@@ -97,6 +97,34 @@ impl<'s, S: LineSource> Entries<'s, S> {
     /// Motion blocks read so far.
     pub fn blocks(&self) -> usize {
         self.parser.drained
+    }
+
+    /// What the lines read so far left open that only later lines can finish, if anything:
+    /// an MDI line must be whole ([`crate::mdi`]).
+    pub(crate) fn unfinished(&self) -> Option<crate::mdi::Unfinished> {
+        use crate::mdi::Unfinished;
+        let (p, i) = (&self.parser, &self.interp);
+        if p.end().is_some() {
+            Some(Unfinished::ProgramEnd)
+        } else if p.open.is_some() || p.g52.is_some() {
+            Some(Unfinished::Spline)
+        } else if p.comp.active.is_some() || p.comp.held_moves() > 0 {
+            Some(Unfinished::CutterComp)
+        } else if i.defining.is_some() {
+            Some(Unfinished::Definition)
+        } else if i.skip.is_some() || i.level() > 0 || i.frames.iter().any(|f| !f.open.is_empty()) {
+            Some(Unfinished::Flow)
+        } else {
+            None
+        }
+    }
+
+    /// The tool stands at `here` (tool tip, the program's frame, mm) with `orientation`: the
+    /// next move starts there (the machine moved without the program: a jog).
+    pub(crate) fn place(&mut self, here: [f64; 3], orientation: Orientation) {
+        self.parser.here = Some(here);
+        self.parser.orientation = orientation;
+        self.parser.orientation_given = true;
     }
 
     /// Moves what the parser produced into `pending`, each action before the block its
