@@ -22,9 +22,13 @@
 
 use crate::error::ParseError;
 use crate::modal::Setup;
+use crate::restart::Standing;
 use crate::source::LineSource;
 use crate::stream::{Entries, Entry};
-use nc_geom::program::{Orientation, SrcPos};
+use nc_geom::kinematics::MachineKinematics;
+use nc_geom::program::{
+    Action, Block, LinearMove, MoveTooling, Orientation, Program, SrcPos, Wait,
+};
 use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::rc::Rc;
@@ -173,6 +177,18 @@ impl<'s> Mdi<'s> {
         self.history.push(Step::At(here, orientation));
     }
 
+    /// The machine stands at `standing` on `kin` (read from its drives): the next move
+    /// starts at its tool tip, at its angles.
+    pub fn standing(&mut self, standing: &Standing, kin: &MachineKinematics) {
+        let (here, orientation) = standing.tip(kin);
+        self.at(here, orientation);
+    }
+
+    /// The tilting-axis letter (`A` or `B`) the session's lines used first, and where.
+    pub fn tilt_word(&self) -> Option<(char, SrcPos)> {
+        self.entries.tilt_word()
+    }
+
     /// Motion blocks the session has produced.
     pub fn blocks(&self) -> usize {
         self.entries.blocks()
@@ -204,6 +220,22 @@ impl<'s> Mdi<'s> {
                 Err(e)
             }
         }
+    }
+
+    /// The line last taken was refused after it was read (the planner, the travel, the
+    /// operator): the session as it was before it, as if it had never been typed. Positions
+    /// given since stay. Returns whether there was a line to take back.
+    pub fn take_back(&mut self) -> bool {
+        let Some(i) = self
+            .history
+            .iter()
+            .rposition(|s| matches!(s, Step::Line(..)))
+        else {
+            return false;
+        };
+        self.history.remove(i);
+        self.rebuild();
+        true
     }
 
     /// Reads one line to its end (a subroutine it calls included).
@@ -254,6 +286,69 @@ impl<'s> Mdi<'s> {
                 }
             }
         }
+    }
+}
+
+/// What a line gave, as a program from where the machine stands (`standing`): a start
+/// there, then the line's blocks, its actions before the blocks they came before (after
+/// the last, those after its moves), and the tilting-axis letter the session's lines used
+/// (`tilt_word`, [`Mdi::tilt_word`]; the segment builder checks it against the machine).
+/// Planned and run as any program is.
+pub fn program(
+    out: &[Entry],
+    tilt_word: Option<(char, SrcPos)>,
+    standing: &Standing,
+    kin: &MachineKinematics,
+) -> Program {
+    let base = out
+        .iter()
+        .map(|e| match e {
+            Entry::Block(i, _) => *i,
+            Entry::Action(a) => a.before_block,
+        })
+        .min()
+        .unwrap_or(0);
+    let mut blocks = Vec::with_capacity(out.len() + 1);
+    let mut actions = Vec::new();
+    let (here, orientation) = standing.tip(kin);
+    let first = out.iter().find_map(|e| match e {
+        Entry::Block(_, b) => Some(b),
+        Entry::Action(_) => None,
+    });
+    let (pos, tooling) = match first {
+        Some(Block::Linear(m)) => (m.pos, m.tooling),
+        Some(Block::Nurbs(b)) => (b.pos, b.tooling),
+        None => (SrcPos::default(), MoveTooling::default()),
+    };
+    blocks.push(Block::Linear(LinearMove {
+        pos,
+        n: None,
+        rapid: true,
+        end: here,
+        orientation,
+        feed_mm_min: 0.0,
+        inverse_time: false,
+        tooling: MoveTooling {
+            tool_length: standing.tool_length,
+            wait: Wait::default(),
+            ..tooling
+        },
+    }));
+    for e in out {
+        match e {
+            Entry::Block(_, b) => blocks.push(b.clone()),
+            Entry::Action(a) => actions.push(Action {
+                before_block: a.before_block - base + 1,
+                ..*a
+            }),
+        }
+    }
+    Program {
+        blocks,
+        end: None,
+        actions,
+        tilt_word,
+        rerun: Vec::new(),
     }
 }
 

@@ -41,6 +41,16 @@ pub struct Standing {
     pub tool_length: f64,
 }
 
+impl Standing {
+    /// The tool tip where the machine stands, in the workpiece frame (mm), and its rotary
+    /// angles as a move gives them.
+    pub fn tip(&self, kin: &MachineKinematics) -> ([f64; 3], Orientation) {
+        let j = &self.joints;
+        let machine = Vector3::new(j[0], j[1], j[2] - self.tool_length);
+        (kin.unplace(&machine, j[3], j[4]).into(), angles(j))
+    }
+}
+
 /// What the lines before the restart line left, besides the pose.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Modal {
@@ -188,8 +198,8 @@ pub fn from_line(
 
     // The approach.
     let j = &standing.joints;
-    let machine = Vector3::new(j[0], j[1], j[2] - standing.tool_length);
-    let here = kin.unplace(&machine, j[3], j[4]);
+    let (here, here_angles) = standing.tip(kin);
+    let here = Vector3::from(here);
     let up = here + kin.tool_axis(j[3], j[4]) * clearance_mm;
     let above = target + target_axis * clearance_mm;
     let pos = blocks[m].pos();
@@ -203,7 +213,6 @@ pub fn from_line(
         wait: Wait::default(),
         ..tooling_of(&blocks[first - 1])
     };
-    let here_angles = angles(j);
     let step = |end: Vector3<f64>, orientation, rapid, wait| {
         Block::Linear(LinearMove {
             pos,

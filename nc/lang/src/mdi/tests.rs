@@ -267,3 +267,18 @@ fn any_text_is_taken_or_refused() {
         prop_assert_eq!(mdi.taken(), taken);
     });
 }
+
+#[test]
+fn a_line_refused_downstream_is_taken_back() {
+    let s = setup();
+    let mut mdi = Mdi::new(&s);
+    assert!(!mdi.take_back(), "nothing to take back");
+    mdi.at([0.0, 0.0, 50.0], VERTICAL);
+    take(&mut mdi, "G91 #<step>=2");
+    // The planner refuses this one (say, over the travel): its G90 and #<step> go with it.
+    take(&mut mdi, "G90 #<step>=900 G0 X#<step>");
+    mdi.at([3.0, 0.0, 50.0], VERTICAL);
+    assert!(mdi.take_back());
+    assert_eq!(mdi.taken(), 1);
+    assert_eq!(ends(&take(&mut mdi, "G0 X#<step>")), [[5.0, 0.0, 50.0]]);
+}
