@@ -101,8 +101,7 @@ impl<'s, S: LineSource> Entries<'s, S> {
 
     /// What the lines read so far left open that only later lines can finish, if anything:
     /// an MDI line must be whole ([`crate::mdi`]).
-    pub(crate) fn unfinished(&self) -> Option<crate::mdi::Unfinished> {
-        use crate::mdi::Unfinished;
+    pub(crate) fn unfinished(&self) -> Option<Unfinished> {
         let (p, i) = (&self.parser, &self.interp);
         if p.end().is_some() {
             Some(Unfinished::ProgramEnd)
@@ -205,5 +204,44 @@ impl<S: LineSource> Iterator for Entries<'_, S> {
                 }
             }
         }
+    }
+}
+
+/// What a line left open that only later lines could finish, or that MDI does not take.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unfinished {
+    /// `M02`/`M30`.
+    ProgramEnd,
+    /// A `G06.2`/`G06.5` NURBS block or a `G05.2` spline: control points on later lines.
+    Spline,
+    /// `G41`/`G42`: each move waits for the next to decide its corner.
+    CutterComp,
+    /// `o... sub`: a subroutine's body on later lines.
+    Definition,
+    /// An `if`, `while`, `do` or `repeat` closed on a later line.
+    Flow,
+}
+
+impl core::fmt::Display for Unfinished {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Unfinished::ProgramEnd => "M02/M30 ends a program: not taken in MDI",
+            Unfinished::Spline => {
+                "a NURBS or spline block takes its control points from later lines: \
+                 not taken in MDI (run it in a program)"
+            }
+            Unfinished::CutterComp => {
+                "cutter radius compensation (G41/G42) holds each move until the next \
+                 decides its corner: not taken in MDI (run it in a program)"
+            }
+            Unfinished::Definition => {
+                "a subroutine is defined over several lines: not taken in MDI \
+                 (call one from a file: o<name> call)"
+            }
+            Unfinished::Flow => {
+                "an O-word block (if, while, do, repeat) is closed on a later line: \
+                 not taken in MDI"
+            }
+        })
     }
 }
