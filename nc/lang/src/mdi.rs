@@ -15,6 +15,9 @@
 //! `M02`/`M30` (they end a program), a tape's `%`, a line continued with `\`. A subroutine
 //! in a file (`o<name> call`, [`Setup::subroutine_dirs`]) runs whole within its line.
 //!
+//! A dwell or a stop (`G04`, `M00`, `M06`) with no move after it on its line is among the
+//! line's actions, for the controller to do; it does not hold the next line's move.
+//!
 //! The machine moves without the session (a jog): [`Mdi::at`] tells it where the tool now
 //! stands, and the next move starts there.
 //!
@@ -219,6 +222,7 @@ impl<'s> Mdi<'s> {
         while let Some(e) = self.entries.take_read() {
             out.push(e);
         }
+        self.entries.end_line_waits();
         match self.entries.unfinished() {
             Some(what) => Err(MdiError::Unfinished {
                 line,

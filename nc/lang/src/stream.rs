@@ -118,6 +118,13 @@ impl<'s, S: LineSource> Entries<'s, S> {
         }
     }
 
+    /// What the next motion block would wait for (a `G04`, `M00`, `M06` with no move
+    /// after it on its line), dropped: an MDI line's waits are its own, reported among
+    /// its actions, and do not hold the next line's move.
+    pub(crate) fn end_line_waits(&mut self) {
+        self.parser.wait = nc_geom::program::Wait::default();
+    }
+
     /// The tool stands at `here` (tool tip, the program's frame, mm) with `orientation`: the
     /// next move starts there (the machine moved without the program: a jog).
     pub(crate) fn place(&mut self, here: [f64; 3], orientation: Orientation) {

@@ -190,6 +190,20 @@ fn actions_come_with_their_line() {
     );
     let out = take(&mut mdi, "G4 P0.5");
     assert!(!out.is_empty(), "a dwell is an action: {out:?}");
+    // It is the line's own: the next line's move does not wait.
+    let out = take(&mut mdi, "G0 X1");
+    match &out[..] {
+        [Entry::Block(_, Block::Linear(m))] => {
+            assert_eq!(m.tooling.wait, nc_geom::program::Wait::default())
+        }
+        other => panic!("{other:?}"),
+    }
+    // A dwell before a move on its line holds that move.
+    let out = take(&mut mdi, "G4 P0.5 G0 X2");
+    match &out[..] {
+        [.., Entry::Block(_, Block::Linear(m))] => assert_eq!(m.tooling.wait.dwell_s, 0.5),
+        other => panic!("{other:?}"),
+    }
 }
 
 /// Any text, any order of lines and positions: never a panic, and a refused line never
