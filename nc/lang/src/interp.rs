@@ -221,6 +221,41 @@ impl<S: LineSource> Interp<S> {
         self.tape.eof()
     }
 
+    /// The interpreter as it stands (parameters, subroutines found in files, the loop
+    /// quirks' flags) over a new main program, `lines`, read from its start: an MDI
+    /// session's state carried into a program. Nothing may be open (the MDI session
+    /// refuses a line that leaves anything open).
+    pub fn with_source<S2: LineSource>(self, lines: S2) -> Interp<S2> {
+        Interp {
+            tape: Tape::new(lines),
+            params: self.params,
+            frames: vec![Frame {
+                src: Src::Main,
+                pc: 0,
+                open: Vec::new(),
+                saved: [0.0; ARGUMENTS],
+                name: String::new(),
+            }],
+            subs: self.subs,
+            labels: HashMap::new(),
+            skip: None,
+            defining: None,
+            dirs: self.dirs,
+            budget: self.max_loop_lines,
+            max_loop_lines: self.max_loop_lines,
+            fresh: 0,
+            rerun: Vec::new(),
+            value: self.value,
+            value_returned: self.value_returned,
+            line: 0,
+            doing_break: self.doing_break,
+            doing_continue: self.doing_continue,
+            block_delete: self.block_delete,
+            percent: Percent::Undecided,
+            finished: false,
+        }
+    }
+
     /// The call level (0: the main program).
     pub fn level(&self) -> usize {
         self.frames.len() - 1

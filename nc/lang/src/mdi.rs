@@ -18,6 +18,9 @@
 //! A dwell or a stop (`G04`, `M00`, `M06`) with no move after it on its line is among the
 //! line's actions, for the controller to do; it does not hold the next line's move.
 //!
+//! A program run after the session starts in the state its lines left
+//! ([`Mdi::into_program`]), as in LinuxCNC.
+//!
 //! The machine moves without the session (a jog): [`Mdi::at`] tells it where the tool now
 //! stands, and the next move starts there.
 //!
@@ -201,6 +204,14 @@ impl<'s> Mdi<'s> {
         self.history.remove(i);
         self.rebuild();
         true
+    }
+
+    /// A program run after the session's lines, `lines`, starts in the state they left:
+    /// modes, offsets, the tool and its length, the feed, the parameters, where the tool
+    /// stands (as LinuxCNC runs a program after MDI). Its blocks count from 0; a first move
+    /// that leaves an axis out starts where the tool stands.
+    pub fn into_program<S: LineSource>(self, lines: S) -> Entries<'s, S> {
+        self.entries.continue_with(lines)
     }
 
     /// Reads one line to its end (a subroutine it calls included).

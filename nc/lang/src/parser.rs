@@ -132,6 +132,17 @@ impl<'s> Parser<'s> {
         parser
     }
 
+    /// A new program starts on this state (an MDI session's): its blocks count from 0, its
+    /// end and its first move's start are its own.
+    pub fn start_program(&mut self) {
+        self.drained = 0;
+        self.from_reference = None;
+        self.end = None;
+        self.just_closed = None;
+        self.skipping = false;
+        self.cycle_moves = 0;
+    }
+
     /// After an error on a line: drop an open NURBS block and skip the rest of its lines.
     pub fn recover(&mut self) {
         if self.open.take().is_some() {

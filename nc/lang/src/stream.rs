@@ -118,6 +118,21 @@ impl<'s, S: LineSource> Entries<'s, S> {
         }
     }
 
+    /// The state the lines read so far left (modes, offsets, tool, parameters, where the
+    /// tool stands) over a new program, `lines`, read from its start, its blocks counted
+    /// from 0. Whatever was read and not taken is dropped.
+    pub(crate) fn continue_with<S2: LineSource>(self, lines: S2) -> Entries<'s, S2> {
+        let mut parser = self.parser;
+        parser.start_program();
+        Entries {
+            interp: self.interp.with_source(lines),
+            parser,
+            words: Vec::new(),
+            pending: VecDeque::new(),
+            finished: false,
+        }
+    }
+
     /// What the next motion block would wait for (a `G04`, `M00`, `M06` with no move
     /// after it on its line), dropped: an MDI line's waits are its own, reported among
     /// its actions, and do not hold the next line's move.

@@ -11,9 +11,10 @@
 //! compensation, an O-word block, a continued line, an error of its own) is counted with
 //! its reason and left out.
 
+use nc_geom::program::SrcPos;
 use nc_geom::program::{Block, Wait};
 use nc_lang::mdi::{Mdi, MdiError};
-use nc_lang::{Entries, Entry, Setup, StrLines};
+use nc_lang::{Entries, Entry, LineSource, ParseError, Setup, StrLines};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -172,4 +173,119 @@ fn a_program_typed_line_by_line_is_the_program() {
     }
     assert!(taken.len() >= 40, "{taken:?}");
     assert!(junk >= 200, "{junk}");
+}
+
+/// A program's lines numbered from `by + 1`: the rest of a program after its first `by`
+/// lines were typed in MDI keeps the whole program's line numbers.
+struct After<'a> {
+    lines: StrLines<'a>,
+    by: u32,
+}
+
+impl LineSource for After<'_> {
+    fn next_line(&mut self) -> Option<Result<(u32, &str), ParseError>> {
+        let by = self.by;
+        Some(self.lines.next_line()?.map(|(n, t)| (n + by, t)))
+    }
+
+    fn eof(&self) -> SrcPos {
+        let e = self.lines.eof();
+        SrcPos {
+            line: e.line + self.by,
+            col: e.col,
+        }
+    }
+}
+
+/// The program's first `k` lines typed in MDI, the rest run as a program after them:
+/// the same entries and errors as the whole program read at once (the rest's blocks
+/// counted from 0). `Err`: MDI refused one of the first `k` lines.
+fn split(name: &str, src: &str, k: usize, setup: &Setup) -> Result<(), String> {
+    let lines: Vec<&str> = src.lines().collect();
+    let typed: Vec<String> = lines[..k]
+        .iter()
+        .map(|l| {
+            if l.trim() == "%" {
+                String::new()
+            } else {
+                (*l).to_owned()
+            }
+        })
+        .collect();
+    let rest = lines[k..].join("\n");
+    let whole = format!("{}\n{rest}", typed.join("\n"));
+    let mut mdi = Mdi::new(setup);
+    let mut before = 0;
+    for line in &typed {
+        let out = mdi.line(line).map_err(|e| e.to_string())?;
+        before += out.iter().filter(|e| matches!(e, Entry::Block(..))).count();
+    }
+    let program = mdi.into_program(After {
+        lines: StrLines::new(&rest),
+        by: k as u32,
+    });
+    // Errors too: the rest reads to the same errors at the same places.
+    let got: Vec<Result<Entry, String>> = program.map(|e| e.map_err(|e| e.to_string())).collect();
+    let want: Vec<Result<Entry, String>> = Entries::new(StrLines::new(&whole), setup)
+        .map(|e| e.map_err(|e| e.to_string()))
+        .collect();
+    // The whole program's entries from its line k + 1 on (the typed lines' own first).
+    assert!(
+        want.len() >= got.len(),
+        "{name} after {k} lines: more entries"
+    );
+    let skip = want.len() - got.len();
+    let shift = |e: &Entry| match e.clone() {
+        Entry::Block(i, b) => Entry::Block(i - before, b),
+        Entry::Action(mut a) => {
+            a.before_block -= before;
+            Entry::Action(a)
+        }
+    };
+    for (g, w) in got.iter().zip(&want[skip..]) {
+        match (g, w) {
+            (Ok(g), Ok(w)) => {
+                assert_eq!(
+                    without_wait(g),
+                    without_wait(&shift(w)),
+                    "{name} after {k} lines"
+                )
+            }
+            (g, w) => assert_eq!(g.as_ref().err(), w.as_ref().err(), "{name} after {k} lines"),
+        }
+    }
+    assert!(
+        want[..skip].iter().all(|e| match e {
+            Ok(Entry::Block(_, b)) => (b.pos().line as usize) <= k,
+            Ok(Entry::Action(a)) => (a.pos.line as usize) <= k,
+            Err(_) => false,
+        }),
+        "{name} after {k} lines: the typed lines' entries come first"
+    );
+    Ok(())
+}
+
+#[test]
+fn a_program_after_mdi_lines_runs_as_the_whole_program() {
+    let setup = setup();
+    let (mut ran, mut not) = (0, 0);
+    for p in programs() {
+        let name = p.display().to_string();
+        let Ok(src) = std::fs::read_to_string(&p) else {
+            continue;
+        };
+        // Cut where the program's lines before can all be typed.
+        let n = mdi_lines(&src, &setup).len();
+        if n < 2 {
+            continue;
+        }
+        let seed = name.bytes().fold(7u64, |h, b| mix(h ^ u64::from(b)));
+        let k = 1 + (seed % (n as u64 - 1)) as usize;
+        match split(&name, &src, k, &setup) {
+            Ok(()) => ran += 1,
+            Err(_) => not += 1,
+        }
+    }
+    eprintln!("MDI then a program: {ran} programs cut and run as a whole, {not} not cut there");
+    assert!(ran >= 100, "{ran}");
 }

@@ -296,3 +296,24 @@ fn a_line_refused_downstream_is_taken_back() {
     assert_eq!(mdi.taken(), 1);
     assert_eq!(ends(&take(&mut mdi, "G0 X#<step>")), [[5.0, 0.0, 50.0]]);
 }
+
+#[test]
+fn a_program_after_the_session_starts_in_its_state() {
+    let s = setup();
+    let mut mdi = Mdi::new(&s);
+    mdi.at([1.0, 2.0, 50.0], VERTICAL);
+    take(&mut mdi, "G20 G91 #<d>=2 F10");
+    take(&mut mdi, "G0 Y1");
+    let program = mdi.into_program(crate::StrLines::new("G1 X#<d>\nG90 G21 G0 X0\nM30\n"));
+    let got: Vec<Entry> = program.map(|e| e.expect("read")).collect();
+    match &got[..] {
+        [Entry::Block(0, Block::Linear(a)), Entry::Block(1, Block::Linear(b))] => {
+            // Inches, incremental, the feed and #<d> from the session; from where it stood.
+            assert_eq!(a.end, [1.0 + 50.8, 2.0 + 25.4, 50.0]);
+            assert_eq!(a.feed_mm_min, 254.0);
+            assert_eq!(a.pos.line, 1, "the program's own lines");
+            assert_eq!(b.end, [0.0, 27.4, 50.0]);
+        }
+        other => panic!("{other:?}"),
+    }
+}
