@@ -59,6 +59,7 @@ mod follower;
 mod gates;
 mod hold;
 pub mod jog;
+pub mod jog_line;
 mod queue;
 mod stop;
 mod tracker;

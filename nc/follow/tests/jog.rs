@@ -13,6 +13,9 @@ static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 use nc_follow::jog::{Jog, JogLimits, JogRefused};
 use proptest::prelude::*;
 
+mod common;
+use common::{axis, stop_periods, Check};
+
 #[derive(Clone, Copy, Debug)]
 enum Act {
     /// Continuous jog at `frac` of the velocity limit for `periods`, renewed every `renew`
@@ -43,94 +46,6 @@ fn act() -> impl Strategy<Value = Act> {
             }),
         (0.0..=1.0f64, 0.01..=1.0f64).prop_map(|(at, speed)| Act::To { at, speed }),
     ]
-}
-
-/// An axis: velocity 1..500, acceleration 10..10 000, jerk 10 to 10 000 times the
-/// acceleration a second, travel 1..1 000 wide, period 1, 2 or 4 ms.
-fn axis() -> impl Strategy<Value = (JogLimits, f64)> {
-    (
-        0.0..1.0f64,
-        0.0..1.0f64,
-        0.0..1.0f64,
-        1.0..1000.0f64,
-        prop_oneof![Just(0.001), Just(0.002), Just(0.004)],
-    )
-        .prop_map(|(v, a, j, width, period)| {
-            let acceleration = 10.0 * 1000f64.powf(a);
-            (
-                JogLimits {
-                    velocity: 500f64.powf(v),
-                    acceleration,
-                    jerk: acceleration * 10.0 * 1000f64.powf(j),
-                    min: -width / 3.0,
-                    max: 2.0 * width / 3.0,
-                },
-                period,
-            )
-        })
-}
-
-/// The setpoints, checked window by window as they come.
-struct Check {
-    lim: JogLimits,
-    period: f64,
-    last: [f64; 3],
-    n: u64,
-}
-
-impl Check {
-    fn new(start: f64, lim: JogLimits, period: f64) -> Self {
-        Check {
-            lim,
-            period,
-            last: [start; 3],
-            n: 0,
-        }
-    }
-
-    fn see(&mut self, p: f64) -> Result<(), TestCaseError> {
-        let [p0, p1, p2] = self.last;
-        let ts = self.period;
-        let v = (p - p2).abs() / ts;
-        let a = (p - 2.0 * p2 + p1).abs() / (ts * ts);
-        let j = (p - 3.0 * p2 + 3.0 * p1 - p0).abs() / (ts * ts * ts);
-        let l = &self.lim;
-        // Rounding of positions near 1 000 (1e-13) over the period's powers.
-        let noise = 1e-12 * (1.0 + p.abs());
-        prop_assert!(
-            v <= l.velocity * (1.0 + 1e-9) + noise / ts,
-            "v {v} > {} at {}",
-            l.velocity,
-            self.n
-        );
-        prop_assert!(
-            a <= l.acceleration * (1.0 + 1e-9) + 4.0 * noise / (ts * ts),
-            "a {a} > {} at {}",
-            l.acceleration,
-            self.n
-        );
-        prop_assert!(
-            j <= l.jerk * (1.0 + 1e-9) + 8.0 * noise / (ts * ts * ts),
-            "j {j} > {} at {}",
-            l.jerk,
-            self.n
-        );
-        prop_assert!(
-            p >= l.min - 1e-9 && p <= l.max + 1e-9,
-            "{p} outside {}..{}",
-            l.min,
-            l.max
-        );
-        self.last = [p1, p2, p];
-        self.n += 1;
-        Ok(())
-    }
-}
-
-/// Periods a stop can take from anywhere: the longest change from full speed, and two.
-fn stop_periods(lim: &JogLimits, period: f64) -> u32 {
-    let t = 2.0 * lim.velocity / lim.acceleration + 2.0 * lim.acceleration / lim.jerk;
-    (t / period).ceil() as u32 + 2
 }
 
 const DEADMAN: u32 = 100;
