@@ -233,7 +233,7 @@ impl<'s> Mdi<'s> {
         while let Some(e) = self.entries.take_read() {
             out.push(e);
         }
-        self.entries.end_line_waits();
+        self.entries.end_mdi_line();
         match self.entries.unfinished() {
             Some(what) => Err(MdiError::Unfinished {
                 line,
@@ -260,6 +260,7 @@ impl<'s> Mdi<'s> {
                     // its error is dropped with the rest of the output).
                     while self.entries.read_line().is_some() {}
                     while self.entries.take_read().is_some() {}
+                    self.entries.end_mdi_line();
                 }
             }
         }

@@ -133,11 +133,14 @@ impl<'s, S: LineSource> Entries<'s, S> {
         }
     }
 
-    /// What the next motion block would wait for (a `G04`, `M00`, `M06` with no move
-    /// after it on its line), dropped: an MDI line's waits are its own, reported among
-    /// its actions, and do not hold the next line's move.
-    pub(crate) fn end_line_waits(&mut self) {
+    /// An MDI line read to its end. What the next motion block would wait for (a `G04`,
+    /// `M00`, `M06` with no move after it on its line) is dropped: an MDI line's waits are
+    /// its own, reported among its actions, and do not hold the next line's move. And the
+    /// budget of lines run again starts afresh, as for a program: a session a machine keeps
+    /// for months does not run out of it.
+    pub(crate) fn end_mdi_line(&mut self) {
         self.parser.wait = nc_geom::program::Wait::default();
+        self.interp.budget = self.interp.max_loop_lines;
     }
 
     /// The tool stands at `here` (tool tip, the program's frame, mm) with `orientation`: the

@@ -190,7 +190,9 @@ fn actions_come_with_their_line() {
     );
     let out = take(&mut mdi, "G4 P0.5");
     assert!(!out.is_empty(), "a dwell is an action: {out:?}");
-    // It is the line's own: the next line's move does not wait.
+    // It is the line's own: the next line's move does not wait, not even after a refusal
+    // rebuilt the session from its lines.
+    mdi.line("G0 X[1/0]").expect_err("refused");
     let out = take(&mut mdi, "G0 X1");
     match &out[..] {
         [Entry::Block(_, Block::Linear(m))] => {
