@@ -8,12 +8,14 @@ pub mod cyclic;
 pub mod health;
 mod home;
 pub mod homing;
+mod reset;
 pub mod setup;
 
 pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
 pub use health::{BusCondition, BusHealth, Reaction};
 pub use home::HomeRefused;
 pub use homing::{HomeRequest, HomingError, HomingState};
+pub use reset::{ResetRefused, RESET_CYCLES};
 pub use setup::{
     configure, configure_nodes, Clock, NodeSetup, Protections, SetupError, SetupErrorKind,
     SetupOptions, VelocitySetup, WallClock, FOLLOWING_OFF,

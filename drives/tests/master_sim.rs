@@ -5,12 +5,18 @@
 //!
 //! Master and drives are stepped in turn on a virtual clock (`Lockstep`): the master's
 //! cycle sends its frames, the drives answer them, the clock moves on a period. No test
-//! sleeps or reads the system clock, so none depends on how busy the machine is.
+//! sleeps or reads the system clock, so none depends on how busy the machine is. The
+//! master's cycle and its reset allocate nothing, faults included (a counting allocator,
+//! armed around the master's calls only: the simulated drives allocate).
+
+#[global_allocator]
+static ALLOC: test_support::CountingAlloc = test_support::CountingAlloc;
 
 use drives::cia402::{Goal, State};
 use drives::link::{CanLink, SocketLink};
 use drives::master::{
-    configure, Clock, DriveFault, FaultCause, Master, SetupErrorKind, SetupOptions, Supervision,
+    configure, Clock, DriveFault, FaultCause, Master, ResetRefused, SetupErrorKind, SetupOptions,
+    Supervision, RESET_CYCLES,
 };
 use drives::sim::{Faults, Lockstep, Record, SimBus, SimNodeConfig};
 use drives::wire::NodeId;
@@ -34,7 +40,10 @@ impl Rig {
     /// clock a period on.
     fn cycle(&mut self, targets: &[i32]) {
         let now = self.drives.now();
+        test_support::arm_this_thread();
         self.m.cycle(targets, now.as_secs_f64());
+        let events = test_support::disarm_this_thread();
+        assert_eq!(events, 0, "heap events in the master's cycle");
         self.drives.advance_to(now);
         self.drives
             .advance_to(now + Duration::from_secs_f64(PERIOD));
@@ -412,5 +421,111 @@ fn a_pre_operational_heartbeat_queued_from_the_set_up_is_not_a_fault() {
     assert_eq!(
         f.cause,
         FaultCause::NotOperational(NmtState::PreOperational)
+    );
+}
+
+/// The operator's reset (issue 55): after a drive fault and the quick stop, `reset` sends
+/// the faulted drive the fault-reset edge (the simulated drive leaves Fault only on a
+/// rising bit 7) and leaves every drive Switch on disabled; enabling again resumes where
+/// each drive stands, with no step, and the program goes on.
+#[test]
+fn a_reset_clears_a_drive_fault_and_the_drives_enable_again_where_they_stand() {
+    let (mut rig, initial) = start(3, |i| Faults {
+        fault_at_sync: (i == 2).then_some(300),
+        ..Faults::default()
+    });
+    // Refused while nothing is faulted.
+    assert_eq!(rig.m.reset(), Err(ResetRefused::NoFault));
+    let mut targets = initial.clone();
+    let mut stopping_refused = false;
+    for k in 0..2000 {
+        for (t, i) in targets.iter_mut().zip(&initial) {
+            *t = i + 10 * k;
+        }
+        rig.cycle(&targets);
+        if rig.m.fault().is_some() && !stopping_refused {
+            // The quick stop has only begun.
+            assert!(matches!(rig.m.reset(), Err(ResetRefused::Stopping(_))));
+            stopping_refused = true;
+        }
+        if rig.m.fault().is_some() && rig.m.goal() == Goal::Disabled {
+            break;
+        }
+    }
+    assert!(stopping_refused);
+    test_support::arm_this_thread();
+    let reset = rig.m.reset();
+    assert_eq!(
+        test_support::disarm_this_thread(),
+        0,
+        "heap events in the reset"
+    );
+    let f = reset.expect("reset once stopped");
+    assert_eq!(f.node, 2, "{f}");
+    assert!(rig.m.fault().is_none());
+    // Held where they stand, the faulted drive reset: all Switch on disabled, none enabled.
+    let held: Vec<i32> = rig.m.status().iter().map(|n| n.actual).collect();
+    for _ in 0..(RESET_CYCLES as usize) {
+        rig.cycle(&held);
+        assert!(rig.m.fault().is_none(), "{:?}", rig.m.fault());
+    }
+    assert!(
+        rig.m.all_in(State::SwitchOnDisabled),
+        "{:?}",
+        rig.m.status()
+    );
+    // On again: enabled where they stand, then a ramp from there for 500 cycles.
+    rig.m.set_goal(Goal::Enabled);
+    for _ in 0..200 {
+        rig.cycle(&held);
+        if rig.m.all_in(State::OperationEnabled) {
+            break;
+        }
+    }
+    assert!(
+        rig.m.all_in(State::OperationEnabled),
+        "{:?}",
+        rig.m.status()
+    );
+    let from: Vec<i32> = rig.m.status().iter().map(|n| n.actual).collect();
+    assert_eq!(from, held, "enabling moved nothing");
+    for k in 0..500 {
+        let t: Vec<i32> = from.iter().map(|p| p + 10 * k).collect();
+        rig.cycle(&t);
+        assert!(rig.m.fault().is_none(), "{:?}", rig.m.fault());
+    }
+    let end: Vec<i32> = rig.m.status().iter().map(|n| n.actual).collect();
+    assert!(
+        end.iter()
+            .zip(&from)
+            .all(|(e, f)| (e - f - 4990).abs() <= 20),
+        "{end:?} {from:?}"
+    );
+}
+
+/// A cause still there comes back with its reason: a node silent for good is raised again
+/// after the reset, with no feedback from it.
+#[test]
+fn a_reset_with_the_cause_still_there_faults_again_naming_it() {
+    let (mut rig, initial) = start(3, |i| Faults {
+        silent_from_sync: (i == 3).then_some(300),
+        ..Faults::default()
+    });
+    run(&mut rig, &initial, 3000, |m| {
+        m.fault().is_some() && m.goal() == Goal::Disabled
+    });
+    let f = rig.m.reset().expect("reset once stopped");
+    assert_eq!(f.node, 3, "{f}");
+    let held: Vec<i32> = rig.m.status().iter().map(|n| n.actual).collect();
+    for _ in 0..50 {
+        rig.cycle(&held);
+    }
+    let again = expect_fault(rig.m.fault(), 3);
+    assert!(
+        matches!(
+            again.cause,
+            FaultCause::NoFeedback(_) | FaultCause::HeartbeatLost { .. }
+        ),
+        "{again}"
     );
 }

@@ -157,6 +157,9 @@ pub struct Master<L: CanLink> {
     bus_pending: Option<BusCondition>,
     /// The clock value the master was created at, s.
     started: f64,
+    /// An operator's reset under way (`reset.rs`): the cycle by which every drive must
+    /// have left Fault.
+    pub(super) resetting: Option<u64>,
 }
 
 impl<L: CanLink> Master<L> {
@@ -226,6 +229,7 @@ impl<L: CanLink> Master<L> {
             jobs: [None; MAX_NODES],
             homing: [HomingState::Idle; MAX_NODES],
             started: now,
+            resetting: None,
         })
     }
 
@@ -393,6 +397,8 @@ impl<L: CanLink> Master<L> {
                 n.state
             };
             let cause = match state {
+                // A reset under way: the fault-reset edge is on its way.
+                Some(State::Fault | State::FaultReactionActive) if self.reset_pending() => None,
                 Some(state @ (State::Fault | State::FaultReactionActive)) => {
                     Some(FaultCause::DriveFault {
                         state,
@@ -464,6 +470,7 @@ impl<L: CanLink> Master<L> {
         self.receive(now);
         self.watch_bus();
         self.supervise(now);
+        self.reset_progress();
         let goal = self.goal;
         let hold = self.fault.is_some();
         // SDO requests of the homings under way first, then the RPDOs and the SYNC.
@@ -484,7 +491,12 @@ impl<L: CanLink> Master<L> {
                 let _ = out.push(rpdo1_io(n.node, n.target as u8));
                 continue;
             }
-            let mut cw = n.seq.step(state, goal);
+            // A drive in Fault during a reset gets the fault-reset edge, whatever the goal.
+            let node_goal = match state {
+                State::Fault if self.resetting.is_some() => Goal::Enabled,
+                _ => goal,
+            };
+            let mut cw = n.seq.step(state, node_goal);
             let (homes, start) = homing[i];
             if start && state == State::OperationEnabled {
                 cw.0 |= START;
