@@ -5,13 +5,17 @@
 //! `index:sub` and the abort code in words), so that an integrator can act on them.
 
 pub mod cyclic;
+pub mod estop;
 pub mod health;
 mod home;
 pub mod homing;
 mod reset;
 pub mod setup;
 
-pub use cyclic::{DriveFault, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES};
+pub use cyclic::{
+    DriveFault, EStop, FaultCause, Master, NodeKind, NodeStatus, Supervision, MAX_NODES,
+};
+pub use estop::EStopRefused;
 pub use health::{BusCondition, BusHealth, Reaction};
 pub use home::HomeRefused;
 pub use homing::{HomeRequest, HomingError, HomingState};

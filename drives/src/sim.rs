@@ -180,6 +180,8 @@
 //!   [`NodeCounters::dropped`]); `Some(0)` drops nothing.
 //! * `silent_from_sync: Some(n)`: from SYNC `n` on every frame the node would send is lost
 //!   (counted in [`NodeCounters::dropped`]).
+//! * `estop_chain`: an I/O module's input wired to an e-stop chain ([`EStopChain`]): it
+//!   reads 1 while the chain is closed, 0 while it is open (a button pressed).
 #![forbid(unsafe_code)]
 
 mod dictionary;
@@ -280,6 +282,28 @@ pub struct Faults {
     /// Writes of this object (index, sub) are acknowledged and not kept: a drive that keeps
     /// its own value, which only reading it back finds.
     pub keeps_object: Option<(u16, u8)>,
+    /// An I/O module's input wired to an e-stop chain: that bit of 0x6000:01 reads 1 (the
+    /// chain closed) but from SYNC `opens` up to SYNC `closes` (not included), where it
+    /// reads 0 (a button pressed, then released).
+    pub estop_chain: Option<EStopChain>,
+}
+
+/// An e-stop chain on an input of a simulated I/O module ([`Faults::estop_chain`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EStopChain {
+    /// The input bit, 0..=7.
+    pub bit: u8,
+    pub opens: Option<u64>,
+    pub closes: Option<u64>,
+}
+
+impl EStopChain {
+    /// The chain is closed at SYNC `sync`.
+    pub fn closed(&self, sync: u64) -> bool {
+        let opened = self.opens.is_some_and(|o| sync >= o);
+        let closed_again = self.closes.is_some_and(|c| sync >= c);
+        !opened || closed_again
+    }
 }
 
 /// One node at one SYNC in operational: the target that took effect and what the node

@@ -39,6 +39,7 @@ impl FaultArgs {
                 .map(|x| x.1),
             silent_from_sync: find(&self.silent_from),
             keeps_object: None,
+            estop_chain: None,
         }
     }
 }

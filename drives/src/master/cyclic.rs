@@ -100,6 +100,17 @@ pub enum FaultCause {
     Link(LinkError),
     #[error("{0}")]
     Bus(BusCondition),
+    #[error("{0}")]
+    EStop(EStop),
+}
+
+/// What stopped the machine at an e-stop (`estop.rs`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EStop {
+    #[error("e-stop requested")]
+    Requested,
+    #[error("e-stop: input {bit} open (the e-stop chain)")]
+    Input { bit: u8 },
 }
 
 /// A fault with the node it came from ([`DriveFault::BUS`] for the bus itself).
@@ -114,6 +125,8 @@ impl DriveFault {
     /// The node of a fault of the bus or the link, not of one drive (CANopen nodes are
     /// 1..=127).
     pub const BUS: u8 = 0;
+    /// The "node" of an e-stop the operator asked for ([`Master::estop`]).
+    pub const OPERATOR: u8 = 128;
 }
 
 /// "node 3", or "CAN bus" for [`DriveFault::BUS`].
@@ -123,6 +136,7 @@ impl core::fmt::Display for NodeName {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self.0 {
             DriveFault::BUS => write!(f, "CAN bus"),
+            DriveFault::OPERATOR => write!(f, "operator"),
             n => write!(f, "node {n}"),
         }
     }
@@ -160,6 +174,8 @@ pub struct Master<L: CanLink> {
     /// An operator's reset under way (`reset.rs`): the cycle by which every drive must
     /// have left Fault.
     pub(super) resetting: Option<u64>,
+    /// The e-stop chain's input: the I/O node's index and the bit (`estop.rs`).
+    pub(super) estop_input: Option<(usize, u8)>,
 }
 
 impl<L: CanLink> Master<L> {
@@ -230,6 +246,7 @@ impl<L: CanLink> Master<L> {
             homing: [HomingState::Idle; MAX_NODES],
             started: now,
             resetting: None,
+            estop_input: None,
         })
     }
 
@@ -306,7 +323,7 @@ impl<L: CanLink> Master<L> {
         }
     }
 
-    fn raise(&mut self, node: u8, cause: FaultCause) {
+    pub(super) fn raise(&mut self, node: u8, cause: FaultCause) {
         if self.fault.is_none() {
             self.fault = Some(DriveFault { node, cause });
             self.goal = Goal::QuickStop;
@@ -435,6 +452,7 @@ impl<L: CanLink> Master<L> {
                 self.raise(node, cause);
             }
         }
+        self.supervise_estop();
         // After a quick stop has taken every drive out of motion, take the power off.
         if self.fault.is_some()
             && self.goal == Goal::QuickStop

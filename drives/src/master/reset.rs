@@ -5,7 +5,8 @@
 //! caller asks for that with [`Master::set_goal`], and each drive then resumes cyclic
 //! synchronous position where it stands.
 //!
-//! A cause that is still there is raised again with its reason: a drive that stays in Fault
+//! Refused while the e-stop chain is open. A cause that is still there is raised again
+//! with its reason: a drive that stays in Fault
 //! [`RESET_CYCLES`] after the reset, a node still silent, a heartbeat still lost.
 
 use super::cyclic::{DriveFault, Master};
@@ -22,6 +23,10 @@ pub enum ResetRefused {
     NoFault,
     #[error("the quick stop after the fault ({0}) is still under way: reset once the drives are out of motion")]
     Stopping(DriveFault),
+    #[error(
+        "the e-stop chain is open (input {bit} of node {node} reads 0): release the e-stop first"
+    )]
+    EStopOpen { node: u8, bit: u8 },
 }
 
 impl<L: CanLink> Master<L> {
@@ -31,6 +36,9 @@ impl<L: CanLink> Master<L> {
         let fault = self.fault.ok_or(ResetRefused::NoFault)?;
         if self.goal != Goal::Disabled {
             return Err(ResetRefused::Stopping(fault));
+        }
+        if let Some((node, bit)) = self.estop_open() {
+            return Err(ResetRefused::EStopOpen { node, bit });
         }
         self.fault = None;
         self.resetting = Some(self.cycles().saturating_add(RESET_CYCLES));

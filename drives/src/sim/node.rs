@@ -402,5 +402,15 @@ impl SimNode {
             App::Drive(d) => d.publish(&mut self.dict),
             App::Io(io) => io.publish(&mut self.dict),
         }
+        if let (App::Io(_), Some(chain)) = (&self.app, self.faults.estop_chain) {
+            let inputs = self.dict.get(od::DIGITAL_INPUTS, 1);
+            let bit = 1 << (chain.bit & 7);
+            let inputs = if chain.closed(self.last_sync) {
+                inputs | bit
+            } else {
+                inputs & !bit
+            };
+            self.dict.set(od::DIGITAL_INPUTS, 1, inputs);
+        }
     }
 }
