@@ -71,3 +71,47 @@ fn outputs_reach_the_module_and_the_path_waits_for_its_inputs() {
     assert!(module.iter().skip(last_on + 1).all(|b| b & 0x08 == 0));
     assert_eq!(*module.last().unwrap(), 0, "all off at the end");
 }
+
+/// The posts' machine with its e-stop chain on module input 8 (`[io] estop_input`), and
+/// the run of `src` with the simulated module's chain opening at SYNC `opens`.
+fn run_with_estop(src: &str, opens: Option<u64>) -> dnurbs_tools::report::Report {
+    let text = std::fs::read_to_string(common::root().join("tests/data/posts/machine.toml"))
+        .expect("the posts machine")
+        .replace("first_input = 3\n", "first_input = 3\nestop_input = 8\n");
+    let path = common::temp("estop-machine.toml");
+    std::fs::write(&path, text).expect("a temp file");
+    let m = config::load(&path).expect("the posts machine with its e-stop");
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(m.bus_io.and_then(|io| io.estop_input), Some(8));
+    let opts = common::run_options("estop.ngc", None);
+    let chain = drives::sim::EStopChain {
+        bit: 7,
+        opens,
+        closes: None,
+    };
+    let faults = |n: u8| drives::sim::Faults {
+        estop_chain: (n == 7).then_some(chain),
+        ..Default::default()
+    };
+    let (r, _) = common::run_simulated(src.as_bytes(), &m, faults, &opts, |_, _| {});
+    r.report("estop.ngc", &m.name)
+}
+
+#[test]
+fn the_e_stop_chain_opening_stops_the_run_naming_the_module_and_its_input() {
+    let src = "G21 G90 G94\nG0 X0 Y0 Z50\nG1 X200 F600\nG1 Y100\nM2\n";
+    // Closed throughout: the run completes.
+    let rep = run_with_estop(src, None);
+    assert_eq!(rep.exit_code, 0, "{}", rep.text());
+    // Opened mid-move: stopped by a fault that names the module and the input.
+    let rep = run_with_estop(src, Some(3000));
+    assert_eq!(
+        rep.exit_code,
+        dnurbs_tools::exit::STOPPED_FAULT,
+        "{}",
+        rep.text()
+    );
+    assert_eq!(rep.stop_node, Some(7), "{}", rep.text());
+    let text = rep.text();
+    assert!(text.contains("e-stop: input 8 open"), "{text}");
+}

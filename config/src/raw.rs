@@ -55,6 +55,8 @@ pub(crate) struct RawIo {
     pub digital_inputs: Option<i64>,
     pub analog_outputs: Option<i64>,
     pub analog_inputs: Option<i64>,
+    /// Module input 1..=8 wired to the normally closed e-stop chain.
+    pub estop_input: Option<i64>,
 }
 
 /// `[program]`: start-up modes, tool table, subroutine path, loop limit; every key optional.

@@ -181,6 +181,8 @@ fn io_counts_and_machine_m_codes() {
         "{MINIMAL}\n[io]\ndigital_outputs = 1\nfirst_output = 3\n"
     ));
     assert_mentions(&shown, &["io.first_output", "machine with a bus"]);
+    let (_, shown) = fail(&format!("{MINIMAL}\n[io]\nestop_input = 1\n"));
+    assert_mentions(&shown, &["io.estop_input", "machine with a bus"]);
 }
 
 /// A machine with a bus and `[io]`: its digital outputs and inputs are consecutive bits of
@@ -228,7 +230,21 @@ fn io_on_a_bus_is_bits_of_the_one_io_module() {
     .unwrap();
     assert_eq!(m.bus_io.map(|b| (b.at.node, b.first_output)), Some((7, 3)));
     assert_eq!(m.io_module(0), Some(7));
+    // The e-stop chain on an input of its own.
+    let m = common::parse(&with_bus(
+        "[io]\nbus = \"can0\"\nnode = 9\ndigital_inputs = 2\nestop_input = 8\n",
+    ))
+    .unwrap();
+    assert_eq!(m.bus_io.and_then(|b| b.estop_input), Some(8));
     for (extra, parts) in [
+        (
+            "[io]\nbus = \"can0\"\nnode = 9\nestop_input = 9\n",
+            &["io.estop_input", "9", "module input 1..=8"][..],
+        ),
+        (
+            "[io]\nbus = \"can0\"\nnode = 9\ndigital_inputs = 2\nestop_input = 2\n",
+            &["io.estop_input", "M66 inputs (module inputs 1..=2)"][..],
+        ),
         ("[io]\ndigital_outputs = 1\n", &["io.bus", "bus and node"][..]),
         (
             "[io]\nbus = \"can0\"\nnode = 9\nanalog_outputs = 1\n",

@@ -22,7 +22,9 @@ use std::time::Duration;
 const PERIOD: f64 = 0.002;
 const AXIS: u8 = 1;
 const IO: u8 = 7;
-const BIT: u8 = 3;
+/// Module input 4 (bit 3).
+const INPUT: u8 = 4;
+const BIT: u8 = INPUT - 1;
 
 fn id(n: u8) -> NodeId {
     NodeId::new(n).unwrap()
@@ -96,9 +98,13 @@ fn start(chain: EStopChain) -> Rig {
     };
     let now = sim.now().as_secs_f64();
     let mut m = Master::with_kinds(link, &kinds, &initial, sup, now).unwrap();
-    assert_eq!(m.watch_estop(id(AXIS), BIT), Err(EStopRefused::NotIo(AXIS)));
-    assert_eq!(m.watch_estop(id(IO), 8), Err(EStopRefused::Bit(8)));
-    m.watch_estop(id(IO), BIT).expect("the module's input");
+    assert_eq!(
+        m.watch_estop(id(AXIS), INPUT),
+        Err(EStopRefused::NotIo(AXIS))
+    );
+    assert_eq!(m.watch_estop(id(IO), 9), Err(EStopRefused::Input(9)));
+    assert_eq!(m.watch_estop(id(IO), 0), Err(EStopRefused::Input(0)));
+    m.watch_estop(id(IO), INPUT).expect("the module's input");
     let mut rig = Rig { m, sim };
     rig.enable(&[0, 0]);
     rig
@@ -120,17 +126,20 @@ fn the_chain_opening_stops_the_machine_and_reset_waits_for_it_to_close() {
     assert!(rig.ramp(0, 2000, stopped), "stopped");
     let f = *rig.m.fault().expect("an e-stop");
     assert_eq!(f.node, IO, "{f}");
-    assert_eq!(f.cause, FaultCause::EStop(EStop::Input { bit: BIT }));
+    assert_eq!(f.cause, FaultCause::EStop(EStop::Input { input: INPUT }));
     assert_eq!(
         f.to_string(),
-        "node 7: e-stop: input 3 open (the e-stop chain)"
+        "node 7: e-stop: input 4 open (the e-stop chain)"
     );
     assert_eq!(rig.m.status()[1].target, 0, "the outputs off");
     // Open: the reset is refused, and changes nothing.
     let held = [rig.m.status()[0].actual, 0];
     assert_eq!(
         rig.m.reset(),
-        Err(ResetRefused::EStopOpen { node: IO, bit: BIT })
+        Err(ResetRefused::EStopOpen {
+            node: IO,
+            input: INPUT
+        })
     );
     assert!(rig.m.fault().is_some());
     // Released: reset, enable where it stands, and on.

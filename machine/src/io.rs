@@ -18,6 +18,9 @@ pub struct BusIo {
     /// Module input 1..=8 that `M66 P0` reads (`P<n>`: `first_input + n`), and how many.
     pub first_input: u8,
     pub inputs: u8,
+    /// Module input 1..=8 wired to the machine's normally closed e-stop chain: when it
+    /// reads 0 every drive is quick-stopped and disabled (`[io] estop_input`).
+    pub estop_input: Option<u8>,
 }
 
 impl BusIo {
@@ -66,6 +69,7 @@ mod tests {
             outputs: 4,
             first_input: 5,
             inputs: 2,
+            estop_input: None,
         };
         // P0 -> output 3 (bit 2), P3 -> output 6 (bit 5); P4 is none of the machine's.
         assert_eq!(io.output_byte(0b1001), 0b0010_0100);

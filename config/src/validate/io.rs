@@ -45,6 +45,7 @@ pub(crate) fn io(
         let given = [
             ("first_output", raw.first_output),
             ("first_input", raw.first_input),
+            ("estop_input", raw.estop_input),
         ];
         if let Some((key, Some(v))) = given.into_iter().find(|(_, v)| v.is_some()) {
             let rule = "is for a machine with a bus (its I/O module's bits): a simulated \
@@ -92,12 +93,14 @@ pub(crate) fn io(
         ));
     }
     let first_input = bits(check, "input", raw.first_input, counts.digital_inputs)?;
+    let estop_input = estop(check, raw.estop_input, first_input, counts.digital_inputs)?;
     let bus_io = BusIo {
         at,
         first_output,
         outputs: counts.digital_outputs,
         first_input,
         inputs: counts.digital_inputs,
+        estop_input,
     };
     Ok((counts, Some(bus_io)))
 }
@@ -154,4 +157,29 @@ fn bits(
         return Err(check.invalid(&["io", &key], Some(first.to_string()), rule));
     }
     Ok(first as u8)
+}
+
+/// `estop_input`: a module input 1..=8 that none of the program's `M66` inputs is.
+fn estop(
+    check: &Check<'_, '_>,
+    input: Option<i64>,
+    first_input: u8,
+    inputs: u8,
+) -> Result<Option<u8>, ConfigError> {
+    let Some(n) = input else {
+        return Ok(None);
+    };
+    let program = i64::from(first_input)..i64::from(first_input) + i64::from(inputs);
+    let rule = if !(1..=i64::from(MODULE_BITS)).contains(&n) {
+        format!("must be a module input 1..={MODULE_BITS} (0x6000:01): the one the normally closed e-stop chain is wired to")
+    } else if program.contains(&n) {
+        format!(
+            "is one of the program's M66 inputs (module inputs {}..={}): the e-stop chain needs an input of its own",
+            program.start,
+            program.end - 1
+        )
+    } else {
+        return Ok(Some(n as u8));
+    };
+    Err(check.invalid(&["io", "estop_input"], Some(n.to_string()), rule))
 }

@@ -109,8 +109,9 @@ pub enum FaultCause {
 pub enum EStop {
     #[error("e-stop requested")]
     Requested,
-    #[error("e-stop: input {bit} open (the e-stop chain)")]
-    Input { bit: u8 },
+    /// The chain on module input `input` (1..=8) opened.
+    #[error("e-stop: input {input} open (the e-stop chain)")]
+    Input { input: u8 },
 }
 
 /// A fault with the node it came from ([`DriveFault::BUS`] for the bus itself).
@@ -174,7 +175,8 @@ pub struct Master<L: CanLink> {
     /// An operator's reset under way (`reset.rs`): the cycle by which every drive must
     /// have left Fault.
     pub(super) resetting: Option<u64>,
-    /// The e-stop chain's input: the I/O node's index and the bit (`estop.rs`).
+    /// The e-stop chain's input: the I/O node's index and the module input 1..=8
+    /// (`estop.rs`).
     pub(super) estop_input: Option<(usize, u8)>,
 }
 

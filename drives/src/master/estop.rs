@@ -19,22 +19,22 @@ pub enum EStopRefused {
         "node {0} is not an I/O module of this bus: the e-stop chain must be one of its inputs"
     )]
     NotIo(u8),
-    #[error("input bit {0}: the I/O module has inputs 0..=7")]
-    Bit(u8),
+    #[error("input {0}: the I/O module has inputs 1..=8")]
+    Input(u8),
 }
 
 impl<L: CanLink> Master<L> {
-    /// Watch input `bit` of I/O module `node` as the e-stop chain (closed: 1).
-    pub fn watch_estop(&mut self, node: NodeId, bit: u8) -> Result<(), EStopRefused> {
-        if bit > 7 {
-            return Err(EStopRefused::Bit(bit));
+    /// Watch input `input` (1..=8) of I/O module `node` as the e-stop chain (closed: 1).
+    pub fn watch_estop(&mut self, node: NodeId, input: u8) -> Result<(), EStopRefused> {
+        if !(1..=8).contains(&input) {
+            return Err(EStopRefused::Input(input));
         }
         let i = self
             .nodes
             .iter()
             .position(|n| n.node == node && n.kind == NodeKind::Io)
             .ok_or(EStopRefused::NotIo(node.get()))?;
-        self.estop_input = Some((i, bit));
+        self.estop_input = Some((i, input));
         Ok(())
     }
 
@@ -49,17 +49,17 @@ impl<L: CanLink> Master<L> {
         }
     }
 
-    /// The chain's node and bit, if it is open now.
+    /// The chain's node and input, if it is open now.
     pub(super) fn estop_open(&self) -> Option<(u8, u8)> {
-        let (i, bit) = self.estop_input?;
+        let (i, input) = self.estop_input?;
         let n = self.nodes.get(i)?;
-        (n.actual & (1 << bit) == 0).then_some((n.node.get(), bit))
+        (n.actual & (1 << (input - 1)) == 0).then_some((n.node.get(), input))
     }
 
     /// Raised when the chain is open.
     pub(super) fn supervise_estop(&mut self) {
-        if let Some((node, bit)) = self.estop_open() {
-            self.raise(node, FaultCause::EStop(EStop::Input { bit }));
+        if let Some((node, input)) = self.estop_open() {
+            self.raise(node, FaultCause::EStop(EStop::Input { input }));
         }
     }
 }

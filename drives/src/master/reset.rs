@@ -24,9 +24,9 @@ pub enum ResetRefused {
     #[error("the quick stop after the fault ({0}) is still under way: reset once the drives are out of motion")]
     Stopping(DriveFault),
     #[error(
-        "the e-stop chain is open (input {bit} of node {node} reads 0): release the e-stop first"
+        "the e-stop chain is open (input {input} of node {node} reads 0): release the e-stop first"
     )]
-    EStopOpen { node: u8, bit: u8 },
+    EStopOpen { node: u8, input: u8 },
 }
 
 impl<L: CanLink> Master<L> {
@@ -37,8 +37,8 @@ impl<L: CanLink> Master<L> {
         if self.goal != Goal::Disabled {
             return Err(ResetRefused::Stopping(fault));
         }
-        if let Some((node, bit)) = self.estop_open() {
-            return Err(ResetRefused::EStopOpen { node, bit });
+        if let Some((node, input)) = self.estop_open() {
+            return Err(ResetRefused::EStopOpen { node, input });
         }
         self.fault = None;
         self.resetting = Some(self.cycles().saturating_add(RESET_CYCLES));

@@ -113,6 +113,13 @@ pub(super) fn set_up<L: CanLink, C: Clock>(
         bus = bus.with_coolant(c.clone());
     }
     if let Some(io) = machine.bus_io.filter(|b| b.on_bus(bi)) {
+        if let Some(input) = io.estop_input {
+            let node = drives::wire::NodeId::new(io.at.node)
+                .ok_or_else(|| anyhow::anyhow!("{bus_name}: node {} of [io]", io.at.node))?;
+            bus.master
+                .watch_estop(node, input)
+                .map_err(|e| anyhow::anyhow!("{bus_name}: [io] estop_input: {e}"))?;
+        }
         bus = bus.with_io(io);
     }
     Ok(bus)
