@@ -10,10 +10,8 @@
 //! types, junk among them).
 
 mod common;
-use common::posts;
 
 use dnurbs_tools::setup::MachineSetup;
-use dnurbs_tools::shop::{parse_setup, ShopArgs};
 use nc_geom::kinematics::Kinematics;
 use nc_geom::program::Block;
 use nc_lang::mdi::{self, Mdi};
@@ -26,17 +24,8 @@ struct Machine {
 }
 
 fn machine() -> Machine {
-    let m = config::load(&posts("machine.toml")).expect("the posts machine");
-    let shop = ShopArgs {
-        tools: Some(posts("tool.tbl")),
-        ..ShopArgs::default()
-    }
-    .load()
-    .expect("the tool table");
-    Machine {
-        parse: parse_setup(&m, &shop).unwrap(),
-        setup: MachineSetup::new(&m),
-    }
+    let (setup, parse) = common::posts_machine();
+    Machine { setup, parse }
 }
 
 /// What one line did on the machine.

@@ -22,12 +22,7 @@ fn machine() -> config::Machine {
 }
 
 fn shop() -> dnurbs_tools::shop::ShopOptions {
-    ShopArgs {
-        tools: Some(posts("tool.tbl")),
-        ..ShopArgs::default()
-    }
-    .load()
-    .expect("the tool table")
+    common::posts_shop()
 }
 
 #[test]

@@ -11,7 +11,7 @@ mod common;
 use common::{posts, POSTS};
 
 use dnurbs_tools::setup::MachineSetup;
-use dnurbs_tools::shop::{parse_setup, ShopArgs};
+use dnurbs_tools::shop::parse_setup;
 use nc_geom::kinematics::MachineKinematics;
 use nc_geom::program::{Block, Program};
 use nc_geom::segment::{build, Segment};
@@ -155,15 +155,7 @@ fn add(
 
 #[test]
 fn a_restart_is_the_program_from_its_line_on_and_plans_within_the_limits() {
-    let m = config::load(&posts("machine.toml")).expect("the posts machine");
-    let shop = ShopArgs {
-        tools: Some(posts("tool.tbl")),
-        ..ShopArgs::default()
-    }
-    .load()
-    .expect("the tool table");
-    let parse = parse_setup(&m, &shop).unwrap();
-    let setup = MachineSetup::new(&m);
+    let (setup, parse) = common::posts_machine();
     let mut total = (0, 0, 0, 0);
     for name in POSTS {
         let prog = dnurbs_tools::load_program(&posts(name), &parse).unwrap();

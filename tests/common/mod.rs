@@ -45,6 +45,23 @@ pub fn posts(name: &str) -> PathBuf {
     root().join("tests/data/posts").join(name)
 }
 
+/// The posts' tool table, as `--tools` loads it.
+pub fn posts_shop() -> dnurbs_tools::shop::ShopOptions {
+    dnurbs_tools::shop::ShopArgs {
+        tools: Some(posts("tool.tbl")),
+        ..dnurbs_tools::shop::ShopArgs::default()
+    }
+    .load()
+    .expect("the tool table")
+}
+
+/// The posts' machine as the planner and as the parser see it (its tool table loaded).
+pub fn posts_machine() -> (dnurbs_tools::setup::MachineSetup, nc_lang::Setup) {
+    let m = config::load(&posts("machine.toml")).expect("the posts machine");
+    let parse = dnurbs_tools::shop::parse_setup(&m, &posts_shop()).expect("the parse setup");
+    (dnurbs_tools::setup::MachineSetup::new(&m), parse)
+}
+
 /// Run `dnurbs` with the given arguments.
 pub fn dnurbs(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_dnurbs"))

@@ -42,11 +42,9 @@ impl<L: CanLink> Master<L> {
     ///
     /// Real-time thread.
     pub fn estop(&mut self) {
+        // Already faulted, the stop is under way or over (the goal cannot be Enabled while
+        // a fault is latched): the first fault stays the one reported.
         self.raise(DriveFault::OPERATOR, FaultCause::EStop(EStop::Requested));
-        // Already faulted: the stop is under way or over; an e-stop asks no less.
-        if self.goal == crate::cia402::Goal::Enabled {
-            self.goal = crate::cia402::Goal::QuickStop;
-        }
     }
 
     /// The chain's node and input, if it is open now.

@@ -90,6 +90,19 @@ pub(crate) struct Frame {
     pub name: String,
 }
 
+impl Frame {
+    /// The main program's frame, at its first line.
+    fn main() -> Self {
+        Frame {
+            src: Src::Main,
+            pc: 0,
+            open: Vec::new(),
+            saved: [0.0; ARGUMENTS],
+            name: String::new(),
+        }
+    }
+}
+
 /// Skipping lines up to the next O-line of `label`: a false branch, a loop's exit.
 #[derive(Clone, Debug)]
 pub(crate) struct Skip {
@@ -189,13 +202,7 @@ impl<S: LineSource> Interp<S> {
         Interp {
             tape: Tape::new(lines),
             params: Params::default(),
-            frames: vec![Frame {
-                src: Src::Main,
-                pc: 0,
-                open: Vec::new(),
-                saved: [0.0; ARGUMENTS],
-                name: String::new(),
-            }],
+            frames: vec![Frame::main()],
             subs: HashMap::new(),
             labels: HashMap::new(),
             skip: None,
@@ -229,13 +236,7 @@ impl<S: LineSource> Interp<S> {
         Interp {
             tape: Tape::new(lines),
             params: self.params,
-            frames: vec![Frame {
-                src: Src::Main,
-                pc: 0,
-                open: Vec::new(),
-                saved: [0.0; ARGUMENTS],
-                name: String::new(),
-            }],
+            frames: vec![Frame::main()],
             subs: self.subs,
             labels: HashMap::new(),
             skip: None,

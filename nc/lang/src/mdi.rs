@@ -33,9 +33,7 @@ use crate::source::LineSource;
 pub use crate::stream::Unfinished;
 use crate::stream::{Entries, Entry};
 use nc_geom::kinematics::MachineKinematics;
-use nc_geom::program::{
-    Action, Block, LinearMove, MoveTooling, Orientation, Program, SrcPos, Wait,
-};
+use nc_geom::program::{Action, Block, MoveTooling, Orientation, Program, SrcPos};
 use std::cell::RefCell;
 use std::collections::VecDeque;
 use std::rc::Rc;
@@ -230,9 +228,6 @@ impl<'s> Mdi<'s> {
                 out.push(e);
             }
         }
-        while let Some(e) = self.entries.take_read() {
-            out.push(e);
-        }
         self.entries.end_mdi_line();
         match self.entries.unfinished() {
             Some(what) => Err(MdiError::Unfinished {
@@ -288,7 +283,6 @@ pub fn program(
         .unwrap_or(0);
     let mut blocks = Vec::with_capacity(out.len() + 1);
     let mut actions = Vec::new();
-    let (here, orientation) = standing.tip(kin);
     let first = out.iter().find_map(|e| match e {
         Entry::Block(_, b) => Some(b),
         Entry::Action(_) => None,
@@ -298,20 +292,7 @@ pub fn program(
         Some(Block::Nurbs(b)) => (b.pos, b.tooling),
         None => (SrcPos::default(), MoveTooling::default()),
     };
-    blocks.push(Block::Linear(LinearMove {
-        pos,
-        n: None,
-        rapid: true,
-        end: here,
-        orientation,
-        feed_mm_min: 0.0,
-        inverse_time: false,
-        tooling: MoveTooling {
-            tool_length: standing.tool_length,
-            wait: Wait::default(),
-            ..tooling
-        },
-    }));
+    blocks.push(standing.start(kin, pos, None, tooling));
     for e in out {
         match e {
             Entry::Block(_, b) => blocks.push(b.clone()),

@@ -49,6 +49,32 @@ impl Standing {
         let machine = Vector3::new(j[0], j[1], j[2] - self.tool_length);
         (kin.unplace(&machine, j[3], j[4]).into(), angles(j))
     }
+
+    /// A program's start block where the machine stands: a rapid of no length to its tool
+    /// tip, at its angles, with its tool length and `tooling`'s mode, waiting for nothing.
+    pub fn start(
+        &self,
+        kin: &MachineKinematics,
+        pos: SrcPos,
+        n: Option<u32>,
+        tooling: MoveTooling,
+    ) -> Block {
+        let (end, orientation) = self.tip(kin);
+        Block::Linear(LinearMove {
+            pos,
+            n,
+            rapid: true,
+            end,
+            orientation,
+            feed_mm_min: 0.0,
+            inverse_time: false,
+            tooling: MoveTooling {
+                tool_length: self.tool_length,
+                wait: Wait::default(),
+                ..tooling
+            },
+        })
+    }
 }
 
 /// What the lines before the restart line left, besides the pose.
@@ -225,19 +251,7 @@ pub fn from_line(
             tooling: MoveTooling { wait, ..tooling },
         })
     };
-    let start = Block::Linear(LinearMove {
-        pos,
-        n,
-        rapid: true,
-        end: here.into(),
-        orientation: here_angles,
-        feed_mm_min: 0.0,
-        inverse_time: false,
-        tooling: MoveTooling {
-            tool_length: standing.tool_length,
-            ..tooling
-        },
-    });
+    let start = standing.start(kin, pos, n, tooling);
     let plunge_rapid =
         feed.is_none() || matches!(blocks.get(first), Some(Block::Linear(l)) if l.rapid);
     let mut out = vec![
