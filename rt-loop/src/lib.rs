@@ -20,6 +20,7 @@ pub mod clock;
 pub mod control;
 pub mod interval;
 pub mod latency;
+pub mod life;
 pub mod os;
 pub mod pipeline;
 pub mod report;

@@ -183,7 +183,7 @@ struct Moving {
 }
 
 /// What [`Pipeline::new`] refuses.
-#[derive(Debug, thiserror::Error)]
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub enum PipelineError {
     #[error(
         "axis {axis} is at {actual:.4} but the program starts at {start:.4}: move it there \
@@ -196,6 +196,13 @@ pub enum PipelineError {
     },
     #[error("the move to the program's start needs more than {0} S-curve phases")]
     ApproachTooComplex(usize),
+}
+
+/// [`Pipeline::from_here`] refused: why, and what it was given, unchanged.
+pub struct NotHere<'q, L: CanLink> {
+    pub error: PipelineError,
+    pub follower: Follower<'q>,
+    pub buses: Vec<BusDrives<L>>,
 }
 
 /// Counts of one cycle, for progress and the report.
@@ -242,10 +249,16 @@ pub struct Pipeline<'q, L: CanLink> {
     /// Where each period's targets go, if they are traced; rows the queue had no room for.
     trace: Option<crate::trace::Producer<'q, crate::trace::TraceRow>>,
     trace_dropped: u64,
+    /// At the program's end, or after a stop that is not a fault, the drives stay enabled
+    /// holding where the path ended ([`Pipeline::keep_enabled`]).
+    keep_enabled: bool,
 }
 
 /// Most periods to wait at the end for the drives to reach their last target.
 pub const SETTLE_CYCLES: u64 = 500;
+
+/// The rotary axes (tilt and C), sent in degrees.
+const ROTARY_DEG: [bool; 5] = [false, false, false, true, true];
 
 /// Axis names in joint order (for messages).
 const AXES: [&str; 5] = ["X", "Y", "Z", "tilt (A/B)", "C"];
@@ -264,7 +277,62 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
         c_continuous: bool,
         enable_timeout_cycles: u64,
     ) -> Result<Self, PipelineError> {
-        let rotary_deg = [false, false, false, true, true];
+        let (c_shift_deg, approach) =
+            Self::from_where_they_stand(&buses, start_joints, approach, c_continuous)?;
+        Ok(Self::build(
+            follower,
+            buses,
+            period,
+            c_shift_deg,
+            approach,
+            enable_timeout_cycles,
+        ))
+    }
+
+    /// A program that starts where the drives stand (within [`AT_START_UNITS`]), on drives
+    /// already enabled: what the long-lived controller runs each program and MDI line with.
+    /// Refused, with the interpolator and the buses given back unchanged, when a drive is
+    /// elsewhere.
+    ///
+    /// Real-time thread: allocates nothing (hence the large refusal, not boxed).
+    #[allow(clippy::result_large_err)]
+    pub fn from_here(
+        follower: Follower<'q>,
+        buses: Vec<BusDrives<L>>,
+        start_joints: Joints,
+        period: f64,
+        c_continuous: bool,
+        enable_timeout_cycles: u64,
+    ) -> Result<Self, NotHere<'q, L>> {
+        match Self::from_where_they_stand(&buses, start_joints, None, c_continuous) {
+            Ok((c_shift_deg, _)) => {
+                let mut p = Self::build(
+                    follower,
+                    buses,
+                    period,
+                    c_shift_deg,
+                    None,
+                    enable_timeout_cycles,
+                );
+                p.keep_enabled();
+                Ok(p)
+            }
+            Err(error) => Err(NotHere {
+                error,
+                follower,
+                buses,
+            }),
+        }
+    }
+
+    /// The C shift (degrees) and the approach from where the drives stand to the start.
+    fn from_where_they_stand(
+        buses: &[BusDrives<L>],
+        start_joints: Joints,
+        approach: Option<ApproachLimits>,
+        c_continuous: bool,
+    ) -> Result<(f64, Option<Approach>), PipelineError> {
+        let rotary_deg = ROTARY_DEG;
         let start: [f64; 5] = core::array::from_fn(|j| {
             if rotary_deg[j] {
                 start_joints[j].to_degrees()
@@ -273,7 +341,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             }
         });
         let mut actual = start;
-        for b in &buses {
+        for b in buses {
             for (d, s) in b.drives.iter().zip(b.master.status()) {
                 if d.axis < 5 {
                     actual[d.axis] = d.position(s.actual);
@@ -305,6 +373,18 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
                 None
             }
         };
+        Ok((c_shift_deg, approach))
+    }
+
+    fn build(
+        follower: Follower<'q>,
+        buses: Vec<BusDrives<L>>,
+        period: f64,
+        c_shift_deg: f64,
+        approach: Option<Approach>,
+        enable_timeout_cycles: u64,
+    ) -> Self {
+        let rotary_deg = ROTARY_DEG;
         let spindle = buses
             .iter()
             .find_map(|b| b.spindle.as_ref().map(|s| s.1.clone()));
@@ -315,7 +395,7 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             let stop_s = s.max_rpm / s.acceleration_rpm_s + 1.0;
             SETTLE_CYCLES.max((stop_s / period).ceil() as u64)
         });
-        Ok(Pipeline {
+        Pipeline {
             aux: Aux::default(),
             settle_limit,
             follower,
@@ -333,7 +413,21 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             commands: None,
             trace: None,
             trace_dropped: 0,
-        })
+            keep_enabled: false,
+        }
+    }
+
+    /// The drives stay enabled at the end: once the path is at rest (its end, or a stop
+    /// that is not a fault) and the drives have settled, the run is finished with them
+    /// holding there. A fault still quick-stops and disables them. What the long-lived
+    /// controller runs each program and MDI line with ([`crate::life`]).
+    pub fn keep_enabled(&mut self) {
+        self.keep_enabled = true;
+    }
+
+    /// The interpolator and the buses back, once the run is over (or never started).
+    pub fn into_parts(self) -> (Follower<'q>, Vec<BusDrives<L>>) {
+        (self.follower, self.buses)
     }
 
     /// Take the operator's commands from this queue, at the start of every period.
@@ -347,14 +441,21 @@ impl<'q, L: CanLink> Pipeline<'q, L> {
             let Some(c) = self.commands.as_mut().and_then(|q| q.dequeue()) else {
                 return;
             };
-            match c {
-                Command::Pause => self.follower.pause(),
-                Command::Resume => self.follower.resume(),
-                Command::Override(p) => self.follower.set_override(f64::from(p.min(100)) / 100.0),
-                Command::Stop => {
-                    if self.stage() != Stage::Finished {
-                        self.stop(StopReason::Operator);
-                    }
+            self.command(c);
+        }
+    }
+
+    /// Apply an operator's command now.
+    ///
+    /// Real-time thread.
+    pub fn command(&mut self, c: Command) {
+        match c {
+            Command::Pause => self.follower.pause(),
+            Command::Resume => self.follower.resume(),
+            Command::Override(p) => self.follower.set_override(f64::from(p.min(100)) / 100.0),
+            Command::Stop => {
+                if self.stage() != Stage::Finished {
+                    self.stop(StopReason::Operator);
                 }
             }
         }

@@ -48,6 +48,15 @@ impl<L: CanLink> Master<L> {
         Ok(())
     }
 
+    /// Stop the homing of the node at `i`, if it is homing (the operator's stop): the start
+    /// bit drops and the drive is put back in cyclic synchronous position where it stands,
+    /// not homed ([`HomingState::Failed`] with [`super::HomingError::Stopped`]).
+    pub fn stop_homing(&mut self, i: usize) {
+        if let Some(Some(job)) = self.jobs.get_mut(i) {
+            job.cancel();
+        }
+    }
+
     /// Where the homing of the node at `i` is.
     pub fn homing(&self, i: usize) -> HomingState {
         self.homing.get(i).copied().unwrap_or(HomingState::Idle)

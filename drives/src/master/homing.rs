@@ -76,6 +76,8 @@ pub enum HomingError {
     Timeout(u32),
     #[error("interrupted: the drive left Operation enabled or the bus faulted")]
     Interrupted,
+    #[error("stopped by the operator before it was homed")]
+    Stopped,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -224,6 +226,22 @@ impl Job {
     pub fn interrupt(&mut self) {
         if self.step != Step::Done {
             self.end(Err(HomingError::Interrupted));
+        }
+    }
+
+    /// The operator's stop: the start bit drops (the drive halts its search) and the mode
+    /// is set back to cyclic synchronous position; not homed. Before the drive is in
+    /// homing mode, it simply ends.
+    pub fn cancel(&mut self) {
+        if self.step == Step::Done || self.outcome.is_some() {
+            return;
+        }
+        if self.homing_mode() {
+            self.outcome = Some(Err(HomingError::Stopped));
+            self.step = Step::Write(MODE_BACK);
+            self.deadline = self.cycles.saturating_add(MODE_BACK_CYCLES);
+        } else {
+            self.end(Err(HomingError::Stopped));
         }
     }
 

@@ -117,6 +117,30 @@ impl<'q> Follower<'q> {
         }
     }
 
+    /// The same interpolator for the next program, from `start`: every chunk of the last
+    /// one still held or still queued is handed back to the planner (bounded by the queue's
+    /// capacity), and the state is as [`Follower::new`] leaves it. The planner must have
+    /// stopped pushing the last program's chunks before this, and pushes the next one's
+    /// only after: what `dnurbs serve` runs one program or MDI line after another with,
+    /// on one pair of queues for the machine's life. The stream counters carry on.
+    ///
+    /// Real-time thread: allocates nothing (the chunks go back to be freed by the planner).
+    pub fn next_program(mut self, start: Start) -> Self {
+        while let Some(c) = self.local.pop_front() {
+            self.give_back(c);
+        }
+        for _ in 0..crate::queue::QUEUE_N {
+            let Some(c) = self.inlet.ready.dequeue() else {
+                break;
+            };
+            self.give_back(c);
+        }
+        let counters = self.counters;
+        let mut next = Follower::new(self.inlet, start, self.kin, self.lim, self.hold);
+        next.counters = counters;
+        next
+    }
+
     /// Decelerate along the path to a stop and stay there (SIGINT, a drive fault).
     pub fn request_stop(&mut self) {
         self.stop_requested = true;

@@ -78,10 +78,7 @@ impl Feeder<'_> {
     /// Free the chunks the interpolator is done with, then push from `source` while fewer
     /// than `depth` are alive. Returns how many were pushed.
     pub fn feed(&mut self, source: &mut impl Iterator<Item = Box<Chunk>>) -> usize {
-        while let Some(done) = self.retired.dequeue() {
-            drop(done);
-            self.alive -= 1;
-        }
+        self.reclaim();
         let mut n = 0;
         while self.alive < self.depth {
             let Some(c) = source.next() else { break };
@@ -97,6 +94,23 @@ impl Feeder<'_> {
             }
         }
         n
+    }
+
+    /// Free the chunks the interpolator handed back; returns how many are still alive (in
+    /// the queue or held by the interpolator).
+    pub fn reclaim(&mut self) -> usize {
+        while let Some(done) = self.retired.dequeue() {
+            drop(done);
+            self.alive = self.alive.saturating_sub(1);
+        }
+        self.alive
+    }
+
+    /// A new program follows on the same queues: its refusal, if any, is its own
+    /// ([`Follower::next_program`](crate::Follower::next_program) hands the last one's
+    /// chunks back).
+    pub fn next_program(&mut self) {
+        self.refused.store(0, Ordering::Release);
     }
 
     /// Chunks pushed so far.

@@ -22,7 +22,7 @@ pub struct BusDrives<L: CanLink> {
     pub coolant: Option<(usize, machine::Coolant)>,
     /// The program's digital I/O on the same module, and its index.
     pub io: Option<(usize, machine::BusIo)>,
-    pub(super) targets: [i32; MAX_NODES],
+    pub(crate) targets: [i32; MAX_NODES],
 }
 
 impl<L: CanLink> BusDrives<L> {

@@ -130,7 +130,11 @@ impl<L: CanLink> Pipeline<'_, L> {
         if p.at_rest {
             m.settle += 1;
             if self.settled() || m.settle > self.settle_limit {
-                return Phase::Disabling;
+                return if self.keep_enabled {
+                    Phase::Finished
+                } else {
+                    Phase::Disabling
+                };
             }
         }
         if stopping {
