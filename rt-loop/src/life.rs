@@ -27,7 +27,10 @@
 //!
 //! Allocates nothing, locks nothing; every loop is bounded by the drives or a queue.
 
+mod looping;
 mod manual;
+
+pub use looping::{life_loop, LoopCounts};
 
 use crate::control::Command;
 use crate::pipeline::{BusDrives, NotHere, Pipeline, PipelineError, StopReason};
@@ -51,7 +54,8 @@ pub enum Order {
     On,
     /// Disable the drives (at rest only).
     Off,
-    /// Home the axis drive at `index` of bus `bus` (the master's node order) as `req` says.
+    /// Home the axis drive at `index` of bus `bus` (the master's node order) as `req` says;
+    /// while others home, it homes with them (up to [`HOMING_AT_ONCE`]).
     Home {
         bus: usize,
         index: usize,
@@ -123,7 +127,14 @@ pub enum Happened {
         index: usize,
         error: HomingError,
     },
+    /// Homing started for the drive at `index` of bus `bus`.
+    HomingStarted {
+        bus: usize,
+        index: usize,
+    },
     HomeRefused(HomeRefused),
+    /// A jog started (or a continuous one was renewed).
+    JogStarted,
     JogRefused(JogRefused),
     /// A jog came to rest; `limited`: short of the travel.
     JogDone {
@@ -252,14 +263,28 @@ impl Queues {
 #[derive(Clone, Copy, Debug)]
 enum Doing {
     Off,
-    Enabling { cycles: u64 },
+    Enabling {
+        cycles: u64,
+    },
     Holding,
-    Homing { bus: usize, index: usize },
-    Jog { axis: usize, jog: Jog },
+    /// The axes homing together, bus and index ([`HOMING_AT_ONCE`] at most).
+    Homing {
+        jobs: [(u8, u8); HOMING_AT_ONCE],
+        n: usize,
+    },
+    Jog {
+        axis: usize,
+        jog: Jog,
+    },
     Program,
-    Disabling { cycles: u64 },
+    Disabling {
+        cycles: u64,
+    },
     Fault,
 }
+
+/// Most axes homing at once (a homing sequence's group).
+pub const HOMING_AT_ONCE: usize = 8;
 
 /// The buses and the interpolator: free between programs, inside the pipeline during one.
 /// (Moved, never boxed: boxing would allocate in the real-time thread.)
@@ -411,7 +436,9 @@ impl<'q, L: CanLink> Life<'q, L> {
             (Order::Reset, Doing::Fault) => self.reset(),
             (Order::On, Doing::Off) => self.doing = Doing::Enabling { cycles: 0 },
             (Order::Off, Doing::Holding) => self.doing = Doing::Disabling { cycles: 0 },
-            (Order::Home { bus, index, req }, Doing::Holding) => self.home(bus, index, req),
+            (Order::Home { bus, index, req }, Doing::Holding | Doing::Homing { .. }) => {
+                self.home(bus, index, req)
+            }
             (
                 Order::Jog {
                     axis,
@@ -423,7 +450,10 @@ impl<'q, L: CanLink> Life<'q, L> {
             (Order::Jog { axis, velocity, .. }, Doing::Jog { axis: a, mut jog }) if a == axis => {
                 // The same jog again: the key is still held (a new speed takes effect).
                 match jog.velocity(velocity) {
-                    Ok(()) => self.doing = Doing::Jog { axis, jog },
+                    Ok(()) => {
+                        self.doing = Doing::Jog { axis, jog };
+                        self.report(Happened::JogStarted);
+                    }
                     Err(e) => self.report(Happened::JogRefused(e)),
                 }
             }
@@ -452,7 +482,11 @@ impl<'q, L: CanLink> Life<'q, L> {
                 jog.stop();
                 self.doing = Doing::Jog { axis, jog };
             }
-            (Order::Stop, Doing::Homing { bus, index }) => self.stop_homing(bus, index),
+            (Order::Stop, Doing::Homing { jobs, n }) => {
+                for &(bus, index) in jobs.iter().take(n) {
+                    self.stop_homing(usize::from(bus), usize::from(index));
+                }
+            }
             _ => self.report(refused),
         }
     }

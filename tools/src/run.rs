@@ -18,7 +18,7 @@
 //! Files: this one (options, result, what both share), `buses.rs` (each bus's drives set up
 //! and handed to a master), `realtime.rs` (the threads of a real run), `simulated.rs`.
 
-mod buses;
+pub(crate) mod buses;
 mod realtime;
 pub mod simulated;
 pub mod trace;

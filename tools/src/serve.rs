@@ -3,7 +3,10 @@
 //! it ([`protocol`]). The process that owns the bus and the real-time thread and serves
 //! them over the control socket is not built yet.
 
+pub mod hub;
+pub mod machine;
 pub mod protocol;
 pub mod state;
+pub mod work;
 
 pub use state::{Command, Controller, Event, Refused, State};

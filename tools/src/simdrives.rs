@@ -80,6 +80,15 @@ pub fn sim_nodes(
             // on its active side.
             if let Some(h) = d.home {
                 c.home = sim_home(d, h, c.home);
+                // A search may cross the whole travel (a turn of an endless axis), twice.
+                let l = [&m.axes.x, &m.axes.y, &m.axes.z, &m.axes.tilt, &m.axes.c][d.axis.min(4)];
+                let span = if l.is_unlimited() {
+                    360.0
+                } else {
+                    l.max - l.min
+                };
+                let counts = (2.0 * span * d.counts_per_unit).min(f64::from(u32::MAX));
+                c.home.search_limit = c.home.search_limit.max(counts as u32);
             }
             c.lag_s = lag_s;
             c.faults = faults.for_node(d.node);

@@ -1,10 +1,10 @@
 //! The modes outside a program: off, enabling, holding, homing, jogging, disabling and the
 //! fault, each a period at a time, and the bus's master cycled with their targets.
 
-use super::{Doing, Happened, Life};
+use super::{Doing, Happened, Life, HOMING_AT_ONCE};
 use drives::cia402::{Goal, State};
 use drives::link::CanLink;
-use drives::master::{HomeRequest, HomingState, NodeKind, Reaction, MAX_NODES};
+use drives::master::{HomeRefused, HomeRequest, HomingState, NodeKind, Reaction, MAX_NODES};
 use nc_follow::jog::{Jog, JogLimits, JogRefused};
 
 impl<L: CanLink> Life<'_, L> {
@@ -31,7 +31,7 @@ impl<L: CanLink> Life<'_, L> {
                 }
             }
             Doing::Holding | Doing::Fault | Doing::Program => doing,
-            Doing::Homing { bus, index } => self.homing(bus, index),
+            Doing::Homing { jobs, n } => self.homing(jobs, n),
             Doing::Jog { axis, mut jog } => {
                 let p = jog.step();
                 self.set_axis(axis, p);
@@ -84,15 +84,26 @@ impl<L: CanLink> Life<'_, L> {
         }
     }
 
-    /// Start homing the drive at `index` of bus `bus`.
+    /// Start homing the drive at `index` of bus `bus` (with those homing already).
     pub(super) fn home(&mut self, bus: usize, index: usize, req: HomeRequest) {
-        let r = match self.buses_mut().get_mut(bus) {
-            Some(b) => b.master.home(index, req),
-            None => Err(drives::master::HomeRefused::NoSuchAxis(index)),
+        let (mut jobs, n) = match self.doing {
+            Doing::Homing { jobs, n } => (jobs, n),
+            _ => ([(0, 0); HOMING_AT_ONCE], 0),
         };
-        match r {
-            Ok(()) => self.doing = Doing::Homing { bus, index },
-            Err(e) => self.report(Happened::HomeRefused(e)),
+        let ids = u8::try_from(bus).ok().zip(u8::try_from(index).ok());
+        let r = match (self.buses_mut().get_mut(bus), ids) {
+            _ if n >= HOMING_AT_ONCE => Err(HomeRefused::Busy(0)),
+            (Some(b), Some(_)) => b.master.home(index, req),
+            _ => Err(HomeRefused::NoSuchAxis(index)),
+        };
+        match (r, ids) {
+            (Ok(()), Some(id)) => {
+                jobs[n] = id;
+                self.doing = Doing::Homing { jobs, n: n + 1 };
+                self.report(Happened::HomingStarted { bus, index });
+            }
+            (Err(e), _) => self.report(Happened::HomeRefused(e)),
+            (Ok(()), None) => {}
         }
     }
 
@@ -103,34 +114,46 @@ impl<L: CanLink> Life<'_, L> {
         }
     }
 
-    /// A period of homing: the master's job sends the drive its own position; once over,
-    /// the target is where the drive stands.
-    fn homing(&mut self, bus: usize, index: usize) -> Doing {
-        let Some(b) = self.buses_mut().get_mut(bus) else {
-            return Doing::Holding;
-        };
-        let actual = b.master.status().get(index).map(|s| s.actual);
-        if let (Some(t), Some(a)) = (b.targets.get_mut(index), actual) {
-            *t = a;
-        }
-        match b.master.homing(index) {
-            HomingState::Running => Doing::Homing { bus, index },
-            HomingState::Attained { position } => {
-                if let Some(t) = b.targets.get_mut(index) {
-                    *t = position;
+    /// A period of homing: each master's job sends its drive its own position; once one is
+    /// over, that target is where the drive stands. Holding once all are over.
+    fn homing(&mut self, mut jobs: [(u8, u8); HOMING_AT_ONCE], n: usize) -> Doing {
+        let mut left = 0;
+        for k in 0..n.min(HOMING_AT_ONCE) {
+            let (bus, index) = (usize::from(jobs[k].0), usize::from(jobs[k].1));
+            let Some(b) = self.buses_mut().get_mut(bus) else {
+                continue;
+            };
+            let actual = b.master.status().get(index).map(|s| s.actual);
+            if let (Some(t), Some(a)) = (b.targets.get_mut(index), actual) {
+                *t = a;
+            }
+            let report = match b.master.homing(index) {
+                HomingState::Running => {
+                    jobs[left] = jobs[k];
+                    left += 1;
+                    None
                 }
-                self.report(Happened::Homed {
-                    bus,
-                    index,
-                    counts: position,
-                });
-                Doing::Holding
+                HomingState::Attained { position } => {
+                    if let Some(t) = b.targets.get_mut(index) {
+                        *t = position;
+                    }
+                    Some(Happened::Homed {
+                        bus,
+                        index,
+                        counts: position,
+                    })
+                }
+                HomingState::Failed(error) => Some(Happened::HomingFailed { bus, index, error }),
+                HomingState::Idle => None,
+            };
+            if let Some(h) = report {
+                self.report(h);
             }
-            HomingState::Failed(error) => {
-                self.report(Happened::HomingFailed { bus, index, error });
-                Doing::Holding
-            }
-            HomingState::Idle => Doing::Holding,
+        }
+        if left == 0 {
+            Doing::Holding
+        } else {
+            Doing::Homing { jobs, n: left }
         }
     }
 
@@ -150,7 +173,10 @@ impl<L: CanLink> Life<'_, L> {
         };
         let mut jog = Jog::new(position, limits, self.period, self.deadman_periods);
         match begin(&mut jog) {
-            Ok(()) => self.doing = Doing::Jog { axis, jog },
+            Ok(()) => {
+                self.doing = Doing::Jog { axis, jog };
+                self.report(Happened::JogStarted);
+            }
             Err(e) => self.report(Happened::JogRefused(e)),
         }
     }

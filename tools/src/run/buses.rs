@@ -68,7 +68,7 @@ pub fn home_request(
 }
 
 /// The set-up's timeouts and the cycle's supervision, from the machine file.
-pub(super) fn options(machine: &Machine) -> (SetupOptions, Supervision) {
+pub(crate) fn options(machine: &Machine) -> (SetupOptions, Supervision) {
     let rtc = &machine.realtime;
     let period = machine.period_s;
     let mut sopts = SetupOptions::new(period);
@@ -83,7 +83,7 @@ pub(super) fn options(machine: &Machine) -> (SetupOptions, Supervision) {
 
 /// Set up bus `bi` of `machine` over `link`, its waits on `clock`; the master starts its
 /// supervision at `now(clock)` (s, the loop's clock).
-pub(super) fn set_up<L: CanLink, C: Clock>(
+pub(crate) fn set_up<L: CanLink, C: Clock>(
     machine: &Machine,
     bi: usize,
     mut link: L,

@@ -204,7 +204,12 @@ impl Controller {
         };
         let idle = |homed: bool| if homed { S::Idle } else { S::On };
         let next = match (c, s) {
-            (Command::EStop, _) => S::EStop,
+            (Command::EStop, _) => {
+                // The quick stop may lose the axes' positions: home again.
+                self.homed = self.all_absolute;
+                self.stepping = false;
+                S::EStop
+            }
             (Command::Reset, S::EStop | S::Fault) => S::Off,
             (Command::Reset, _) => return Err(refuse("nothing to reset")),
             (_, S::EStop) => return Err(refuse("the e-stop is on: reset first")),

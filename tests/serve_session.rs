@@ -1,0 +1,420 @@
+//! `dnurbs serve`'s controller core on a virtual clock: the hub (requests as the control
+//! socket passes them, validated against the machine's state) and the real-time thread's
+//! life against the paper machine's five drives simulated in-process, a period at a time,
+//! as fast as the machine computes. The machine file is the demo's, with a home table for
+//! every axis (every method the simulated drives offer, one absolute) and fine counts.
+//!
+//! One operator's session: refusals while off, on, home, jog by a step, a continuous jog
+//! whose client goes away, a jog beyond the travel, MDI (a move, a syntax error), load and
+//! run a program with a pause, run it again and stop it, the e-stop and its reset, a drive
+//! fault mid-move (the status names the node), reset, home again and run to the end. Every
+//! target sent is checked by finite differences against the machine's limits.
+
+mod common;
+
+use config::bus::{Home, HomeMethod};
+use dnurbs_tools::serve::hub::{Asker, Hub};
+use dnurbs_tools::serve::machine::{lockstep_buses, Fixed};
+use dnurbs_tools::serve::protocol::{Reply, Request};
+use dnurbs_tools::simdrives::FaultArgs;
+use drives::link::MemLink;
+use drives::sim::Lockstep;
+use rt_loop::life::{Life, Mode};
+use std::time::Duration;
+
+/// The node (Y) that faults, and the SYNC it faults at: after the session's first part.
+const FAULT_NODE: u8 = 2;
+const FAULT_AT: u64 = 40_000;
+
+struct Rig {
+    life: Life<'static, MemLink>,
+    hub: Hub<'static>,
+    sims: Vec<Lockstep<MemLink>>,
+    drives: Vec<config::bus::Drive>,
+    limits: [config::AxisLimits; 5],
+    period: f64,
+    t: u64,
+    next_id: u64,
+    /// Per period: each axis drive's target in axis units, and the life's mode.
+    sent: Vec<([f64; 5], Mode)>,
+}
+
+fn machine() -> config::Machine {
+    let mut m = dnurbs_tools::demo::demo_machine().unwrap();
+    let methods = [
+        (HomeMethod::Switch { positive: false }, -5.0, 0),
+        (HomeMethod::SwitchIndex { positive: true }, 4.0, 0),
+        (HomeMethod::Current, 2.5, 1),
+        (HomeMethod::Absolute, 0.0, 0),
+        (HomeMethod::Switch { positive: true }, 3.0, 2),
+    ];
+    let limits = [&m.axes.x, &m.axes.y, &m.axes.z, &m.axes.tilt, &m.axes.c].map(|l| l.clone());
+    for d in m.drives.iter_mut() {
+        let (method, position, sequence) = methods[d.axis];
+        let l = &limits[d.axis];
+        d.home = Some(Home {
+            method,
+            position,
+            search_velocity: l.velocity / 10.0,
+            latch_velocity: l.velocity / 100.0,
+            acceleration: l.acceleration / 2.0,
+            sequence,
+        });
+        // Fine counts: the finite differences see the setpoints, not the rounding.
+        d.counts_per_unit = if d.axis < 3 { 1e6 } else { 1e5 };
+    }
+    m
+}
+
+impl Rig {
+    fn new() -> Rig {
+        let m = machine();
+        let faults = FaultArgs {
+            fault_at: vec![(FAULT_NODE, FAULT_AT)],
+            ..FaultArgs::default()
+        };
+        let (buses, sims) = lockstep_buses(&m, &faults).unwrap();
+        let drives = m.drives.clone();
+        let shop = dnurbs_tools::shop::parse_setup(&m, &Default::default()).unwrap();
+        let fixed: &'static mut Fixed = Box::leak(Fixed::new(m, shop));
+        let limits = fixed.setup.limits.clone();
+        let period = fixed.machine.period_s;
+        let (life, hub) = fixed.split(buses);
+        let t = sims[0].now().as_nanos() as u64;
+        Rig {
+            life,
+            hub,
+            sims,
+            drives,
+            limits,
+            period,
+            t,
+            next_id: 0,
+            sent: Vec::new(),
+        }
+    }
+
+    /// One period: the loop, the drives, the hub.
+    fn step(&mut self) -> Vec<(Asker, Reply)> {
+        self.life.cycle(self.t);
+        self.life.publish(self.hub.published());
+        let mut row = [0.0; 5];
+        for (d, s) in self.drives.iter().zip(self.life.buses()[0].master.status()) {
+            row[d.axis] = d.position(s.target);
+        }
+        // A fault's quick stop is the drives' own ramp (0x6085), whatever the targets.
+        let faulted = self.life.buses()[0].master.fault().is_some();
+        let mode = if faulted {
+            Mode::Fault
+        } else {
+            self.life.mode()
+        };
+        self.sent.push((row, mode));
+        self.t += (self.period * 1e9).round() as u64;
+        for s in self.sims.iter_mut() {
+            s.advance_to(Duration::from_nanos(self.t));
+        }
+        self.hub.poll()
+    }
+
+    /// Ask as client 1 and wait for the answer (at most 1000 periods).
+    fn ask(&mut self, request: Request) -> Reply {
+        self.ask_as(1, request)
+    }
+
+    fn ask_as(&mut self, client: u64, request: Request) -> Reply {
+        self.next_id += 1;
+        let who = Asker {
+            client,
+            id: Some(self.next_id),
+        };
+        if let Some(r) = self.hub.request(who, request.clone()) {
+            return r;
+        }
+        for _ in 0..1000 {
+            if let Some((_, r)) = self.step().into_iter().find(|(a, _)| *a == who) {
+                return r;
+            }
+        }
+        panic!("{request:?}: no answer in 1000 periods");
+    }
+
+    fn ok(&mut self, request: Request) -> &'static str {
+        let r = self.ask(request.clone());
+        assert!(r.ok, "{request:?}: {:?}", r.error);
+        r.state.unwrap()
+    }
+
+    fn refused(&mut self, request: Request, says: &str) {
+        let before = self.hub.state();
+        let r = self.ask(request.clone());
+        assert!(!r.ok, "{request:?} taken in state {}", before.name());
+        let e = r.error.unwrap();
+        assert!(e.contains(says), "{request:?}: {e}");
+        assert_eq!(
+            self.hub.state(),
+            before,
+            "{request:?} refused but the state moved"
+        );
+    }
+
+    /// Periods until the state is `name` (at most `max`).
+    fn until(&mut self, name: &str, max: usize) {
+        for k in 0..max {
+            if self.hub.state().name() == name {
+                return;
+            }
+            if std::env::var_os("SERVE_DEBUG").is_some() && k % 2000 == 0 {
+                eprintln!("{k}: {:?}", self.hub.status());
+            }
+            self.step();
+        }
+        panic!(
+            "not {name} within {max} periods: {} ({:?})",
+            self.hub.state().name(),
+            self.hub.status().message
+        );
+    }
+
+    fn axes(&self) -> Vec<f64> {
+        self.hub.status().axes
+    }
+
+    fn sync(&self) -> u64 {
+        self.sims[0].bus().records().last().map_or(0, |r| r.sync)
+    }
+}
+
+fn jog(axis: &str, positive: bool, step: Option<f64>, speed: Option<f64>) -> Request {
+    let line = format!(
+        r#"{{"v":1,"cmd":"jog","axis":"{axis}","dir":"{}"{}{}}}"#,
+        if positive { "+" } else { "-" },
+        step.map_or(String::new(), |s| format!(r#","step":{s}"#)),
+        speed.map_or(String::new(), |s| format!(r#","speed":{s}"#)),
+    );
+    dnurbs_tools::serve::protocol::Request::parse(&line)
+        .unwrap()
+        .request
+}
+
+#[test]
+fn an_operators_session_on_the_controller_core() {
+    let mut rig = Rig::new();
+    for _ in 0..10 {
+        rig.step();
+    }
+    assert_eq!(rig.hub.state().name(), "off");
+    rig.refused(jog("X", true, Some(1.0), None), "turn it on first");
+    rig.refused(Request::Run { from_line: None }, "turn it on first");
+    rig.refused(Request::Reset, "nothing to reset");
+
+    assert_eq!(rig.ok(Request::On), "on");
+    rig.refused(Request::Mdi("G0 X0".into()), "not every axis is homed");
+    rig.refused(jog("B", true, Some(1.0), None), "no such axis");
+
+    // Every axis in the file's sequence: X (switch) and Y (switch and index) together,
+    // then Z (here), then C (switch); A is absolute.
+    assert_eq!(rig.ok(Request::Home(None)), "homing");
+    rig.until("idle", 200_000);
+    assert_eq!(rig.hub.status().homed, ["X", "Y", "Z", "A", "C"]);
+    let a = rig.axes();
+    for (j, home) in [(0, -5.0), (1, 4.0), (2, 2.5), (4, 3.0)] {
+        let l = &rig.limits[j];
+        // Past the home point by the stop from the search (or latch) velocity.
+        let v = l.velocity / 10.0;
+        let slack = v * v / l.acceleration + 2.0 * v * rig.period + 1e-3;
+        assert!(
+            (a[j] - home).abs() <= slack,
+            "axis {j} at {}, home {home}",
+            a[j]
+        );
+    }
+
+    // Jog X by 10 mm, ending there exactly.
+    let x0 = a[0];
+    assert_eq!(rig.ok(jog("X", true, Some(10.0), Some(50.0))), "jog");
+    rig.refused(Request::Mdi("G0 X0".into()), "only at rest");
+    rig.until("idle", 5000);
+    assert!(
+        (rig.axes()[0] - (x0 + 10.0)).abs() < 1e-6,
+        "{:?}",
+        rig.axes()
+    );
+    rig.refused(jog("X", true, Some(1000.0), None), "outside the travel");
+
+    // Continuous, renewed by client 7, which then goes away: stopped at once.
+    assert_eq!(
+        rig.ask_as(7, jog("Y", false, None, Some(20.0))).state,
+        Some("jog")
+    );
+    for k in 0..100 {
+        if k % 25 == 0 {
+            assert!(rig.ask_as(7, jog("Y", false, None, Some(20.0))).ok);
+        }
+        rig.step();
+    }
+    let gone = rig.sent.len();
+    rig.hub.gone(7);
+    rig.until("idle", 500);
+    // The stop from 20 mm/s: well under the dead-man's 200 ms.
+    assert!(
+        rig.sent.len() - gone < 50,
+        "{} periods",
+        rig.sent.len() - gone
+    );
+    // Not renewed: the dead-man stops it 200 ms after the jog began.
+    assert!(rig.ask_as(8, jog("Y", true, None, Some(20.0))).ok);
+    let began = rig.sent.len();
+    rig.until("idle", 500);
+    let took = (rig.sent.len() - began) as f64 * rig.period;
+    assert!((0.2..0.3).contains(&took), "dead-man stop after {took} s");
+
+    // MDI: a rapid; a syntax error changes nothing.
+    assert_eq!(rig.ok(Request::Mdi("G0 X0 Y0".into())), "mdi");
+    rig.until("idle", 5000);
+    let a = rig.axes();
+    assert!(a[0].abs() < 1e-6 && a[1].abs() < 1e-6, "{a:?}");
+    rig.refused(Request::Mdi("G0 X".into()), "mdi `G0 X`");
+    rig.refused(Request::Mdi("G0 X900".into()), "mdi `G0 X900`");
+    assert_eq!(rig.ok(Request::Mdi("G91".into())), "idle");
+    assert_eq!(rig.ok(Request::Mdi("G0 Z1".into())), "mdi");
+    rig.until("idle", 5000);
+    assert!((rig.axes()[2] - (a[2] + 1.0)).abs() < 1e-6);
+    assert_eq!(rig.ok(Request::Mdi("G90".into())), "idle");
+
+    // Load and run, with a pause.
+    let program = common::root()
+        .join("tests/data/two-blocks-g2.nc")
+        .display()
+        .to_string();
+    rig.refused(Request::Load("/no/such/file.nc".into()), "/no/such/file.nc");
+    assert_eq!(rig.ok(Request::Load(program.clone())), "idle");
+    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    for _ in 0..300 {
+        rig.step();
+    }
+    assert!(rig.hub.status().line > 0);
+    assert_eq!(rig.ok(Request::Pause), "paused");
+    rig.refused(jog("X", true, Some(1.0), None), "only at rest");
+    for _ in 0..500 {
+        rig.step();
+    }
+    let held = rig.axes();
+    rig.step();
+    assert_eq!(rig.axes(), held, "paused: standing");
+    assert_eq!(rig.ok(Request::Override(50)), "paused");
+    assert_eq!(rig.ok(Request::Resume), "running");
+    rig.until("idle", 50_000);
+    let end = rig.axes();
+    assert!(
+        (end[0] - 60.0).abs() < 1e-6 && (end[1] + 10.0).abs() < 1e-6,
+        "{end:?}"
+    );
+
+    // Again, stopped along the path.
+    assert_eq!(rig.ok(Request::Override(100)), "idle");
+    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    for _ in 0..600 {
+        rig.step();
+    }
+    assert_eq!(rig.ok(Request::Stop), "running");
+    rig.until("idle", 5000);
+    assert!(rig
+        .hub
+        .status()
+        .message
+        .unwrap()
+        .contains("stopped by the operator"));
+
+    // The e-stop: every drive quick-stopped and disabled; homing is lost.
+    assert_eq!(rig.ok(Request::Estop), "estop");
+    rig.refused(Request::On, "reset first");
+    for _ in 0..300 {
+        rig.step();
+    }
+    assert_eq!(rig.ok(Request::Reset), "off");
+    assert_eq!(rig.ok(Request::On), "on");
+    assert_eq!(rig.hub.status().homed, ["A"]);
+    assert_eq!(rig.ok(Request::Home(None)), "homing");
+    rig.until("idle", 200_000);
+
+    // A drive fault mid-move: a long move started just before node 2 faults.
+    assert!(
+        rig.sync() < FAULT_AT - 600,
+        "the session got to SYNC {}",
+        rig.sync()
+    );
+    while rig.sync() < FAULT_AT - 500 {
+        rig.step();
+    }
+    assert_eq!(rig.ok(Request::Mdi("G1 X200 F3000".into())), "mdi");
+    rig.until("fault", 2000);
+    let message = rig.hub.status().message.unwrap();
+    assert!(message.contains("node 2"), "{message}");
+    rig.refused(Request::On, "reset first");
+    for _ in 0..500 {
+        rig.step();
+    }
+    assert_eq!(rig.ok(Request::Reset), "off");
+    assert_eq!(rig.ok(Request::On), "on");
+    assert_eq!(rig.ok(Request::Home(None)), "homing");
+    rig.until("idle", 200_000);
+    assert_eq!(rig.ok(Request::Mdi("G0 X0 Y0".into())), "mdi");
+    rig.until("idle", 5000);
+    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    rig.until("idle", 50_000);
+    let end = rig.axes();
+    assert!(
+        (end[0] - 60.0).abs() < 1e-6 && (end[1] + 10.0).abs() < 1e-6,
+        "{end:?}"
+    );
+    assert_eq!(rig.ok(Request::Off), "off");
+    assert_eq!(rig.hub.status().lost, 0);
+
+    check_targets(&rig.sent, &rig.limits, rig.period);
+}
+
+/// Velocity and acceleration of every axis within its limits at every period outside
+/// homing (the drive's own move, then its position redefined) and the quick stops of the
+/// e-stop and the fault (the drive's own ramp); the jerk too while jogging.
+fn check_targets(sent: &[([f64; 5], Mode)], limits: &[config::AxisLimits; 5], period: f64) {
+    let mut worst = [[0.0f64; 3]; 5];
+    for j in 0..5 {
+        let l = &limits[j];
+        for k in 3..sent.len() {
+            let modes = || (k - 3..=k).map(|i| sent[i].1);
+            if modes().any(|m| matches!(m, Mode::Homing | Mode::Fault | Mode::Off)) {
+                continue;
+            }
+            let q = |i: usize| sent[i].0[j];
+            let v = (q(k) - q(k - 1)) / period;
+            let a = (q(k) - 2.0 * q(k - 1) + q(k - 2)) / period.powi(2);
+            let jerk = (q(k) - 3.0 * q(k - 1) + 3.0 * q(k - 2) - q(k - 3)) / period.powi(3);
+            let count = if j < 3 { 1e-6 } else { 1e-5 };
+            assert!(
+                v.abs() <= l.velocity + count / period,
+                "axis {j} period {k} ({:?}): velocity {v}",
+                sent[k].1
+            );
+            assert!(
+                a.abs() <= l.acceleration + 2.0 * count / period.powi(2),
+                "axis {j} period {k} ({:?}): acceleration {a}",
+                sent[k].1
+            );
+            let jogging = modes().all(|m| m == Mode::Jog);
+            if jogging {
+                assert!(
+                    jerk.abs() <= l.jerk + 4.0 * count / period.powi(3),
+                    "axis {j} period {k}: jerk {jerk}"
+                );
+                worst[j][2] = worst[j][2].max(jerk.abs() / l.jerk);
+            }
+            worst[j][0] = worst[j][0].max(v.abs() / l.velocity);
+            worst[j][1] = worst[j][1].max(a.abs() / l.acceleration);
+        }
+    }
+    eprintln!(
+        "{} periods; largest share of the limits (v, a, jog jerk) per axis: {worst:.3?}",
+        sent.len()
+    );
+}
