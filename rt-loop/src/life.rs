@@ -211,6 +211,8 @@ impl Mode {
 #[derive(Debug, Default)]
 pub struct Status {
     mode: AtomicU8,
+    /// Periods the life has run ([`Life::cycle`] calls); each sends one SYNC a bus.
+    cycles: AtomicU64,
     /// The targets sent, per axis (mm, degrees), as f64 bits.
     axes: [AtomicU64; 5],
     /// The program's progress while one runs.
@@ -220,6 +222,10 @@ pub struct Status {
 impl Status {
     pub fn mode(&self) -> Mode {
         Mode::ALL[usize::from(self.mode.load(Relaxed)).min(Mode::ALL.len() - 1)]
+    }
+
+    pub fn cycles(&self) -> u64 {
+        self.cycles.load(Relaxed)
     }
 
     pub fn axes(&self) -> [f64; 5] {
@@ -307,6 +313,7 @@ pub struct Life<'q, L: CanLink> {
     out: Producer<'q, Happened>,
     /// Reports the queue had no room for.
     lost: u64,
+    cycles: u64,
     period: f64,
     enable_timeout_cycles: u64,
     /// Periods a continuous jog goes on after its last renewal.
@@ -332,6 +339,7 @@ impl<'q, L: CanLink> Life<'q, L> {
             orders,
             out,
             lost: 0,
+            cycles: 0,
             period,
             enable_timeout_cycles,
             deadman_periods,
@@ -385,6 +393,7 @@ impl<'q, L: CanLink> Life<'q, L> {
     /// Real-time thread.
     pub fn publish(&self, status: &Status) {
         status.mode.store(self.mode().index(), Relaxed);
+        status.cycles.store(self.cycles, Relaxed);
         let mut axes = [0.0; 5];
         for b in self.buses() {
             for (d, t) in b.drives.iter().zip(&b.targets) {
@@ -405,6 +414,7 @@ impl<'q, L: CanLink> Life<'q, L> {
     ///
     /// Real-time thread.
     pub fn cycle(&mut self, now_ns: u64) {
+        self.cycles = self.cycles.wrapping_add(1);
         for _ in 0..ORDERS {
             let Some(o) = self.orders.dequeue() else {
                 break;

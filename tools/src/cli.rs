@@ -122,19 +122,30 @@ pub enum Command {
         #[command(flatten)]
         shop: crate::shop::ShopArgs,
     },
-    /// Operate a running `dnurbs run` or `demo` through its control socket.
+    /// Operate `dnurbs serve`, or a running `dnurbs run` or `demo`, through its control socket.
     ///
-    /// Commands: `status` (one line; `--watch` repeats it), `pause` (decelerate along the
-    /// path and hold), `resume`, `stop` (decelerate along the path, then disable the
-    /// drives), `override PCT` (0..=100 % of the planned feed, reached with jerk-limited
-    /// transitions; above 100 % is refused: the plan already runs at the machine's limits).
+    /// Every controller takes `status` (`--watch` repeats it), `pause` (decelerate along
+    /// the path and hold), `resume`, `stop`, `override PCT` (0..=100 % of the planned feed,
+    /// reached with jerk-limited transitions; above 100 % is refused: the plan already runs
+    /// at the machine's limits). `serve` also takes `on`, `off`, `home`, `jog`, `mdi`,
+    /// `load`, `run`, `reset`, `estop`. A refusal says why, exit 2.
     #[command(after_help = CTL_HELP)]
     Ctl {
-        /// The socket given to `run --control` (or the machine file's [control] socket).
+        /// The socket given to `serve` or `run --control` (or the machine file's [control]
+        /// socket).
         socket: PathBuf,
         #[command(subcommand)]
         command: CtlCommand,
     },
+    /// The long-lived machine controller: homes, jogs, takes MDI, runs programs.
+    ///
+    /// Sets up the machine's drives once and keeps them for its whole life: off until
+    /// `dnurbs ctl SOCKET on`, then homing, jogging, MDI lines and programs from where the
+    /// machine stands, the drives held enabled between them; a fault or the e-stop
+    /// quick-stops and disables every drive until `reset`. Operated through the control
+    /// socket (`dnurbs ctl`, protocol in docs/serve.md). SIGINT or SIGTERM stops what
+    /// moves, disables the drives and ends.
+    Serve(crate::serve::args::ServeArgs),
     /// Interpolate a program offline, exactly as the real-time thread does, and report.
     ///
     /// Reports machining time, feed fluctuation, chord error and each axis's velocity,
@@ -353,11 +364,13 @@ pub enum Command {
     },
 }
 
-#[derive(Subcommand, Clone, Copy, Debug, PartialEq)]
+#[derive(Subcommand, Clone, Debug, PartialEq)]
 pub enum CtlCommand {
-    /// Print the run's state: stage, program line, block, axes, feed, override, counts.
+    /// Print the state: for serve, the machine's state, homed axes, axes, program line,
+    /// override, the last message (one JSON line); for a run, its stage, line and axes.
     Status {
-        /// Repeat every 200 ms until the run ends (Ctrl-C to leave).
+        /// Print it again whenever it changes (polled every 200 ms) until the controller
+        /// ends (Ctrl-C to leave).
         #[arg(long)]
         watch: bool,
     },
@@ -365,7 +378,8 @@ pub enum CtlCommand {
     Pause,
     /// Go on after a pause (or an M00/M01 stop).
     Resume,
-    /// Decelerate along the path, then disable the drives; the run ends (exit 4).
+    /// Stop what moves: a program along its path, a jog jerk-limited, homing. (A run then
+    /// disables the drives and ends, exit 4; serve holds them enabled.)
     Stop,
     /// Feed override, 0..=100 % of the planned feed.
     Override {
@@ -373,6 +387,64 @@ pub enum CtlCommand {
         #[arg(value_parser = clap::value_parser!(u8).range(0..=100))]
         percent: u8,
     },
+    /// serve: enable the drives, holding where they stand.
+    On,
+    /// serve: disable the drives (at rest).
+    Off,
+    /// serve: home AXIS, or every axis in the machine file's sequence.
+    Home {
+        /// X, Y, Z, A, B or C.
+        axis: Option<String>,
+    },
+    /// serve: jog AXIS + or -: by --step (incremental), or continuously while ctl holds
+    /// the key (--for), renewing the controller's 200 ms dead-man every 50 ms; ctl ended
+    /// (Ctrl-C) stops it at once.
+    Jog {
+        /// X, Y, Z, A, B or C.
+        axis: String,
+        /// + or -.
+        #[arg(value_parser = ["+", "-"], allow_hyphen_values = true)]
+        dir: String,
+        /// Distance, mm or degrees: an incremental jog.
+        #[arg(long)]
+        step: Option<f64>,
+        /// Speed, mm/s or degrees/s (default a tenth of the axis's velocity limit).
+        #[arg(long)]
+        speed: Option<f64>,
+        /// A continuous jog lasts this long, then ctl lets go, 1ms..=1h.
+        #[arg(long = "for", default_value = "1s", value_parser = hold, conflicts_with = "step")]
+        hold_ns: u64,
+    },
+    /// serve: one NC line, run from where the machine stands (the modes carry on).
+    Mdi {
+        /// The line (its words may be given as separate arguments).
+        #[arg(required = true, allow_hyphen_values = true, num_args = 1..)]
+        line: Vec<String>,
+    },
+    /// serve: read and check a program (the controller reads the file).
+    Load { file: PathBuf },
+    /// serve: run the loaded program from where the machine stands.
+    Run {
+        /// Restart from this line (not built in serve yet: refused with the reason).
+        #[arg(long)]
+        from_line: Option<u32>,
+    },
+    /// serve: single block (not built yet: refused with the reason).
+    Step,
+    /// serve: acknowledge a fault or the e-stop (the CiA-402 fault-reset edge); the drives
+    /// end disabled.
+    Reset,
+    /// serve: quick-stop and disable every drive.
+    Estop,
+}
+
+/// `ctl jog --for`: 1 ms..=1 h.
+fn hold(s: &str) -> Result<u64, String> {
+    let ns = duration(s)?;
+    if !(MS..=60 * MIN).contains(&ns) {
+        return Err(format!("{s}: must be in 1ms..=1h"));
+    }
+    Ok(ns)
 }
 
 /// `--cpu N [--idle-poll]` of `demo` and `latency`.

@@ -59,6 +59,10 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             &shop,
         ),
         Command::Ctl { socket, command } => ctl::ctl(&socket, command),
+        Command::Serve(args) => {
+            crate::serve::process::serve(args.options()?)?;
+            Ok(crate::exit::Outcome::Completed)
+        }
         Command::Simulate {
             program,
             machine,

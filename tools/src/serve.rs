@@ -3,9 +3,12 @@
 //! it ([`protocol`]). The process that owns the bus and the real-time thread and serves
 //! them over the control socket is not built yet.
 
+pub mod args;
 pub mod hub;
 pub mod machine;
+pub mod process;
 pub mod protocol;
+pub mod server;
 pub mod state;
 pub mod work;
 

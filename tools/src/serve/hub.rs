@@ -83,7 +83,10 @@ pub struct StatusBody {
     pub loaded: Option<String>,
     /// The program's source line being machined (while one runs).
     pub line: u32,
+    /// The feed override, % of the planned feed.
     pub override_pct: u8,
+    /// Periods the real-time thread has run (one SYNC each).
+    pub cycles: u64,
     /// The last fault, refusal of the thread or end of a program, with its reason.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
@@ -123,6 +126,7 @@ pub struct Hub<'q> {
     standing: Standing,
     message: Option<String>,
     lost: u64,
+    override_pct: u8,
 }
 
 impl<'q> Hub<'q> {
@@ -171,6 +175,7 @@ impl<'q> Hub<'q> {
             },
             message: None,
             lost: 0,
+            override_pct: 100,
         }
     }
 
@@ -186,6 +191,10 @@ impl<'q> Hub<'q> {
     /// Take `request`: its answer now, or `None` if it waits for the real-time thread
     /// ([`Hub::poll`] gives it then).
     pub fn request(&mut self, who: Asker, request: Request) -> Option<Reply> {
+        if request == Request::Status {
+            let body = serde_json::to_value(self.status()).unwrap_or_default();
+            return Some(Reply::ok(who.id, self.ctl.state().name()).with_status(body));
+        }
         match self.take(who, request) {
             Ok(Some(state)) => Some(Reply::ok(who.id, state.name())),
             Ok(None) => None,
@@ -213,7 +222,8 @@ impl<'q> Hub<'q> {
             axes: axes.to_vec(),
             loaded: self.loaded.as_ref().map(|l| l.name.clone()),
             line: if running { run.line } else { 0 },
-            override_pct: run.override_pct,
+            override_pct: self.override_pct,
+            cycles: self.status.cycles(),
             message: self.message.clone(),
             lost: self.lost,
         }
@@ -300,6 +310,9 @@ impl<'q> Hub<'q> {
                     _ => unreachable!("matched above"),
                 };
                 self.ctl.command(c).map_err(|e| e.to_string())?;
+                if let Request::Override(p) = request {
+                    self.override_pct = p;
+                }
                 self.send(Order::Run(o));
                 Ok(Some(self.ctl.state()))
             }

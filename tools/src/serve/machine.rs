@@ -26,10 +26,7 @@ pub type SimBuses = (Vec<BusDrives<MemLink>>, Vec<Lockstep<MemLink>>);
 /// Each bus of `machine` on an in-memory link to drives simulated on a virtual clock (the
 /// drives' clock): set up, configured and taken over by their masters, every bus's clock
 /// where the slowest set-up left its own. `faults` are injected as `sim-drives` does.
-pub fn lockstep_buses(
-    machine: &Machine,
-    faults: &FaultArgs,
-) -> anyhow::Result<SimBuses> {
+pub fn lockstep_buses(machine: &Machine, faults: &FaultArgs) -> anyhow::Result<SimBuses> {
     let mut out = Vec::new();
     let mut sims = Vec::new();
     for bi in 0..machine.buses.len() {

@@ -272,6 +272,9 @@ pub struct Reply {
     pub state: Option<&'static str>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The status, in the answer to `status`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub status: Option<serde_json::Value>,
 }
 
 impl Reply {
@@ -282,7 +285,14 @@ impl Reply {
             ok: true,
             state: Some(state),
             error: None,
+            status: None,
         }
+    }
+
+    /// The answer with the status.
+    pub fn with_status(mut self, status: serde_json::Value) -> Self {
+        self.status = Some(status);
+        self
     }
 
     pub fn refused(id: Option<u64>, error: impl ToString) -> Self {
@@ -292,6 +302,7 @@ impl Reply {
             ok: false,
             state: None,
             error: Some(error.to_string()),
+            status: None,
         }
     }
 

@@ -351,6 +351,11 @@ impl Hub<'_> {
                     self.feeder.next_program();
                     self.standing.tool_length = p.tool_length;
                     self.source = p.chunks.into_iter();
+                    // The override the operator set holds for every program and line.
+                    if self.override_pct != 100 {
+                        let o = rt_loop::control::Command::Override(self.override_pct);
+                        self.send(Order::Run(o));
+                    }
                 }
                 self.answer(|w| matches!(w, Waiting::Program(..)).then_some(Ok(())))
             }
