@@ -6,8 +6,8 @@
 //! The session: refusals while off (and of the watch socket, malformed and unknown
 //! requests), on, home, jog by a step, a jog beyond the travel, a continuous jog whose ctl
 //! is killed, MDI, load and run a program with a pause and an override, run it again and
-//! stop it, single block and run-from-line (refused: not built), the e-stop and its
-//! reset, home again, run to the end, off. Then a second serve whose node 2 faults: the
+//! stop it, restart it from a line (the approach said, then confirmed), single block
+//! (refused: not built), the e-stop and its reset, home again, run to the end, off. Then a second serve whose node 2 faults: the
 //! status names it, reset, home, run to the end.
 //!
 //! The recorded targets are checked by finite differences at the period against the
@@ -297,7 +297,21 @@ fn a_session_through_ctl_on_simulated_drives() {
     serve.ok(&["stop"]);
     let s = serve.until("idle");
     assert!(s["message"].as_str().unwrap().contains("operator"), "{s}");
-    serve.refused(&["run", "--from-line", "3"], "not built");
+    // Restart from line 4: the approach is said, nothing moves; confirmed, it runs to
+    // the end.
+    serve.refused(
+        &["run", "--from-line", "4"],
+        "the approach: back along the tool axis",
+    );
+    let r = serve.ok(&["run", "--from-line", "4", "--clearance", "5", "--confirm"]);
+    assert_eq!(r, "running");
+    let s = serve.until("idle");
+    assert!(s["message"].is_null(), "{s}");
+    let a = serve.axes();
+    assert!(
+        a[0].abs() < 2e-4 && a[1].abs() < 2e-4,
+        "back at X0 Y0: {a:?}"
+    );
 
     let c0 = serve.cycles();
     assert_eq!(serve.ok(&["estop"]), "estop");

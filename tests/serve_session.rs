@@ -22,6 +22,12 @@ use drives::sim::Lockstep;
 use rt_loop::life::{Life, Mode};
 use std::time::Duration;
 
+const RUN: Request = Request::Run {
+    from_line: None,
+    clearance: 10.0,
+    confirm: false,
+};
+
 /// The node (Y) that faults, and the SYNC it faults at: after the session's first part.
 const FAULT_NODE: u8 = 2;
 const FAULT_AT: u64 = 40_000;
@@ -205,7 +211,7 @@ fn an_operators_session_on_the_controller_core() {
     }
     assert_eq!(rig.hub.state().name(), "off");
     rig.refused(jog("X", true, Some(1.0), None), "turn it on first");
-    rig.refused(Request::Run { from_line: None }, "turn it on first");
+    rig.refused(RUN, "turn it on first");
     rig.refused(Request::Reset, "nothing to reset");
 
     assert_eq!(rig.ok(Request::On), "on");
@@ -289,7 +295,8 @@ fn an_operators_session_on_the_controller_core() {
         .to_string();
     rig.refused(Request::Load("/no/such/file.nc".into()), "/no/such/file.nc");
     assert_eq!(rig.ok(Request::Load(program.clone())), "idle");
-    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    assert_eq!(rig.ok(RUN), "running");
+    let whole_from = rig.sent.len();
     for _ in 0..300 {
         rig.step();
     }
@@ -305,15 +312,34 @@ fn an_operators_session_on_the_controller_core() {
     assert_eq!(rig.ok(Request::Override(50)), "paused");
     assert_eq!(rig.ok(Request::Resume), "running");
     rig.until("idle", 50_000);
+    let whole = rig.sent[whole_from..].to_vec();
     let end = rig.axes();
     assert!(
         (end[0] - 60.0).abs() < 1e-6 && (end[1] + 10.0).abs() < 1e-6,
         "{end:?}"
     );
 
+    // Restart from line 13, the second NURBS block, from elsewhere: the approach is said
+    // first and nothing moves; confirmed, the tool comes down onto the block's start and
+    // follows the program's path from there.
+    assert_eq!(rig.ok(Request::Mdi("G0 X-10 Y-10 Z5".into())), "mdi");
+    rig.until("idle", 5000);
+    let restart = |confirm| Request::Run {
+        from_line: Some(13),
+        clearance: 10.0,
+        confirm,
+    };
+    rig.refused(restart(false), "the approach: back along the tool axis");
+    assert_eq!(rig.ok(restart(true)), "running");
+    let from = rig.sent.len();
+    rig.until("idle", 50_000);
+    on_the_path(&rig.sent[from..], &whole);
+    let end = rig.axes();
+    assert!((end[0] - 60.0).abs() < 1e-6 && (end[1] + 10.0).abs() < 1e-6);
+
     // Again, stopped along the path.
     assert_eq!(rig.ok(Request::Override(100)), "idle");
-    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    assert_eq!(rig.ok(RUN), "running");
     for _ in 0..600 {
         rig.step();
     }
@@ -361,7 +387,7 @@ fn an_operators_session_on_the_controller_core() {
     rig.until("idle", 200_000);
     assert_eq!(rig.ok(Request::Mdi("G0 X0 Y0".into())), "mdi");
     rig.until("idle", 5000);
-    assert_eq!(rig.ok(Request::Run { from_line: None }), "running");
+    assert_eq!(rig.ok(RUN), "running");
     rig.until("idle", 50_000);
     let end = rig.axes();
     assert!(
@@ -372,6 +398,99 @@ fn an_operators_session_on_the_controller_core() {
     assert_eq!(rig.hub.status().lost, 0);
 
     check_targets(&rig.sent, &rig.limits, rig.period);
+}
+
+/// From where the restart's approach comes down onto the path (the first target within
+/// 1 um of it), the tool tip of every target of the restarted run (in the workpiece frame)
+/// is within 1 um of the whole run's (its tips joined by straight lines: at 2 ms and these
+/// feeds a chord of the curves deviates from them by far less).
+fn on_the_path(restarted: &[([f64; 5], Mode)], whole: &[([f64; 5], Mode)]) {
+    // The tool tip in the workpiece frame (the paper machine, no tool length).
+    let tip = |j: &[f64; 5]| -> [f64; 5] {
+        use nc_geom::kinematics::Kinematics;
+        let m = nc_geom::kinematics::MachineKinematics::Paper;
+        let p = m.unplace(
+            &nalgebra::Vector3::new(j[0], j[1], j[2]),
+            j[3].to_radians(),
+            j[4].to_radians(),
+        );
+        [p.x, p.y, p.z, 0.0, 0.0]
+    };
+    let whole: Vec<([f64; 5], Mode)> = whole.iter().map(|(j, m)| (tip(j), *m)).collect();
+    let restarted: Vec<([f64; 5], Mode)> = restarted.iter().map(|(j, m)| (tip(j), *m)).collect();
+    // The reference is the whole run's tips joined by chords: each chord is off the
+    // curve by at most its sagitta, L^2 k / 8 (k from the circle through its neighbours),
+    // which the distance may take on top of the 1 um.
+    let pts: Vec<[f64; 3]> = whole.iter().map(|(p, _)| [p[0], p[1], p[2]]).collect();
+    let sub = |a: &[f64; 3], b: &[f64; 3]| [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let curvature = |i: usize| -> f64 {
+        if i == 0 || i + 1 >= pts.len() {
+            return 0.0;
+        }
+        let (a, b, c) = (&pts[i - 1], &pts[i], &pts[i + 1]);
+        let (u, v) = (sub(a, b), sub(a, c));
+        let cross = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let d = norm(sub(a, b)) * norm(sub(b, c)) * norm(sub(a, c));
+        if d > 0.0 {
+            2.0 * norm(cross) / d
+        } else {
+            0.0
+        }
+    };
+    let sagitta: Vec<f64> = (0..pts.len().saturating_sub(1))
+        .map(|i| {
+            let l = norm(sub(&pts[i], &pts[i + 1]));
+            l * l * curvature(i).max(curvature(i + 1)) / 8.0
+        })
+        .collect();
+    let dist = |p: &[f64; 5]| {
+        pts.windows(2)
+            .zip(&sagitta)
+            .map(|(w, sag)| {
+                let (a, b) = (&w[0], &w[1]);
+                let ab: Vec<f64> = (0..3).map(|i| b[i] - a[i]).collect();
+                let ap: Vec<f64> = (0..3).map(|i| p[i] - a[i]).collect();
+                let l2: f64 = ab.iter().map(|x| x * x).sum();
+                let t = if l2 > 0.0 {
+                    (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / l2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let d = (0..3)
+                    .map(|i| (ap[i] - t * ab[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                (d - sag).max(0.0)
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let first = restarted
+        .iter()
+        .position(|(p, _)| dist(p) < 1e-6)
+        .expect("the approach comes down onto the path");
+    let mut worst = 0.0f64;
+    for (k, (p, _)) in restarted.iter().enumerate().skip(first) {
+        let d = dist(p);
+        worst = worst.max(d);
+        assert!(
+            d < 1e-6,
+            "period {k} after the restart: {d} mm off the path at {p:?}"
+        );
+    }
+    assert!(
+        restarted.len() - first > 500,
+        "{} periods on the path",
+        restarted.len() - first
+    );
+    eprintln!(
+        "restart: {} periods on the path after the approach, at most {worst:.2e} mm off it",
+        restarted.len() - first
+    );
 }
 
 /// Velocity and acceleration of every axis within its limits at every period outside

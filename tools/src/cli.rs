@@ -423,13 +423,24 @@ pub enum CtlCommand {
     },
     /// serve: read and check a program (the controller reads the file).
     Load { file: PathBuf },
-    /// serve: run the loaded program from where the machine stands.
+    /// serve: run the loaded program from where the machine stands; or restart it from a
+    /// line: the lines before read without moving, the spindle and coolant they left
+    /// restored, the tool backing off along its axis, over, and down onto the restart
+    /// pose. Without --confirm the answer says what that approach would be and nothing
+    /// moves.
     Run {
-        /// Restart from this line (not built in serve yet: refused with the reason).
-        #[arg(long)]
+        /// Restart from this line (from 1).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
         from_line: Option<u32>,
+        /// With --from-line: how far the tool backs off along its axis and stands above the
+        /// restart pose, mm (0 < MM <= 1000; default 10).
+        #[arg(long, value_name = "MM", requires = "from_line")]
+        clearance: Option<f64>,
+        /// With --from-line: the operator has seen the approach; go.
+        #[arg(long, requires = "from_line")]
+        confirm: bool,
     },
-    /// serve: single block (not built yet: refused with the reason).
+    /// serve: single block (not built in serve yet: refused with the reason).
     Step,
     /// serve: acknowledge a fault or the e-stop (the CiA-402 fault-reset edge); the drives
     /// end disabled.

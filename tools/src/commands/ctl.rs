@@ -124,10 +124,21 @@ pub fn ctl(socket: &Path, command: CtlCommand) -> anyhow::Result<Outcome> {
             let path = std::fs::canonicalize(file).unwrap_or_else(|_| file.clone());
             json!({"cmd": "load", "file": path.display().to_string()})
         }
-        CtlCommand::Run { from_line } => match from_line {
-            Some(n) => json!({"cmd": "run", "from_line": n}),
-            None => json!({"cmd": "run"}),
-        },
+        CtlCommand::Run {
+            from_line,
+            clearance,
+            confirm,
+        } => {
+            let mut j = json!({"cmd": "run"});
+            if let Some(n) = from_line {
+                j["from_line"] = json!(n);
+                j["confirm"] = json!(confirm);
+            }
+            if let Some(c) = clearance {
+                j["clearance"] = json!(c);
+            }
+            j
+        }
     };
     let status = matches!(command, CtlCommand::Status { .. });
     let watch = matches!(command, CtlCommand::Status { watch: true });

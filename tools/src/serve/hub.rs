@@ -296,7 +296,14 @@ impl<'q> Hub<'q> {
             } => self.jog(who, axis, positive, step, speed),
             Request::Mdi(line) => self.mdi(who, &line),
             Request::Load(file) => self.load(&file),
-            Request::Run { from_line } => self.run(who, from_line),
+            Request::Run {
+                from_line,
+                clearance,
+                confirm,
+            } => match from_line {
+                None => self.run(who),
+                Some(n) => self.restart(who, n, clearance, confirm),
+            },
             Request::Step => Err(format!(
                 "step refused in state {}: single block is not built in dnurbs serve yet \
                  (M01 optional stops and pause/resume are)",

@@ -21,6 +21,8 @@ pub const VERSION: u32 = 1;
 pub const MAX_LINE: usize = 4096;
 /// Longest MDI line, characters (LinuxCNC's is 255).
 pub const MAX_MDI: usize = 255;
+/// A restart's approach backs off and stands this far above the restart pose, mm.
+pub const DEFAULT_CLEARANCE_MM: f64 = 10.0;
 
 /// A request's command and arguments as they arrive (`v` and `id` taken off first). The
 /// commands without arguments are struct variants so that extra keys are refused too.
@@ -51,6 +53,10 @@ enum RawCmd {
     Run {
         #[serde(default)]
         from_line: Option<u32>,
+        #[serde(default)]
+        clearance: Option<f64>,
+        #[serde(default)]
+        confirm: Option<bool>,
     },
     Pause {},
     Resume {},
@@ -93,8 +99,13 @@ pub enum Request {
     },
     Mdi(String),
     Load(String),
+    /// `from_line`: restart there, the approach `clearance` mm (default
+    /// [`DEFAULT_CLEARANCE_MM`]) along the tool axis; the approach must be `confirm`ed
+    /// (without, the answer says what it would do and nothing moves).
     Run {
         from_line: Option<u32>,
+        clearance: f64,
+        confirm: bool,
     },
     Pause,
     Resume,
@@ -216,11 +227,35 @@ impl Request {
                 }
                 Request::Load(file)
             }
-            RawCmd::Run { from_line } => {
+            RawCmd::Run {
+                from_line,
+                clearance,
+                confirm,
+            } => {
                 if from_line == Some(0) {
                     return Err(bad("from_line", "0".into(), "lines count from 1"));
                 }
-                Request::Run { from_line }
+                if from_line.is_none() && (clearance.is_some() || confirm.is_some()) {
+                    let key = if clearance.is_some() {
+                        "clearance"
+                    } else {
+                        "confirm"
+                    };
+                    return Err(bad(key, "given".into(), "only with from_line"));
+                }
+                let clearance = clearance.unwrap_or(DEFAULT_CLEARANCE_MM);
+                if !(clearance > 0.0 && clearance <= nc_lang::restart::MAX_CLEARANCE_MM) {
+                    return Err(bad(
+                        "clearance",
+                        clearance.to_string(),
+                        "must be more than 0 and at most 1000 (mm)",
+                    ));
+                }
+                Request::Run {
+                    from_line,
+                    clearance,
+                    confirm: confirm.unwrap_or(false),
+                }
             }
             RawCmd::Pause {} => Request::Pause,
             RawCmd::Resume {} => Request::Resume,

@@ -218,22 +218,9 @@ impl Hub<'_> {
         Ok(Some(self.ctl.state()))
     }
 
-    pub(super) fn run(
-        &mut self,
-        who: Asker,
-        from_line: Option<u32>,
-    ) -> Result<Option<State>, String> {
+    pub(super) fn run(&mut self, who: Asker) -> Result<Option<State>, String> {
         let mut next = self.ctl;
         next.command(Command::Run).map_err(|e| e.to_string())?;
-        if let Some(n) = from_line {
-            return Err(format!(
-                "run --from-line {n}: not built in dnurbs serve yet (dnurbs simulate \
-                 --from-line shows the restart offline)"
-            ));
-        }
-        if self.loaded.is_none() {
-            return Err("run: no program is loaded".into());
-        }
         self.stand_here(None);
         let Some(loaded) = self.loaded.as_ref() else {
             return Err("run: no program is loaded".into());
@@ -250,6 +237,66 @@ impl Hub<'_> {
         let program = work::from_here(&all, entries.tilt_word(), &self.standing, self.setup);
         let planned =
             work::plan(&program, self.setup, self.depth).map_err(|e| format!("run {name}: {e}"))?;
+        self.hand_over(who, next, Kind::Program, planned);
+        Ok(None)
+    }
+
+    /// Run the loaded program from `line`: the lines before it read without moving, what
+    /// they left on restored, and the approach from where the machine stands (back along
+    /// the tool axis by `clearance`, over, down onto the restart pose). Unless `confirm`,
+    /// the answer says what the approach would be and nothing moves.
+    pub(super) fn restart(
+        &mut self,
+        who: Asker,
+        line: u32,
+        clearance: f64,
+        confirm: bool,
+    ) -> Result<Option<State>, String> {
+        let mut next = self.ctl;
+        next.command(Command::Run).map_err(|e| e.to_string())?;
+        self.stand_here(None);
+        let Some(loaded) = self.loaded.as_ref() else {
+            return Err("run: no program is loaded".into());
+        };
+        let name = loaded.name.clone();
+        let program = nc_lang::parse_with(&loaded.text, self.shop).map_err(|e| {
+            let first = e.first().map_or(String::new(), |p| p.to_string());
+            format!("run {name}:{first}")
+        })?;
+        let r = nc_lang::restart::from_line(
+            &program,
+            line,
+            &self.setup.kin,
+            &self.setup.build,
+            &self.standing,
+            clearance,
+        )
+        .map_err(|e| format!("run {name} from line {line}: {e}"))?;
+        let [up, over, down] = r
+            .approach
+            .map(|p| format!("X{:.3} Y{:.3} Z{:.3}", p[0], p[1], p[2]));
+        let restored = r.modal.aux;
+        if !confirm {
+            return Err(format!(
+                "run {name} from line {line} (restarts at line {}): the approach: back \
+                 along the tool axis to {up}, over to {over}, down to {down}; spindle {} \
+                 rpm, coolant {}; nothing moved: confirm it (ctl run --from-line {line} \
+                 --confirm)",
+                r.line,
+                restored.spindle_rpm,
+                if restored.mist || restored.flood {
+                    "on"
+                } else {
+                    "off"
+                },
+            ));
+        }
+        let planned = work::plan(&r.program, self.setup, self.depth)
+            .map_err(|e| format!("run {name} from line {line}: {e}"))?;
+        self.message = Some(format!(
+            "restarted {name} at line {}: approach over {over}, down to {down}",
+            r.line
+        ));
         self.hand_over(who, next, Kind::Program, planned);
         Ok(None)
     }

@@ -2,6 +2,12 @@
 
 use super::*;
 
+const RUN: Request = Request::Run {
+    from_line: None,
+    clearance: DEFAULT_CLEARANCE_MM,
+    confirm: false,
+};
+
 fn ok(line: &str) -> Request {
     Request::parse(line)
         .unwrap_or_else(|e| panic!("{line}: {e}"))
@@ -67,16 +73,32 @@ fn every_command_parses() {
         ok(r#"{"v":1,"cmd":"load","file":"/tmp/a.nc"}"#),
         Request::Load("/tmp/a.nc".into())
     );
-    assert_eq!(
-        ok(r#"{"v":1,"cmd":"run"}"#),
-        Request::Run { from_line: None }
-    );
+    assert_eq!(ok(r#"{"v":1,"cmd":"run"}"#), RUN);
     assert_eq!(
         ok(r#"{"v":1,"cmd":"run","from_line":240}"#),
         Request::Run {
-            from_line: Some(240)
+            from_line: Some(240),
+            clearance: 10.0,
+            confirm: false,
         }
     );
+    assert_eq!(
+        ok(r#"{"v":1,"cmd":"run","from_line":240,"clearance":25,"confirm":true}"#),
+        Request::Run {
+            from_line: Some(240),
+            clearance: 25.0,
+            confirm: true,
+        }
+    );
+    for bad in [
+        r#"{"v":1,"cmd":"run","confirm":true}"#,
+        r#"{"v":1,"cmd":"run","clearance":5}"#,
+        r#"{"v":1,"cmd":"run","from_line":3,"clearance":0}"#,
+        r#"{"v":1,"cmd":"run","from_line":3,"clearance":1001}"#,
+        r#"{"v":1,"cmd":"run","from_line":3,"confirm":"yes"}"#,
+    ] {
+        assert!(Request::parse(bad).is_err(), "{bad}");
+    }
     assert_eq!(
         ok(r#"{"v":1,"cmd":"override","percent":30}"#),
         Request::Override(30)
