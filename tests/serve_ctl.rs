@@ -6,8 +6,9 @@
 //! The session: refusals while off (and of the watch socket, malformed and unknown
 //! requests), on, home, jog by a step, a jog beyond the travel, a continuous jog whose ctl
 //! is killed, MDI, load and run a program with a pause and an override, run it again and
-//! stop it, restart it from a line (the approach said, then confirmed), single block
-//! (refused: not built), the e-stop and its reset, home again, run to the end, off. Then a second serve whose node 2 faults: the
+//! stop it, single block (two blocks stepped, then resumed; refused in the middle of a
+//! program started with run), restart it from a line (the approach said, then
+//! confirmed), the e-stop and its reset, home again, run to the end, off. Then a second serve whose node 2 faults: the
 //! status names it, reset, home, run to the end.
 //!
 //! The recorded targets are checked by finite differences at the period against the
@@ -280,7 +281,7 @@ fn a_session_through_ctl_on_simulated_drives() {
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(serve.ok(&["pause"]), "paused");
     serve.refused(&["jog", "X", "+", "--step", "1"], "only at rest");
-    serve.refused(&["step"], "single block is not built");
+    serve.refused(&["step"], "started with run");
     assert!(serve.status()["line"].as_u64().unwrap() > 0);
     assert_eq!(serve.ok(&["resume"]), "running");
     let s = serve.until("idle");
@@ -290,6 +291,20 @@ fn a_session_through_ctl_on_simulated_drives() {
         a[0].abs() < 2e-4 && a[1].abs() < 2e-4,
         "back at X0 Y0: {a:?}"
     );
+
+    // Single block: step two blocks, then resume to the end.
+    assert_eq!(serve.ok(&["step"]), "stepping");
+    serve.until("paused");
+    assert_eq!(serve.ok(&["step"]), "stepping");
+    let s = serve.until("paused");
+    assert!(s["message"].as_str().unwrap().contains("line 4"), "{s}");
+    let a = serve.axes();
+    assert!(
+        (a[0] - 20.0).abs() < 2e-4 && (a[1] - 10.0).abs() < 2e-4,
+        "{a:?}"
+    );
+    assert_eq!(serve.ok(&["resume"]), "running");
+    serve.until("idle");
 
     assert_eq!(serve.ok(&["override", "100"]), "idle");
     assert_eq!(serve.ok(&["run"]), "running");

@@ -319,13 +319,13 @@ fn an_operators_session_on_the_controller_core() {
         "{end:?}"
     );
 
-    // Restart from line 13, the second NURBS block, from elsewhere: the approach is said
+    // Restart from line 14, the second NURBS block, from elsewhere: the approach is said
     // first and nothing moves; confirmed, the tool comes down onto the block's start and
     // follows the program's path from there.
     assert_eq!(rig.ok(Request::Mdi("G0 X-10 Y-10 Z5".into())), "mdi");
     rig.until("idle", 5000);
     let restart = |confirm| Request::Run {
-        from_line: Some(13),
+        from_line: Some(14),
         clearance: 10.0,
         confirm,
     };
@@ -336,6 +336,42 @@ fn an_operators_session_on_the_controller_core() {
     on_the_path(&rig.sent[from..], &whole);
     let end = rig.axes();
     assert!((end[0] - 60.0).abs() < 1e-6 && (end[1] + 10.0).abs() < 1e-6);
+
+    // Single block: started with step, each block ends at rest and waits; step runs the
+    // next, resume runs on.
+    assert_eq!(rig.ok(Request::Mdi("G0 X-10 Y-10 Z5".into())), "mdi");
+    rig.until("idle", 5000);
+    assert_eq!(rig.ok(Request::Step), "stepping");
+    rig.until("paused", 20_000);
+    let a = rig.axes();
+    assert!(
+        a[0].abs() < 1e-6 && a[1].abs() < 1e-6 && a[2].abs() < 1e-6,
+        "{a:?}"
+    );
+    let m = rig.hub.status().message.unwrap();
+    assert!(m.contains("line 9"), "{m}");
+    assert_eq!(rig.ok(Request::Step), "stepping");
+    rig.until("paused", 20_000);
+    let a = rig.axes();
+    assert!((a[0] - 30.0).abs() < 1e-6 && a[1].abs() < 1e-6, "{a:?}");
+    assert_eq!(rig.ok(Request::Resume), "running");
+    rig.until("idle", 20_000);
+    let a = rig.axes();
+    assert!(
+        (a[0] - 60.0).abs() < 1e-6 && (a[1] + 10.0).abs() < 1e-6,
+        "{a:?}"
+    );
+    // A program started with run is planned without block stops: no step from its middle.
+    assert_eq!(rig.ok(Request::Mdi("G0 X0 Y0".into())), "mdi");
+    rig.until("idle", 5000);
+    assert_eq!(rig.ok(RUN), "running");
+    for _ in 0..200 {
+        rig.step();
+    }
+    assert_eq!(rig.ok(Request::Pause), "paused");
+    rig.refused(Request::Step, "started with run");
+    assert_eq!(rig.ok(Request::Resume), "running");
+    rig.until("idle", 20_000);
 
     // Again, stopped along the path.
     assert_eq!(rig.ok(Request::Override(100)), "idle");

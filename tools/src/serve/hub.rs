@@ -27,6 +27,7 @@ use rt_loop::life::{Happened, Order, Status};
 use serde::Serialize;
 
 mod answer;
+mod step;
 
 /// Who asked: the client's connection and the request's id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,6 +128,11 @@ pub struct Hub<'q> {
     message: Option<String>,
     lost: u64,
     override_pct: u8,
+    /// The lines of the stops single block put before each block of the program under way
+    /// (none: it was started with `run`).
+    block_stops: Vec<u32>,
+    /// The operator stop last let go (the thread still reports it for a period or two).
+    released: Option<u32>,
 }
 
 impl<'q> Hub<'q> {
@@ -176,6 +182,8 @@ impl<'q> Hub<'q> {
             message: None,
             lost: 0,
             override_pct: 100,
+            block_stops: Vec::new(),
+            released: None,
         }
     }
 
@@ -246,6 +254,7 @@ impl<'q> Hub<'q> {
             self.happened(h);
         }
         self.feeder.feed(&mut self.source);
+        self.watch_stops();
         std::mem::take(&mut self.answers)
     }
 
@@ -301,26 +310,32 @@ impl<'q> Hub<'q> {
                 clearance,
                 confirm,
             } => match from_line {
-                None => self.run(who),
+                None => self.run(who, false),
                 Some(n) => self.restart(who, n, clearance, confirm),
             },
-            Request::Step => Err(format!(
-                "step refused in state {}: single block is not built in dnurbs serve yet \
-                 (M01 optional stops and pause/resume are)",
-                self.ctl.state().name()
-            )),
-            Request::Pause | Request::Resume | Request::Override(_) => {
-                let (c, o) = match request {
-                    Request::Pause => (Command::Pause, RunCommand::Pause),
-                    Request::Resume => (Command::Resume, RunCommand::Resume),
-                    Request::Override(p) => (Command::Override, RunCommand::Override(p)),
-                    _ => unreachable!("matched above"),
-                };
-                self.ctl.command(c).map_err(|e| e.to_string())?;
-                if let Request::Override(p) = request {
-                    self.override_pct = p;
-                }
-                self.send(Order::Run(o));
+            Request::Step => self.step(who),
+            Request::Pause => {
+                self.ctl
+                    .command(Command::Pause)
+                    .map_err(|e| e.to_string())?;
+                self.send(Order::Run(RunCommand::Pause));
+                Ok(Some(self.ctl.state()))
+            }
+            Request::Resume => {
+                self.ctl
+                    .command(Command::Resume)
+                    .map_err(|e| e.to_string())?;
+                // An operator stop (M00, M01, a block's end in single block) is let go.
+                self.released = self.status.run.snapshot().awaiting;
+                self.send(Order::Run(RunCommand::Resume));
+                Ok(Some(self.ctl.state()))
+            }
+            Request::Override(p) => {
+                self.ctl
+                    .command(Command::Override)
+                    .map_err(|e| e.to_string())?;
+                self.override_pct = p;
+                self.send(Order::Run(RunCommand::Override(p)));
                 Ok(Some(self.ctl.state()))
             }
             Request::Stop => {

@@ -258,11 +258,9 @@ impl Controller {
             (Command::Pause, S::Running | S::Stepping | S::Mdi) => S::Paused,
             (Command::Pause, _) => return Err(refuse("nothing runs")),
             (Command::Resume, S::Paused) => {
-                if self.stepping {
-                    S::Stepping
-                } else {
-                    S::Running
-                }
+                // Runs on (as LinuxCNC's resume after a step); `step` is the next block.
+                self.stepping = false;
+                S::Running
             }
             (Command::Resume, _) => return Err(refuse("nothing is paused")),
             (Command::Stop, S::Homing | S::Jog | S::Mdi | S::Running | S::Paused | S::Stepping) => {

@@ -59,6 +59,24 @@ pub fn from_here(
     nc_lang::mdi::program(entries, tilt_word, standing, &setup.kin)
 }
 
+/// Single block: a stop before every block of `program` but its start and its first move
+/// (an operator stop, as `M00` makes it), so that the path comes to rest at the end of each
+/// block and waits. The lines of the stops, sorted.
+pub fn stop_before_each_block(program: &mut Program) -> Vec<u32> {
+    let mut lines = Vec::new();
+    for b in program.blocks.iter_mut().skip(2) {
+        let (pos, wait) = match b {
+            Block::Linear(m) => (m.pos, &mut m.tooling.wait),
+            Block::Nurbs(n) => (n.pos, &mut n.tooling.wait),
+        };
+        wait.operator.get_or_insert(pos);
+        lines.push(pos.line);
+    }
+    lines.sort_unstable();
+    lines.dedup();
+    lines
+}
+
 /// One drive of an axis: its bus, its index in the master's node order, the drive.
 #[derive(Clone, Debug)]
 pub struct AxisDrive {

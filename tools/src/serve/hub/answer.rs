@@ -218,9 +218,16 @@ impl Hub<'_> {
         Ok(Some(self.ctl.state()))
     }
 
-    pub(super) fn run(&mut self, who: Asker) -> Result<Option<State>, String> {
+    /// Run the loaded program (`single_block`: with a stop before each block, as `step`
+    /// starts it).
+    pub(super) fn run(&mut self, who: Asker, single_block: bool) -> Result<Option<State>, String> {
         let mut next = self.ctl;
-        next.command(Command::Run).map_err(|e| e.to_string())?;
+        let c = if single_block {
+            Command::Step
+        } else {
+            Command::Run
+        };
+        next.command(c).map_err(|e| e.to_string())?;
         self.stand_here(None);
         let Some(loaded) = self.loaded.as_ref() else {
             return Err("run: no program is loaded".into());
@@ -234,7 +241,12 @@ impl Hub<'_> {
         for e in entries.by_ref() {
             all.push(e.map_err(|e| format!("run {name}:{e}"))?);
         }
-        let program = work::from_here(&all, entries.tilt_word(), &self.standing, self.setup);
+        let mut program = work::from_here(&all, entries.tilt_word(), &self.standing, self.setup);
+        self.block_stops = if single_block {
+            work::stop_before_each_block(&mut program)
+        } else {
+            Vec::new()
+        };
         let planned =
             work::plan(&program, self.setup, self.depth).map_err(|e| format!("run {name}: {e}"))?;
         self.hand_over(who, next, Kind::Program, planned);
@@ -293,6 +305,7 @@ impl Hub<'_> {
         }
         let planned = work::plan(&r.program, self.setup, self.depth)
             .map_err(|e| format!("run {name} from line {line}: {e}"))?;
+        self.block_stops = Vec::new();
         self.message = Some(format!(
             "restarted {name} at line {}: approach over {over}, down to {down}",
             r.line

@@ -143,7 +143,10 @@ fn a_program_runs_only_homed_and_loaded() {
 fn stepping_runs_a_block_then_pauses() {
     let mut c = reach(State::Stepping);
     assert_eq!(c.event(Event::AtRest), State::Paused);
-    assert_eq!(c.command(Command::Resume), Ok(State::Stepping));
+    assert_eq!(c.command(Command::Step), Ok(State::Stepping));
+    assert_eq!(c.event(Event::AtRest), State::Paused);
+    assert_eq!(c.command(Command::Resume), Ok(State::Running), "runs on");
+    c.command(Command::Pause).unwrap();
     assert_eq!(c.command(Command::Stop), Ok(State::Idle));
     c.command(Command::Run).unwrap();
     c.command(Command::Pause).unwrap();
