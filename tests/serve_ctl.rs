@@ -427,3 +427,62 @@ fn check(by_node: &[Vec<(u64, i32)>], skip: &[(u64, u64)]) {
     eprintln!("{checked} of {total} recorded targets checked");
     assert!(checked * 2 > total, "{checked} of {total} checked");
 }
+
+/// The systemd unit's command line, as `config/systemd/dnurbs-serve.service` has it (its
+/// paths moved to a temporary directory, `--sim` added): both sockets answer, the control
+/// one with mode 0660 and the watch one 0666, and SIGTERM ends it cleanly.
+#[test]
+fn the_units_command_line_serves() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = setup();
+    let unit = std::fs::read_to_string(common::root().join("config/systemd/dnurbs-serve.service"))
+        .unwrap();
+    let exec = unit
+        .lines()
+        .find_map(|l| l.strip_prefix("ExecStart="))
+        .expect("an ExecStart= line");
+    let mut words = exec.split_whitespace();
+    assert_eq!(words.next(), Some("/usr/local/bin/dnurbs"));
+    let here = dir.display().to_string();
+    let args: Vec<String> = words
+        .map(|w| {
+            w.replace("/etc/dnurbs/machine.toml", &format!("{here}/machine.toml"))
+                .replace("/run/dnurbs", &here)
+        })
+        .collect();
+    assert_eq!(args[0], "serve");
+    let child = Command::new(env!("CARGO_BIN_EXE_dnurbs"))
+        .args(&args)
+        .arg("--sim")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (control, watch) = (dir.join("control.sock"), dir.join("watch.sock"));
+    let t0 = Instant::now();
+    while !(control.exists() && watch.exists()) {
+        assert!(t0.elapsed() < Duration::from_secs(30), "no sockets");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    assert_eq!((mode(&control), mode(&watch)), (0o660, 0o666));
+    for sock in [&control, &watch] {
+        let out = common::dnurbs(&["ctl", sock.to_str().unwrap(), "status"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let serve = Serve {
+        child,
+        sock: control,
+        record: dir.join("none.csv"),
+    };
+    std::fs::write(
+        &serve.record,
+        "sync,node,target_counts,actual_counts,statusword\n",
+    )
+    .unwrap();
+    serve.end();
+}
