@@ -22,32 +22,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const HOMES: &str = r#"
-[axes.x.home]
-method = "switch"
-direction = "negative"
-position = -5.0
-
-[axes.y.home]
-method = "switch-index"
-direction = "positive"
-position = 4.0
-
-[axes.z.home]
-method = "current"
-position = 2.5
-sequence = 1
-
-[axes.a.home]
-method = "absolute"
-
-[axes.c.home]
-method = "switch"
-direction = "positive"
-position = 3.0
-sequence = 2
-"#;
-
 const PROGRAM: &str = "G90 G21 G17\nG1 X10 Y0 F1200\nG2 X20 Y10 I10 J0\nG1 Y30\nG1 X0\n\
                        G0 Y0\nM30\n";
 
@@ -175,7 +149,7 @@ fn setup() -> PathBuf {
     let dir = common::temp("serve");
     std::fs::create_dir_all(&dir).unwrap();
     let text = common::machine_text("paper-ac-table.toml");
-    std::fs::write(dir.join("machine.toml"), text + HOMES).unwrap();
+    std::fs::write(dir.join("machine.toml"), text + common::SERVE_HOMES).unwrap();
     std::fs::copy(
         common::root().join("config/machines/mill.tbl"),
         dir.join("mill.tbl"),
@@ -484,5 +458,27 @@ fn the_units_command_line_serves() {
         "sync,node,target_counts,actual_counts,statusword\n",
     )
     .unwrap();
+    serve.end();
+}
+
+/// Homing that never finds its switch (X's not wired, `--no-home-switch 1`): the drive's
+/// homing error, named with the axis; the machine stays on, X not homed, and Y homes.
+#[test]
+fn a_homing_that_finds_no_switch_says_why() {
+    let dir = setup();
+    let serve = Serve::start(&dir, &["--no-home-switch", "1"]);
+    assert_eq!(serve.ok(&["on"]), "on");
+    assert_eq!(serve.ok(&["home", "X"]), "homing");
+    let s = serve.until("on");
+    let m = s["message"].as_str().unwrap();
+    assert!(
+        m.contains("homing X failed") && m.contains("did not find its switch"),
+        "{s}"
+    );
+    assert_eq!(s["homed"], serde_json::json!(["A"]));
+    assert_eq!(serve.ok(&["home", "Y"]), "homing");
+    let s = serve.until("on");
+    assert_eq!(s["homed"], serde_json::json!(["Y", "A"]));
+    serve.refused(&["run"], "not every axis is homed");
     serve.end();
 }

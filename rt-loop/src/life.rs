@@ -40,6 +40,7 @@ use drives::master::ResetRefused;
 use drives::master::{BusCondition, DriveFault, HomeRefused, HomeRequest, HomingError};
 use heapless::spsc::{Consumer, Producer, Queue};
 use nc_follow::jog::{Jog, JogLimits, JogRefused};
+use nc_follow::jog_line::{LineJog, LineRefused};
 use nc_follow::{Follower, Start};
 
 /// Slots of the order queue (it holds one fewer).
@@ -75,6 +76,16 @@ pub enum Order {
         target: f64,
         speed: f64,
     },
+    /// Jog X Y Z together along `dir` (machine X Y Z, any length), the rotary axes still:
+    /// the workpiece's X, Y or Z, or the tool axis ([`nc_follow::jog_line`]).
+    /// `distance`: incremental, that far at up to `speed`; none: continuous at `speed`
+    /// (signed), renewed by the same order again.
+    LineJog {
+        dir: [f64; 3],
+        limits: [JogLimits; 3],
+        distance: Option<f64>,
+        speed: f64,
+    },
     /// Run the program (or MDI line) whose chunks the planner feeds from now on; it starts
     /// where the drives stand.
     Program { start: Start },
@@ -97,6 +108,7 @@ impl Order {
             Order::Home { .. } => "home",
             Order::Jog { .. } => "jog",
             Order::JogTo { .. } => "jog to",
+            Order::LineJog { .. } => "jog along a line",
             Order::Program { .. } => "program",
             Order::Run(Command::Pause) => "pause",
             Order::Run(Command::Resume) => "resume",
@@ -136,6 +148,7 @@ pub enum Happened {
     /// A jog started (or a continuous one was renewed).
     JogStarted,
     JogRefused(JogRefused),
+    LineJogRefused(LineRefused),
     /// A jog came to rest; `limited`: short of the travel.
     JogDone {
         limited: bool,
@@ -282,6 +295,9 @@ enum Doing {
         axis: usize,
         jog: Jog,
     },
+    LineJog {
+        jog: LineJog,
+    },
     Program,
     Disabling {
         cycles: u64,
@@ -353,7 +369,7 @@ impl<'q, L: CanLink> Life<'q, L> {
             Doing::Enabling { .. } => Mode::Enabling,
             Doing::Holding => Mode::Holding,
             Doing::Homing { .. } => Mode::Homing,
-            Doing::Jog { .. } => Mode::Jog,
+            Doing::Jog { .. } | Doing::LineJog { .. } => Mode::Jog,
             Doing::Program => Mode::Program,
             Doing::Disabling { .. } => Mode::Disabling,
             Doing::Fault => Mode::Fault,
@@ -476,6 +492,30 @@ impl<'q, L: CanLink> Life<'q, L> {
                 },
                 Doing::Holding,
             ) => self.jog(axis, limits, |j| j.to(target, speed)),
+            (
+                Order::LineJog {
+                    dir,
+                    limits,
+                    distance,
+                    speed,
+                },
+                Doing::Holding,
+            ) => self.line_jog(dir, &limits, distance, speed),
+            (
+                Order::LineJog {
+                    distance: None,
+                    speed,
+                    dir,
+                    ..
+                },
+                Doing::LineJog { mut jog },
+            ) if same_direction(jog.direction(), dir) => match jog.velocity(speed) {
+                Ok(()) => {
+                    self.doing = Doing::LineJog { jog };
+                    self.report(Happened::JogStarted);
+                }
+                Err(e) => self.report(Happened::LineJogRefused(e)),
+            },
             (Order::Program { start }, Doing::Holding) => self.program(start),
             (Order::Run(c), Doing::Program) => {
                 if let Parts::Running(p) = &mut self.parts {
@@ -491,6 +531,10 @@ impl<'q, L: CanLink> Life<'q, L> {
             (Order::Stop, Doing::Jog { axis, mut jog }) => {
                 jog.stop();
                 self.doing = Doing::Jog { axis, jog };
+            }
+            (Order::Stop, Doing::LineJog { mut jog }) => {
+                jog.stop();
+                self.doing = Doing::LineJog { jog };
             }
             (Order::Stop, Doing::Homing { jobs, n }) => {
                 for &(bus, index) in jobs.iter().take(n) {
@@ -559,4 +603,10 @@ impl<'q, L: CanLink> Life<'q, L> {
             None => Doing::Off,
         };
     }
+}
+
+/// `a` and `b` (any lengths) point the same way (a renewal of the same line jog).
+fn same_direction(a: [f64; 3], b: [f64; 3]) -> bool {
+    let n = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+    n > 0.0 && (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / n > 1.0 - 1e-12
 }

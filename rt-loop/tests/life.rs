@@ -345,6 +345,21 @@ fn an_operators_session_with_the_drives_on_throughout() {
     s.until(2000, |h| matches!(h, Happened::JogDone { .. }));
     assert!((s.axes()[0] - (x0 + 10.0)).abs() < 1e-6, "{:?}", s.axes());
 
+    // Along a line of X Y Z (the workpiece's diagonal, say): 5 mm, both axes their share.
+    let before = s.axes();
+    s.order(Order::LineJog {
+        dir: [1.0, 1.0, 0.0],
+        limits: [limits(0), limits(1), limits(2)],
+        distance: Some(5.0),
+        speed: 40.0,
+    });
+    s.until(2000, |h| matches!(h, Happened::JogDone { .. }));
+    let after = s.axes();
+    let share = 5.0 / 2f64.sqrt();
+    assert!((after[0] - before[0] - share).abs() < 1e-6, "{after:?}");
+    assert!((after[1] - before[1] - share).abs() < 1e-6, "{after:?}");
+    assert_eq!(after[2], before[2]);
+
     // A program from where the machine stands, paused and resumed.
     let a = s.axes();
     let src = format!(

@@ -551,3 +551,32 @@ pub fn assert_within_limits(s: &serde_json::Value) {
         "{s}"
     );
 }
+
+/// Home tables for the paper machine's axes, one of each method the simulated drives offer:
+/// X on a switch, Y on a switch and the index pulse together with it, Z where it stands,
+/// A absolute, C on a switch, in three sequence groups (`dnurbs serve`'s tests).
+pub const SERVE_HOMES: &str = r#"
+[axes.x.home]
+method = "switch"
+direction = "negative"
+position = -5.0
+
+[axes.y.home]
+method = "switch-index"
+direction = "positive"
+position = 4.0
+
+[axes.z.home]
+method = "current"
+position = 2.5
+sequence = 1
+
+[axes.a.home]
+method = "absolute"
+
+[axes.c.home]
+method = "switch"
+direction = "positive"
+position = 3.0
+sequence = 2
+"#;

@@ -259,6 +259,10 @@ pub enum Command {
         /// NODE sends nothing from SYNC count N on (a broken cable).
         #[arg(long, value_name = "NODE:N", value_parser = simdrives::node_value::<u64>)]
         silent_from: Vec<(u8, u64)>,
+        /// NODE's home switch is not wired: its homing search fails with the drive's
+        /// homing error after a tenth of the axis's travel.
+        #[arg(long, value_name = "NODE")]
+        no_home_switch: Vec<u8>,
     },
     /// Measure this computer's real-time wake-up latency (like cyclictest).
     ///
@@ -411,6 +415,11 @@ pub enum CtlCommand {
         /// Speed, mm/s or degrees/s (default a tenth of the axis's velocity limit).
         #[arg(long)]
         speed: Option<f64>,
+        /// `machine`: the axis itself; `work`: the workpiece's X, Y or Z at the table's
+        /// angles; `tool`: along the tool axis (axis Z). For work and tool X Y Z move
+        /// together, the rotary axes still.
+        #[arg(long, default_value = "machine", value_parser = ["machine", "work", "tool"])]
+        frame: String,
         /// A continuous jog lasts this long, then ctl lets go, 1ms..=1h.
         #[arg(long = "for", default_value = "1s", value_parser = hold, conflicts_with = "step")]
         hold_ns: u64,

@@ -149,6 +149,7 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
             never_boots,
             drop_every,
             silent_from,
+            no_home_switch,
         } => {
             let machine = crate::load_machine(&machine)?;
             simdrives::run(simdrives::SimArgs {
@@ -163,6 +164,7 @@ pub fn dispatch(command: Command) -> anyhow::Result<Outcome> {
                     never_boots,
                     drop_every,
                     silent_from,
+                    no_home_switch,
                 },
             })?;
             Ok(Outcome::Completed)

@@ -23,6 +23,8 @@ pub struct FaultArgs {
     pub never_boots: Vec<u8>,
     pub drop_every: Vec<(u8, u32)>,
     pub silent_from: Vec<(u8, u64)>,
+    /// Nodes whose home switch is not wired (a search fails after a tenth of the travel).
+    pub no_home_switch: Vec<u8>,
 }
 
 impl FaultArgs {
@@ -89,6 +91,10 @@ pub fn sim_nodes(
                 };
                 let counts = (2.0 * span * d.counts_per_unit).min(f64::from(u32::MAX));
                 c.home.search_limit = c.home.search_limit.max(counts as u32);
+                if faults.no_home_switch.contains(&d.node) {
+                    c.home.switch = None;
+                    c.home.search_limit = (0.1 * span * d.counts_per_unit).max(1.0) as u32;
+                }
             }
             c.lag_s = lag_s;
             c.faults = faults.for_node(d.node);

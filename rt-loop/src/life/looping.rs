@@ -62,7 +62,9 @@ impl<L: CanLink> Life<'_, L> {
                     p.command(Command::Stop);
                 }
             }
-            Doing::Jog { .. } | Doing::Homing { .. } => self.order(Order::Stop),
+            Doing::Jog { .. } | Doing::LineJog { .. } | Doing::Homing { .. } => {
+                self.order(Order::Stop)
+            }
             Doing::Holding => self.order(Order::Off),
             Doing::Enabling { .. } => self.doing = Doing::Disabling { cycles: 0 },
             Doing::Disabling { .. } => {}

@@ -6,6 +6,7 @@ use drives::cia402::{Goal, State};
 use drives::link::CanLink;
 use drives::master::{HomeRefused, HomeRequest, HomingState, NodeKind, Reaction, MAX_NODES};
 use nc_follow::jog::{Jog, JogLimits, JogRefused};
+use nc_follow::jog_line::LineJog;
 
 impl<L: CanLink> Life<'_, L> {
     /// A period outside a program: the mode's targets, then every master's cycle.
@@ -44,6 +45,20 @@ impl<L: CanLink> Life<'_, L> {
                     Doing::Jog { axis, jog }
                 }
             }
+            Doing::LineJog { mut jog } => {
+                let p = jog.step();
+                for (axis, &x) in p.iter().enumerate() {
+                    self.set_axis(axis, x);
+                }
+                if jog.at_rest() {
+                    self.report(Happened::JogDone {
+                        limited: jog.limited(),
+                    });
+                    Doing::Holding
+                } else {
+                    Doing::LineJog { jog }
+                }
+            }
             Doing::Disabling { cycles } => {
                 self.set_goal(Goal::Disabled);
                 let out = |s: State| s != State::OperationEnabled;
@@ -68,10 +83,17 @@ impl<L: CanLink> Life<'_, L> {
         }
         if let Some(c) = condition {
             // A jog is an operator's move: anything worse than a warning stops it.
-            if let Doing::Jog { axis, mut jog } = self.doing {
-                if c.reaction() != Reaction::Warn {
-                    jog.stop();
-                    self.doing = Doing::Jog { axis, jog };
+            if c.reaction() != Reaction::Warn {
+                match self.doing {
+                    Doing::Jog { axis, mut jog } => {
+                        jog.stop();
+                        self.doing = Doing::Jog { axis, jog };
+                    }
+                    Doing::LineJog { mut jog } => {
+                        jog.stop();
+                        self.doing = Doing::LineJog { jog };
+                    }
+                    _ => {}
                 }
             }
             self.report(Happened::Bus(c));
@@ -178,6 +200,39 @@ impl<L: CanLink> Life<'_, L> {
                 self.report(Happened::JogStarted);
             }
             Err(e) => self.report(Happened::JogRefused(e)),
+        }
+    }
+
+    /// Start a jog of X Y Z along `dir` from where their targets are.
+    pub(super) fn line_jog(
+        &mut self,
+        dir: [f64; 3],
+        limits: &[JogLimits; 3],
+        distance: Option<f64>,
+        speed: f64,
+    ) {
+        let origin = [0, 1, 2].map(|a| self.axis_target(a));
+        let [Some(x), Some(y), Some(z)] = origin else {
+            self.report(Happened::Refused {
+                order: "jog along a line",
+                mode: self.mode(),
+            });
+            return;
+        };
+        let started = LineJog::new([x, y, z], dir, limits, self.period, self.deadman_periods)
+            .and_then(|mut jog| {
+                match distance {
+                    Some(d) => jog.to(d, speed)?,
+                    None => jog.velocity(speed)?,
+                }
+                Ok(jog)
+            });
+        match started {
+            Ok(jog) => {
+                self.doing = Doing::LineJog { jog };
+                self.report(Happened::JogStarted);
+            }
+            Err(e) => self.report(Happened::LineJogRefused(e)),
         }
     }
 

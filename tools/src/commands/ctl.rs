@@ -107,9 +107,10 @@ pub fn ctl(socket: &Path, command: CtlCommand) -> anyhow::Result<Outcome> {
             dir,
             step,
             speed,
+            frame,
             ..
         } => {
-            let mut j = json!({"cmd": "jog", "axis": axis, "dir": dir});
+            let mut j = json!({"cmd": "jog", "axis": axis, "dir": dir, "frame": frame});
             if let Some(s) = step {
                 j["step"] = json!(s);
             }

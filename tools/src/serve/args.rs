@@ -31,6 +31,10 @@ pub struct ServeArgs {
     /// With --sim: drive fault (EMCY 0x8611, statusword Fault) on NODE at SYNC count N.
     #[arg(long, value_name = "NODE:N", requires = "sim", value_parser = simdrives::node_value::<u64>)]
     pub fault_at: Vec<(u8, u64)>,
+    /// With --sim: NODE's home switch is not wired: its homing search fails with the
+    /// drive's homing error after a tenth of the axis's travel.
+    #[arg(long, value_name = "NODE", requires = "sim")]
+    pub no_home_switch: Vec<u8>,
     /// Run without mlockall and SCHED_FIFO (development machines; timing not guaranteed).
     #[arg(long)]
     pub no_rt: bool,
@@ -75,6 +79,7 @@ impl ServeArgs {
             record: self.record,
             faults: FaultArgs {
                 fault_at: self.fault_at,
+                no_home_switch: self.no_home_switch,
                 ..FaultArgs::default()
             },
             rt,

@@ -12,7 +12,7 @@
 //! once it has answered; until then no other request of that kind is taken. A refusal
 //! changes nothing.
 
-use super::protocol::{Axis, Reply, Request};
+use super::protocol::{Axis, Frame, Reply, Request};
 use super::state::{Command, Controller, Event, State};
 use super::work::{self, AxisDrive, Homing, Planned};
 use crate::setup::MachineSetup;
@@ -27,6 +27,7 @@ use rt_loop::life::{Happened, Order, Status};
 use serde::Serialize;
 
 mod answer;
+mod jog_line;
 mod step;
 
 /// Who asked: the client's connection and the request's id.
@@ -58,6 +59,7 @@ enum Kind {
 /// The continuous jog under way: a renewal is the same request again.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct JogKey {
+    frame: Frame,
     joint: usize,
     positive: bool,
     continuous: bool,
@@ -302,7 +304,15 @@ impl<'q> Hub<'q> {
                 positive,
                 step,
                 speed,
+                frame: Frame::Machine,
             } => self.jog(who, axis, positive, step, speed),
+            Request::Jog {
+                axis,
+                positive,
+                step,
+                speed,
+                frame,
+            } => self.line_jog(who, axis, frame, positive, step, speed),
             Request::Mdi(line) => self.mdi(who, &line),
             Request::Load(file) => self.load(&file),
             Request::Run {

@@ -43,6 +43,8 @@ enum RawCmd {
         step: Option<f64>,
         #[serde(default)]
         speed: Option<f64>,
+        #[serde(default)]
+        frame: Option<String>,
     },
     Mdi {
         line: String,
@@ -80,6 +82,19 @@ pub enum Axis {
     C,
 }
 
+/// What a jog moves along.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Frame {
+    /// The machine's axis itself (a joint).
+    Machine,
+    /// The workpiece's X, Y or Z at the table's angles: X Y Z move together, the rotary
+    /// axes still.
+    Work,
+    /// The tool axis (the axis named must be Z): X Y Z move together, the rotary axes
+    /// still, the tool centre point held on the line.
+    Tool,
+}
+
 /// A validated request.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Request {
@@ -96,6 +111,7 @@ pub enum Request {
         positive: bool,
         step: Option<f64>,
         speed: Option<f64>,
+        frame: Frame,
     },
     Mdi(String),
     Load(String),
@@ -189,7 +205,20 @@ impl Request {
                 dir,
                 step,
                 speed,
+                frame,
             } => {
+                let frame = match frame.as_deref() {
+                    None | Some("machine") => Frame::Machine,
+                    Some("work") => Frame::Work,
+                    Some("tool") => Frame::Tool,
+                    Some(other) => {
+                        return Err(bad(
+                            "frame",
+                            format!("{other:?}"),
+                            "must be \"machine\", \"work\" or \"tool\"",
+                        ))
+                    }
+                };
                 let positive = match dir.as_str() {
                     "+" => true,
                     "-" => false,
@@ -200,11 +229,21 @@ impl Request {
                         return Err(bad(key, v.to_string(), "must be a number more than 0"));
                     }
                 }
+                let axis = axis_of(&axis)?;
+                let linear = matches!(axis, Axis::X | Axis::Y | Axis::Z);
+                if (frame == Frame::Work && !linear) || (frame == Frame::Tool && axis != Axis::Z) {
+                    return Err(bad(
+                        "frame",
+                        format!("{frame:?} with axis {axis:?}"),
+                        "work jogs X, Y or Z; tool jogs Z (the tool axis)",
+                    ));
+                }
                 Request::Jog {
-                    axis: axis_of(&axis)?,
+                    axis,
                     positive,
                     step,
                     speed,
+                    frame,
                 }
             }
             RawCmd::Mdi { line } => {

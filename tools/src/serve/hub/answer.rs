@@ -118,6 +118,7 @@ impl Hub<'_> {
     ) -> Result<Option<State>, String> {
         let joint = self.joint(axis)?;
         let key = JogKey {
+            frame: crate::serve::protocol::Frame::Machine,
             joint,
             positive,
             continuous: step.is_none(),
@@ -130,9 +131,9 @@ impl Hub<'_> {
         let sign = if positive { 1.0 } else { -1.0 };
         // The same continuous jog again: the operator still holds the key.
         if self.ctl.state() == State::Jog
-            && self
-                .jog
-                .is_some_and(|k| k.continuous && key.continuous && k.joint == joint)
+            && self.jog.is_some_and(|k| {
+                k.continuous && key.continuous && k.joint == joint && k.frame == key.frame
+            })
         {
             self.send(Order::Jog {
                 axis: joint,
@@ -393,6 +394,9 @@ impl Hub<'_> {
                 self.answer(|w| matches!(w, Waiting::Jog(..)).then_some(Ok(())))
             }
             Happened::JogRefused(e) => self.answer(|w| {
+                matches!(w, Waiting::Jog(..)).then(|| Err(format!("jog refused: {e}")))
+            }),
+            Happened::LineJogRefused(e) => self.answer(|w| {
                 matches!(w, Waiting::Jog(..)).then(|| Err(format!("jog refused: {e}")))
             }),
             Happened::JogDone { limited } => {

@@ -53,7 +53,8 @@ fn every_command_parses() {
             axis: Axis::X,
             positive: true,
             step: Some(10.0),
-            speed: Some(5.0)
+            speed: Some(5.0),
+            frame: Frame::Machine,
         }
     );
     assert_eq!(
@@ -62,9 +63,27 @@ fn every_command_parses() {
             axis: Axis::C,
             positive: false,
             step: None,
-            speed: None
+            speed: None,
+            frame: Frame::Machine,
         }
     );
+    assert_eq!(
+        ok(r#"{"v":1,"cmd":"jog","axis":"Z","dir":"-","frame":"tool","step":2}"#),
+        Request::Jog {
+            axis: Axis::Z,
+            positive: false,
+            step: Some(2.0),
+            speed: None,
+            frame: Frame::Tool,
+        }
+    );
+    for bad in [
+        r#"{"v":1,"cmd":"jog","axis":"X","dir":"+","frame":"tool"}"#,
+        r#"{"v":1,"cmd":"jog","axis":"A","dir":"+","frame":"work"}"#,
+        r#"{"v":1,"cmd":"jog","axis":"X","dir":"+","frame":"table"}"#,
+    ] {
+        assert!(Request::parse(bad).is_err(), "{bad}");
+    }
     assert_eq!(
         ok(r#"{"v":1,"cmd":"mdi","line":" G0 X0 Y0 "}"#),
         Request::Mdi("G0 X0 Y0".into())
