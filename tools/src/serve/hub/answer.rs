@@ -206,11 +206,14 @@ impl Hub<'_> {
             ));
         }
         let text = std::fs::read_to_string(file).map_err(|e| format!("load {file}: {e}"))?;
-        // Read through once: a program that does not parse is not loaded.
-        nc_lang::parse_with(&text, self.shop).map_err(|e| {
-            let first = e.first().map_or(String::new(), |p| p.to_string());
-            format!("load {file}:{first}")
-        })?;
+        // Read through once, as `run` will read it (from where the machine stands, its
+        // first move from there): a program that does not read is not loaded.
+        self.stand_here(None);
+        let mut check = nc_lang::mdi::Mdi::new(self.shop);
+        check.standing(&self.standing, &self.setup.kin);
+        for e in check.into_program(StrLines::new(&text)) {
+            e.map_err(|e| format!("load {file}:{e}"))?;
+        }
         self.loaded = Some(Loaded {
             name: file.to_owned(),
             text,
