@@ -628,3 +628,31 @@ fn check_targets(sent: &[([f64; 5], Mode)], limits: &[config::AxisLimits; 5], pe
         sent.len()
     );
 }
+
+/// A request the real-time thread never answers (its loop not running) is refused after
+/// `WAIT_POLLS` polls, the state unchanged; what it may still do once it runs is undone.
+#[test]
+fn a_request_the_real_time_thread_never_answers_is_refused() {
+    let mut rig = Rig::new();
+    let who = Asker {
+        client: 1,
+        id: Some(1),
+    };
+    assert_eq!(rig.hub.request(who, Request::On), None);
+    let mut answer = None;
+    for _ in 0..=dnurbs_tools::serve::hub::WAIT_POLLS {
+        if let Some((_, r)) = rig.hub.poll().into_iter().next() {
+            answer = Some(r);
+            break;
+        }
+    }
+    let r = answer.expect("an answer");
+    assert!(!r.ok && r.error.unwrap().contains("did not answer in time"));
+    assert_eq!(rig.hub.state().name(), "off");
+    // The loop runs again: the late `on` is followed by the `off` sent with the refusal.
+    for _ in 0..1000 {
+        rig.step();
+    }
+    assert_eq!(rig.life.mode(), Mode::Off);
+    assert_eq!(rig.hub.state().name(), "off");
+}

@@ -461,7 +461,9 @@ impl<'q, L: CanLink> Life<'q, L> {
             }
             (Order::Reset, Doing::Fault) => self.reset(),
             (Order::On, Doing::Off) => self.doing = Doing::Enabling { cycles: 0 },
-            (Order::Off, Doing::Holding) => self.doing = Doing::Disabling { cycles: 0 },
+            (Order::Off, Doing::Holding | Doing::Enabling { .. }) => {
+                self.doing = Doing::Disabling { cycles: 0 }
+            }
             (Order::Home { bus, index, req }, Doing::Holding | Doing::Homing { .. }) => {
                 self.home(bus, index, req)
             }
@@ -547,9 +549,13 @@ impl<'q, L: CanLink> Life<'q, L> {
 
     /// Start a program from where the drives stand.
     fn program(&mut self, start: Start) {
-        let Parts::Free { buses, follower } = core::mem::replace(&mut self.parts, Parts::Moving)
-        else {
-            return;
+        let (buses, follower) = match core::mem::replace(&mut self.parts, Parts::Moving) {
+            Parts::Free { buses, follower } => (buses, follower),
+            // Cannot be (a program starts only from holding): put it back as it was.
+            other => {
+                self.parts = other;
+                return;
+            }
         };
         let follower = follower.next_program(start);
         match Pipeline::from_here(
@@ -579,8 +585,12 @@ impl<'q, L: CanLink> Life<'q, L> {
     /// The pipeline finished: the parts come back, the drives hold where the path ended
     /// (or, after a fault, the master has quick-stopped them).
     fn program_over(&mut self) {
-        let Parts::Running(p) = core::mem::replace(&mut self.parts, Parts::Moving) else {
-            return;
+        let p = match core::mem::replace(&mut self.parts, Parts::Moving) {
+            Parts::Running(p) => p,
+            other => {
+                self.parts = other;
+                return;
+            }
         };
         let reason = p.reason();
         let line = p.stop_line().unwrap_or(0);

@@ -30,6 +30,10 @@ mod answer;
 mod jog_line;
 mod step;
 
+/// Polls a request waits for the real-time thread's answer before it is refused (the
+/// thread answers within a period or two; serve polls every millisecond at most).
+pub const WAIT_POLLS: u64 = 10_000;
+
 /// Who asked: the client's connection and the request's id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Asker {
@@ -119,6 +123,8 @@ pub struct Hub<'q> {
     homing_left: usize,
     homing_failed: Option<String>,
     waiting: Option<(Asker, Waiting)>,
+    /// Polls the request waiting has waited.
+    waited: u64,
     answers: Vec<(Asker, Reply)>,
     /// The program or line planned, waiting for the thread to take it; then its chunks.
     next: Option<Planned>,
@@ -172,6 +178,7 @@ impl<'q> Hub<'q> {
             homing_left: 0,
             homing_failed: None,
             waiting: None,
+            waited: 0,
             answers: Vec::new(),
             next: None,
             source: Vec::new().into_iter(),
@@ -257,7 +264,33 @@ impl<'q> Hub<'q> {
         }
         self.feeder.feed(&mut self.source);
         self.watch_stops();
+        self.give_up_waiting();
         std::mem::take(&mut self.answers)
+    }
+
+    /// A request the real-time thread has not answered in [`WAIT_POLLS`] polls is refused;
+    /// whatever it may still start is stopped (a program gets no chunks).
+    fn give_up_waiting(&mut self) {
+        let Some((who, waiting)) = self.waiting else {
+            self.waited = 0;
+            return;
+        };
+        self.waited += 1;
+        if self.waited <= WAIT_POLLS {
+            return;
+        }
+        self.waiting = None;
+        self.waited = 0;
+        self.next = None;
+        self.send(Order::Stop);
+        if matches!(waiting, Waiting::On(_)) {
+            // Should it enable the drives after all, they are disabled again.
+            self.send(Order::Off);
+        }
+        let why = "the real-time thread did not answer in time (is it running?): stopped; \
+                   check the status";
+        self.message = Some(why.into());
+        self.answers.push((who, Reply::refused(who.id, why)));
     }
 
     fn send(&mut self, o: Order) {
