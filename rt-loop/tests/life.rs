@@ -290,6 +290,41 @@ fn an_operators_session_with_the_drives_on_throughout() {
     );
     assert_eq!(s.life.mode(), Mode::Holding);
 
+    // The operator stops a homing under way (Z searching again): not homed, the drive back
+    // in cyclic synchronous position where it stands, and it holds there.
+    s.order(Order::Home {
+        bus: 0,
+        index: 2,
+        req: home(19, 0.0),
+    });
+    for _ in 0..200 {
+        s.period();
+    }
+    assert_eq!(s.life.mode(), Mode::Homing);
+    s.order(Order::Stop);
+    let h = s.until(500, |h| matches!(h, Happened::HomingFailed { .. }));
+    assert!(
+        matches!(
+            h,
+            Happened::HomingFailed {
+                index: 2,
+                error: HomingError::Stopped,
+                ..
+            }
+        ),
+        "{h:?}"
+    );
+    assert_eq!(s.life.mode(), Mode::Holding);
+    for _ in 0..20 {
+        s.period();
+    }
+    let actual = |s: &Session| s.life.buses()[0].master.status()[2].actual;
+    let z = actual(&s);
+    for _ in 0..100 {
+        s.period();
+    }
+    assert_eq!(actual(&s), z, "the drive holds where the stop left it");
+
     // Continuous jog of X at 50 mm/s, renewed every 20 periods for 300, then the client
     // vanishes: the jog stops within the dead-man and the stop from 50 mm/s.
     s.order(Order::Jog {
