@@ -226,6 +226,8 @@ pub struct Status {
     mode: AtomicU8,
     /// Periods the life has run ([`Life::cycle`] calls); each sends one SYNC a bus.
     cycles: AtomicU64,
+    /// Reports lost because their queue was full ([`Life::lost`]).
+    lost: AtomicU64,
     /// The targets sent, per axis (mm, degrees), as f64 bits.
     axes: [AtomicU64; 5],
     /// The program's progress while one runs.
@@ -239,6 +241,10 @@ impl Status {
 
     pub fn cycles(&self) -> u64 {
         self.cycles.load(Relaxed)
+    }
+
+    pub fn lost(&self) -> u64 {
+        self.lost.load(Relaxed)
     }
 
     pub fn axes(&self) -> [f64; 5] {
@@ -410,6 +416,7 @@ impl<'q, L: CanLink> Life<'q, L> {
     pub fn publish(&self, status: &Status) {
         status.mode.store(self.mode().index(), Relaxed);
         status.cycles.store(self.cycles, Relaxed);
+        status.lost.store(self.lost, Relaxed);
         let mut axes = [0.0; 5];
         for b in self.buses() {
             for (d, t) in b.drives.iter().zip(&b.targets) {

@@ -373,7 +373,8 @@ pub enum CtlCommand {
     /// Print the state: for serve, the machine's state, homed axes, axes, program line,
     /// override, the last message (one JSON line); for a run, its stage, line and axes.
     Status {
-        /// Print it again whenever it changes (polled every 200 ms) until the controller
+        /// Print it again every 200 ms when it has changed (under serve it always has: its
+        /// periods count) until the controller
         /// ends (Ctrl-C to leave).
         #[arg(long)]
         watch: bool,
@@ -449,7 +450,8 @@ pub enum CtlCommand {
         #[arg(long, requires = "from_line")]
         confirm: bool,
     },
-    /// serve: single block (not built in serve yet: refused with the reason).
+    /// serve: single block: from rest, the loaded program a block at a time (each block ends
+    /// at rest and waits); while it waits, the next block. `resume` runs on.
     Step,
     /// serve: acknowledge a fault or the e-stop (the CiA-402 fault-reset edge); the drives
     /// end disabled.

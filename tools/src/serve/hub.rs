@@ -97,7 +97,8 @@ pub struct StatusBody {
     /// The last fault, refusal of the thread or end of a program, with its reason.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub message: Option<String>,
-    /// Reports of the real-time thread lost to a full queue (0).
+    /// Reports of the real-time thread lost because their queue was full (0 unless the hub
+    /// stalled for 63 reports).
     pub lost: u64,
 }
 
@@ -134,7 +135,6 @@ pub struct Hub<'q> {
     stopping: bool,
     standing: Standing,
     message: Option<String>,
-    lost: u64,
     override_pct: u8,
     /// The lines of the stops single block put before each block of the program under way
     /// (none: it was started with `run`).
@@ -189,7 +189,6 @@ impl<'q> Hub<'q> {
                 tool_length: 0.0,
             },
             message: None,
-            lost: 0,
             override_pct: 100,
             block_stops: Vec::new(),
             released: None,
@@ -242,7 +241,7 @@ impl<'q> Hub<'q> {
             override_pct: self.override_pct,
             cycles: self.status.cycles(),
             message: self.message.clone(),
-            lost: self.lost,
+            lost: self.status.lost(),
         }
     }
 
