@@ -5,8 +5,6 @@ use crate::feed::Input;
 use crate::run::{run_input, RunOptions, RunResult};
 use config::Machine;
 use drives::link::{CanLink, MemLink, SocketLink};
-use rt_loop::os;
-use std::time::Duration;
 
 /// The demo's machine: the paper's machine (its drives on an in-process bus).
 pub const DEMO_MACHINE: &str = include_str!("../../config/machines/paper-ac-table.toml");
@@ -67,27 +65,8 @@ fn demo_on<L: CanLink + Send + 'static>(
     input: Input,
     pair: impl Fn() -> std::io::Result<(L, L)>,
 ) -> anyhow::Result<(RunResult, Vec<drives::sim::Record>)> {
-    let mut links = Vec::new();
-    let mut sims = Vec::new();
-    for bi in 0..machine.buses.len() {
-        let (master_end, drive_end) = pair()?;
-        let nodes = crate::simdrives::sim_nodes(machine, bi, 0.0, &Default::default());
-        // The drives answer within their cycle: with real-time privileges their thread runs
-        // SCHED_FIFO one priority below the controller's, so a loaded host cannot starve it.
-        let below = opts.rt.priority.map(|p| (p - 1).max(1));
-        sims.push(drives::sim::SimThread::start_with(
-            drive_end,
-            nodes,
-            machine.period_s,
-            Duration::from_micros(200),
-            move || {
-                if let Some(p) = below {
-                    let _ = os::set_fifo(p);
-                }
-            },
-        )?);
-        links.push(master_end);
-    }
+    let (links, sims) =
+        crate::simdrives::sim_threads(machine, &Default::default(), opts.rt.priority, pair)?;
     let result = run_input(input, machine, move || Ok(links), opts);
     let records = sims.into_iter().flat_map(|s| s.finish()).collect();
     Ok((result?, records))

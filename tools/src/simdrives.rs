@@ -118,6 +118,57 @@ pub fn sim_nodes(
     nodes
 }
 
+/// The header of a record CSV (`sim-drives --record`, `serve --sim --record`).
+pub const RECORD_HEADER: &str = "sync,node,target_counts,actual_counts,statusword";
+
+/// Write `records` as rows of a record CSV.
+pub fn write_records<'r>(
+    w: &mut impl Write,
+    records: impl IntoIterator<Item = &'r drives::sim::Record>,
+) -> std::io::Result<()> {
+    for r in records {
+        writeln!(
+            w,
+            "{},{},{},{},{}",
+            r.sync, r.node, r.target_counts, r.actual_counts, r.statusword
+        )?;
+    }
+    Ok(())
+}
+
+/// Each bus of `m` on an in-process link (`pair` makes its two ends) to its drives
+/// simulated in a thread of their own, `faults` injected: the master's ends, in bus order,
+/// and the threads. With real-time privileges (`priority`, the controller's) the drives'
+/// thread runs SCHED_FIFO one priority below the controller's, so that a loaded host cannot
+/// starve it (`dnurbs demo`, `dnurbs serve --sim`).
+pub fn sim_threads<L: CanLink + Send + 'static>(
+    m: &config::Machine,
+    faults: &FaultArgs,
+    priority: Option<i32>,
+    pair: impl Fn() -> std::io::Result<(L, L)>,
+) -> anyhow::Result<(Vec<L>, Vec<drives::sim::SimThread>)> {
+    let mut links = Vec::new();
+    let mut sims = Vec::new();
+    for bi in 0..m.buses.len() {
+        let (master_end, drive_end) = pair()?;
+        let nodes = sim_nodes(m, bi, 0.0, faults);
+        let below = priority.map(|p| (p - 1).max(1));
+        sims.push(drives::sim::SimThread::start_with(
+            drive_end,
+            nodes,
+            m.period_s,
+            Duration::from_micros(200),
+            move || {
+                if let Some(p) = below {
+                    let _ = rt_loop::os::set_fifo(p);
+                }
+            },
+        )?);
+        links.push(master_end);
+    }
+    Ok((links, sims))
+}
+
 pub struct SimArgs {
     pub iface: String,
     pub machine: config::Machine,
@@ -153,7 +204,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
                 std::fs::File::create(p)
                     .map_err(|e| anyhow::anyhow!("{}: cannot create: {e}", p.display()))?,
             );
-            writeln!(f, "sync,node,target_counts,actual_counts,statusword")?;
+            writeln!(f, "{RECORD_HEADER}")?;
             f.flush()?;
             Some(f)
         }
@@ -191,13 +242,7 @@ pub fn run(args: SimArgs) -> anyhow::Result<()> {
         {
             last_flush = Instant::now();
             if let Some(w) = record.as_mut() {
-                for r in sim.take_records() {
-                    writeln!(
-                        w,
-                        "{},{},{},{},{}",
-                        r.sync, r.node, r.target_counts, r.actual_counts, r.statusword
-                    )?;
-                }
+                write_records(w, &sim.take_records())?;
                 w.flush()?;
             } else {
                 sim.take_records();

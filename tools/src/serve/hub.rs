@@ -304,9 +304,6 @@ impl<'q> Hub<'q> {
 
     /// The request's work: `Ok(Some)` done (the state now), `Ok(None)` waiting.
     fn take(&mut self, who: Asker, request: Request) -> Result<Option<State>, String> {
-        if request == Request::Status {
-            return Ok(Some(self.ctl.state()));
-        }
         if self.waiting.is_some() && !matches!(request, Request::Estop) {
             return Err(format!(
                 "{}: busy with the last request (the real-time thread has not answered yet): \

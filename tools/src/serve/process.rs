@@ -13,7 +13,7 @@
 
 use super::machine::{Fixed, SIM_QUEUE_FRAMES};
 use super::server::{Listener, Msg};
-use crate::simdrives::{sim_nodes, FaultArgs};
+use crate::simdrives::{sim_threads, write_records, FaultArgs, RECORD_HEADER};
 use anyhow::Context;
 use drives::link::{CanLink, MemLink, SocketLink};
 use drives::master::WallClock;
@@ -60,25 +60,8 @@ pub fn serve(opts: ServeOptions) -> anyhow::Result<()> {
             .map_or(String::new(), |w| format!(", watch socket {}", w.display()))
     );
     if opts.sim {
-        let mut links = Vec::new();
-        let mut sims = Vec::new();
-        for bi in 0..m.buses.len() {
-            let (master_end, drive_end) = MemLink::pair(SIM_QUEUE_FRAMES);
-            let nodes = sim_nodes(m, bi, 0.0, &opts.faults);
-            let below = opts.rt.priority.map(|p| (p - 1).max(1));
-            sims.push(drives::sim::SimThread::start_with(
-                drive_end,
-                nodes,
-                m.period_s,
-                Duration::from_micros(200),
-                move || {
-                    if let Some(p) = below {
-                        let _ = os::set_fifo(p);
-                    }
-                },
-            )?);
-            links.push(master_end);
-        }
+        let pair = || Ok(MemLink::pair(SIM_QUEUE_FRAMES));
+        let (links, sims) = sim_threads(m, &opts.faults, opts.rt.priority, pair)?;
         let r = run(&opts, links, control, watch);
         let records: Vec<_> = sims.into_iter().flat_map(|s| s.finish()).collect();
         if let Some(path) = &opts.record {
@@ -86,14 +69,8 @@ pub fn serve(opts: ServeOptions) -> anyhow::Result<()> {
                 std::fs::File::create(path)
                     .with_context(|| format!("{}: cannot create", path.display()))?,
             );
-            writeln!(f, "sync,node,target_counts,actual_counts,statusword")?;
-            for r in &records {
-                writeln!(
-                    f,
-                    "{},{},{},{},{}",
-                    r.sync, r.node, r.target_counts, r.actual_counts, r.statusword
-                )?;
-            }
+            writeln!(f, "{RECORD_HEADER}")?;
+            write_records(&mut f, &records)?;
             f.flush()?;
         }
         r
